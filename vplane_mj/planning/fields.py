@@ -1,0 +1,69 @@
+"""Khatib's FIRAS potentials and forces (paper eqs. 2-6), as corrected in DESIGN.md section 3.
+
+Positions in metres; potentials and forces are in the planner's own force units
+(the controller maps a force of magnitude 1 to its cruise speed).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+MIN_DISTANCE_M = 1e-3
+"""Distances are clamped to at least this, so no force is ever inf or NaN."""
+
+
+def attractive_potential(position: np.ndarray, goal: np.ndarray, gain: float, radius: float) -> float:
+    """Eq. 2: w|d|^2 for |d| <= r, w(2r|d| - r^2) beyond (continuous at r); d = x - x_goal."""
+    d = float(np.linalg.norm(np.asarray(position, float) - goal))
+    if d <= radius:
+        return gain * d * d
+    return gain * (2.0 * radius * d - radius * radius)
+
+
+def attractive_force(position: np.ndarray, goal: np.ndarray, gain: float, radius: float) -> np.ndarray:
+    """Eq. 3: -grad of eq. 2: -2w d inside r, -2wr d/|d| beyond; zero at the goal."""
+    d = np.asarray(position, float) - np.asarray(goal, float)
+    dist = float(np.hypot(d[0], d[1]))
+    if dist <= radius:
+        return -2.0 * gain * d
+    return -2.0 * gain * radius * d / dist
+
+
+def repulsive_potential(
+    position: np.ndarray, points: np.ndarray, gain: float, influence: float
+) -> float:
+    """Eq. 4 summed over obstacle points: 1/2 eta (1/f - 1/f0)^2 for f <= f0, else 0.
+
+    `points` (N, 2) are obstacle points (sonar echoes); f is clamped to MIN_DISTANCE_M.
+    """
+    f = _distances(position, points)
+    near = f <= influence
+    return float(0.5 * gain * np.sum((1.0 / f[near] - 1.0 / influence) ** 2))
+
+
+def repulsive_force(
+    position: np.ndarray, points: np.ndarray, gain: float, influence: float
+) -> np.ndarray:
+    """Eq. 5 summed over obstacle points: eta (1/f - 1/f0) (1/f^2) (x - x_obs)/f for f <= f0.
+
+    Each sonar echo is one obstacle point, so the force is the negative gradient of
+    `repulsive_potential`; it points away from every point within the influence distance.
+    """
+    pts = np.asarray(points, float).reshape(-1, 2)
+    if len(pts) == 0:
+        return np.zeros(2)
+    rel = np.asarray(position, float) - pts
+    f = np.maximum(np.hypot(rel[:, 0], rel[:, 1]), MIN_DISTANCE_M)
+    near = f <= influence
+    if not np.any(near):
+        return np.zeros(2)
+    f, rel = f[near], rel[near]
+    magnitude = gain * (1.0 / f - 1.0 / influence) / (f * f)
+    # At a clamped distance the direction (x - x_obs)/f is still a unit vector or zero.
+    return (magnitude[:, None] * rel / f[:, None]).sum(axis=0)
+
+
+def _distances(position: np.ndarray, points: np.ndarray) -> np.ndarray:
+    pts = np.asarray(points, float).reshape(-1, 2)
+    rel = np.asarray(position, float) - pts
+    return np.maximum(np.hypot(rel[:, 0], rel[:, 1]), MIN_DISTANCE_M)

@@ -1,0 +1,82 @@
+"""Local-minimum detection: the paper's two criteria, made robust for a wheeled robot.
+
+The paper declares a local minimum when the speed v_r <= v_th, or when the distance
+d_t travelled in a time t is <= d_th. A differential-drive robot has near-zero speed
+while it turns in place, so both criteria are judged over a whole window of
+`window_s` seconds: the largest speed in the window, and the net displacement
+across it. Detection is off for `startup_s` after the start and inside the goal
+tolerance. Once trapped, the robot counts as trapped until it has moved more than
+twice `displacement_m` from where the trap was detected (hysteresis), so one trap
+is one detection.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class MinimumState:
+    """`trapped`: in a local minimum now; `new`: detected this tick; `trapped_for_s`: since when."""
+
+    trapped: bool
+    new: bool
+    trapped_for_s: float
+
+
+class LocalMinimumDetector:
+    """Feeds on (time, position) samples at the control rate; see the module docstring."""
+
+    def __init__(self, window_s: float, displacement_m: float, speed_mps: float, startup_s: float):
+        self.window_s = window_s
+        self.displacement_m = displacement_m
+        self.speed_mps = speed_mps
+        self.startup_s = startup_s
+        self._samples: deque[tuple[float, np.ndarray]] = deque()
+        self._trap_position: np.ndarray | None = None
+        self._trap_time = 0.0
+
+    def reset(self) -> None:
+        """Forget the history (after an escape manoeuvre starts, for instance)."""
+        self._samples.clear()
+        self._trap_position = None
+
+    def update(self, time_s: float, position: np.ndarray, near_goal: bool) -> MinimumState:
+        position = np.array(position, dtype=float)
+        self._samples.append((time_s, position))
+        while self._samples and self._samples[0][0] < time_s - self.window_s - 1e-9:
+            self._samples.popleft()
+
+        if self._trap_position is not None:
+            if near_goal or np.hypot(*(position - self._trap_position)) > 2 * self.displacement_m:
+                self._trap_position = None
+            else:
+                return MinimumState(True, False, time_s - self._trap_time)
+
+        if near_goal or time_s < self.startup_s or not self._window_full(time_s):
+            return MinimumState(False, False, 0.0)
+        if self._slow_throughout() or self._displacement() <= self.displacement_m:
+            self._trap_position = position
+            self._trap_time = time_s
+            return MinimumState(True, True, 0.0)
+        return MinimumState(False, False, 0.0)
+
+    def _window_full(self, time_s: float) -> bool:
+        return time_s - self._samples[0][0] >= self.window_s - 1e-9
+
+    def _displacement(self) -> float:
+        """d_t: net distance (m) between the oldest and newest sample of the window."""
+        return float(np.hypot(*(self._samples[-1][1] - self._samples[0][1])))
+
+    def _slow_throughout(self) -> bool:
+        """v_r <= v_th at every step of the window (speeds from successive samples, m/s)."""
+        times = np.array([t for t, _ in self._samples])
+        points = np.array([p for _, p in self._samples])
+        dt = np.diff(times)
+        if len(dt) == 0 or np.any(dt <= 0):
+            return False
+        speeds = np.hypot(*np.diff(points, axis=0).T) / dt
+        return bool(np.max(speeds) <= self.speed_mps)

@@ -1,0 +1,52 @@
+"""Planner parameters as data: each has a default, a unit, bounds and a one-line meaning."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True)
+class Param:
+    """One numeric planner parameter. Bounds are exclusive (`gt`) or inclusive (`ge`, `le`)."""
+
+    default: float
+    unit: str
+    doc: str
+    gt: float | None = None
+    ge: float | None = None
+    le: float | None = None
+    integer: bool = False
+
+    def check(self, value: object) -> str | None:
+        """Return why `value` is unacceptable, or None when it is fine."""
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            return f"must be a number, got {type(value).__name__}"
+        if self.integer and not isinstance(value, int):
+            return f"must be an integer, got {value!r}"
+        if not math.isfinite(value):
+            return f"must be finite, got {value!r}"
+        if self.gt is not None and not value > self.gt:
+            return f"must be greater than {self.gt:g}, got {value!r}"
+        if self.ge is not None and not value >= self.ge:
+            return f"must be at least {self.ge:g}, got {value!r}"
+        if self.le is not None and not value <= self.le:
+            return f"must be at most {self.le:g}, got {value!r}"
+        return None
+
+
+@dataclass(frozen=True)
+class PlannerInfo:
+    """What `vplane-mj list` shows of a planner, and what the scenario validator checks."""
+
+    name: str
+    summary: str
+    citation: str
+    params: Mapping[str, Param] = field(default_factory=dict)
+
+    def resolve(self, overrides: Mapping[str, float]) -> dict[str, float]:
+        """Defaults updated with already-validated overrides."""
+        values = {key: p.default for key, p in self.params.items()}
+        values.update(overrides)
+        return values

@@ -1,0 +1,52 @@
+"""What a planner sees each control tick and what it answers."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Observation:
+    """The planner's whole view of the world: its pose, its goal and its sonar ring.
+
+    `ranges` (m) are measured from the robot's centre along `bearings` (rad, robot
+    frame, counter-clockwise from the heading); NaN means no echo.
+    """
+
+    time_s: float
+    position: np.ndarray
+    yaw: float
+    goal: np.ndarray
+    goal_tolerance: float
+    bearings: np.ndarray
+    ranges: np.ndarray
+
+    def echo_points(self) -> np.ndarray:
+        """World-frame points (N, 2) of the sonar echoes; no-echo readings are dropped."""
+        hit = np.isfinite(self.ranges)
+        angles = self.yaw + self.bearings[hit]
+        r = self.ranges[hit]
+        return self.position + np.column_stack((r * np.cos(angles), r * np.sin(angles)))
+
+    def distance_to_goal(self) -> float:
+        return float(np.hypot(*(self.goal - self.position)))
+
+
+@dataclass
+class Decision:
+    """A planner's answer: the total force (world frame) to follow, and what it is doing.
+
+    `components` names the parts of the force (attractive, repulsive, ...) for the log;
+    `events` are short human-readable notes of what happened this tick;
+    `local_minimum` and `escape_completed` mark a detection and a finished escape.
+    """
+
+    force: np.ndarray
+    mode: str
+    components: dict[str, np.ndarray] = field(default_factory=dict)
+    events: list[str] = field(default_factory=list)
+    local_minimum: bool = False
+    escape_completed: bool = False
+    gave_up: bool = False
