@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import matplotlib.image
@@ -66,14 +67,19 @@ def _add_polyline(scene: mujoco.MjvScene, points: np.ndarray, rgba) -> None:
     stride = max(1, int(np.ceil((len(points) - 1) / MAX_PATH_SEGMENTS)))
     kept = np.vstack([points[::stride], points[-1:]])
     z = MARKER_HEIGHT_M + 0.01
-    for a, b in zip(kept[:-1], kept[1:], strict=True):
+    for a, b in itertools.pairwise(kept):
         if scene.ngeom >= scene.maxgeom:
             return
         geom = scene.geoms[scene.ngeom]
         mujoco.mjv_initGeom(
-            geom, type=mujoco.mjtGeom.mjGEOM_LINE, size=np.zeros(3), pos=np.zeros(3),
-            mat=np.eye(3).flatten(), rgba=np.array(rgba, dtype=np.float32),
+            geom,
+            type=mujoco.mjtGeom.mjGEOM_LINE,
+            size=np.zeros(3),
+            pos=np.zeros(3),
+            mat=np.eye(3).flatten(),
+            rgba=np.array(rgba, dtype=np.float32),
         )
-        mujoco.mjv_connector(geom, mujoco.mjtGeom.mjGEOM_LINE, 4.0, np.array([a[0], a[1], z]),
-                             np.array([b[0], b[1], z]))
+        mujoco.mjv_connector(
+            geom, mujoco.mjtGeom.mjGEOM_LINE, 4.0, np.array([a[0], a[1], z]), np.array([b[0], b[1], z])
+        )
         scene.ngeom += 1

@@ -30,7 +30,7 @@ def robot_geometry() -> dict[str, float]:
         "wheel_radius_m": float(wheel.size[0]),
         "track_m": float(abs(left[1] - right[1])),
         "torque_limit_nm": float(model.actuator("wheel_left").forcerange[1]),
-        "radius_m": footprint_radius(model),
+        "radius_m": round(footprint_radius(model), 9),
     }
 
 

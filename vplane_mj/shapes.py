@@ -198,9 +198,7 @@ class Footprints:
         return best
 
 
-def scene_footprints(
-    obstacles: Iterable[Obstacle], arena_size: Vec2 | None = None
-) -> Footprints:
+def scene_footprints(obstacles: Iterable[Obstacle], arena_size: Vec2 | None = None) -> Footprints:
     """All obstacle pieces, plus the border walls when `arena_size` is given."""
     pieces: list[Piece] = [p for ob in obstacles for p in ob.footprint()]
     if arena_size is not None:

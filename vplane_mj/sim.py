@@ -21,9 +21,11 @@ from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.robot import BASE_BODY, WHEEL_JOINTS, WHEEL_MOTORS, robot_geometry
 from vplane_mj.scenario import Scenario
 from vplane_mj.sonar import SonarRing
-from vplane_mj.world import BORDER_SIDES, ROBOT_PREFIX, SonarLayout, build_model
+from vplane_mj.world import BUMP_SENSOR, OBSTACLES_BODY, ROBOT_PREFIX, SonarLayout, build_model
 
 SUMMARY_FORMAT = 1
+CLEARANCE_BATCH = 200
+"""Positions collected before one vectorised clearance query (2 s at the 100 Hz motor rate)."""
 
 
 @dataclass(frozen=True)
@@ -40,7 +42,7 @@ class Tick:
 
 
 class Observer(Protocol):
-    """Something that watches a run: called at every control tick and once at the end."""
+    """Something that watches a run: every control tick and every event."""
 
     def on_tick(self, tick: Tick) -> None: ...
 
@@ -49,49 +51,67 @@ class Observer(Protocol):
 
 @dataclass
 class RunResult:
-    """The summary of INTERFACE.md section 3 plus the trajectory at control ticks."""
+    """The summary of INTERFACE.md section 3, the path at control ticks and the wheel torques."""
 
     summary: dict
     times: np.ndarray
     positions: np.ndarray
     modes: list[str]
     final_qpos: np.ndarray
+    torques: np.ndarray
+    """(motor updates, 2) left and right wheel torques (N m), one row per motor period."""
     collision_points: list[tuple[float, float]] = field(default_factory=list)
 
 
-class _ContactWatch:
-    """Counts separate contact episodes between robot geoms and obstacle or border geoms."""
+class _CollisionCounter:
+    """Separate contact episodes between the robot and the obstacles body.
 
-    def __init__(self, model: mujoco.MjModel):
-        robot_body = model.body(ROBOT_PREFIX + BASE_BODY).id
-        self.is_robot = np.zeros(model.ngeom, bool)
-        self.is_obstacle = np.zeros(model.ngeom, bool)
-        for g in range(model.ngeom):
-            name = model.geom(g).name
-            if model.body_rootid[model.geom_bodyid[g]] == model.body_rootid[robot_body]:
-                self.is_robot[g] = True
-            elif name.startswith("obstacle") or name in {f"border_{s}" for s in BORDER_SIDES}:
-                self.is_obstacle[g] = True
+    MuJoCo's contact sensor counts the contacts; only when an episode starts are the
+    contacts scanned in Python for the point of impact.
+    """
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData):
+        self.found = data.sensordata[model.sensor_adr[model.sensor(BUMP_SENSOR).id] :][:1]
+        self._obstacles = model.body(OBSTACLES_BODY).id
+        self._geom_body = model.geom_bodyid
+        self._base = model.body(ROBOT_PREFIX + BASE_BODY).id
         self.touching = False
-        self.episodes = 0
+        self.points: list[tuple[float, float]] = []
 
     def update(self, data: mujoco.MjData) -> tuple[float, float] | None:
-        """Check the current contacts; return the contact point when a new episode starts."""
-        if data.ncon == 0:
-            self.touching = False
-            return None
-        geoms = data.contact.geom
-        pairs = (self.is_robot[geoms[:, 0]] & self.is_obstacle[geoms[:, 1]]) | (
-            self.is_obstacle[geoms[:, 0]] & self.is_robot[geoms[:, 1]]
-        )
-        touching = bool(pairs.any())
+        """Return the contact point when a new episode starts, else None."""
+        touching = self.found[0] > 0
         started = touching and not self.touching
         self.touching = touching
-        if started:
-            self.episodes += 1
-            point = data.contact.pos[int(np.argmax(pairs))]
-            return float(point[0]), float(point[1])
-        return None
+        if not started:
+            return None
+        for contact in data.contact[: data.ncon]:
+            if self._obstacles in (self._geom_body[contact.geom[0]], self._geom_body[contact.geom[1]]):
+                point = (float(contact.pos[0]), float(contact.pos[1]))
+                break
+        else:  # unreachable while the sensor and the contact list agree; keep the robot's place
+            point = (float(data.xpos[self._base][0]), float(data.xpos[self._base][1]))
+        self.points.append(point)
+        return point
+
+
+class _Clearance:
+    """Smallest distance from base_link's centre to any obstacle or border (m), batched."""
+
+    def __init__(self, footprints: shapes.Footprints):
+        self._footprints = footprints
+        self._pending: list[np.ndarray] = []
+        self.minimum = math.inf
+
+    def add(self, positions: np.ndarray) -> None:
+        self._pending.append(positions)
+        if sum(len(p) for p in self._pending) >= CLEARANCE_BATCH:
+            self.flush()
+
+    def flush(self) -> None:
+        if self._pending and len(self._footprints):
+            self.minimum = min(self.minimum, float(self._footprints.distance(np.vstack(self._pending)).min()))
+        self._pending.clear()
 
 
 def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> RunResult:
@@ -101,59 +121,68 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
     mujoco.mj_forward(model, data)
     geometry = robot_geometry()
     gains = ControllerGains()
-    layout = SonarLayout.from_spec(scenario.sensors)
+    sensors = scenario.sensors
+    layout = SonarLayout.from_spec(sensors)
     rng = np.random.default_rng(scenario.run.seed)
     sonar = SonarRing(
-        scenario.sensors.count, scenario.sensors.rays_per_sonar, scenario.sensors.range_max,
-        scenario.sensors.noise_std, scenario.sensors.dropout, rng,
+        sensors.count,
+        sensors.rays_per_sonar,
+        sensors.range_max,
+        sensors.noise_std,
+        sensors.dropout,
+        rng,
     )
-    planner = make_planner(scenario.planner, scenario.planner_params)
-    field_of_obstacles = shapes.scene_footprints(
-        scenario.world.obstacles, scenario.world.size if scenario.world.border else None
+    first_ray = model.sensor_adr[model.sensor(ROBOT_PREFIX + "sonar0_ray0").id]
+    rays = data.sensordata[first_ray : first_ray + sensors.count * sensors.rays_per_sonar]
+    planner = make_planner(scenario.planner, scenario.planner_params, geometry["radius_m"])
+    clearance = _Clearance(
+        shapes.scene_footprints(
+            scenario.world.obstacles, scenario.world.size if scenario.world.border else None
+        )
     )
-    contacts = _ContactWatch(model)
+    collisions = _CollisionCounter(model, data)
+    found = collisions.found  # robot-obstacle contact count, a view into sensordata
 
     dt = model.opt.timestep
     motor_steps = max(1, round(1.0 / (gains.motor_rate_hz * dt)))
-    chunks_per_tick = max(1, round(1.0 / (scenario.run.control_hz * dt * motor_steps)))
+    motor_dt = motor_steps * dt
+    chunks_per_tick = max(1, round(1.0 / (scenario.run.control_hz * motor_dt)))
     base = model.body(ROBOT_PREFIX + BASE_BODY).id
     root_dof = model.jnt_dofadr[int(np.flatnonzero(model.jnt_type == mujoco.mjtJoint.mjJNT_FREE)[0])]
-    wheel_dofs = [model.jnt_dofadr[model.joint(ROBOT_PREFIX + j).id] for j in WHEEL_JOINTS]
-    motors = [model.actuator(ROBOT_PREFIX + a).id for a in WHEEL_MOTORS]
-    wheels = [WheelPI(gains.wheel_kp, gains.wheel_ki, geometry["torque_limit_nm"]) for _ in motors]
+    left_dof, right_dof = (model.jnt_dofadr[model.joint(ROBOT_PREFIX + j).id] for j in WHEEL_JOINTS)
+    left_motor, right_motor = (model.actuator(ROBOT_PREFIX + a).id for a in WHEEL_MOTORS)
+    left_pi, right_pi = (
+        WheelPI(gains.wheel_kp, gains.wheel_ki, geometry["torque_limit_nm"]) for _ in range(2)
+    )
+    qvel, ctrl, base_xpos, base_xmat = data.qvel, data.ctrl, data.xpos[base], data.xmat[base]
     goal = np.asarray(scenario.robot.goal, float)
-    sonar_period = 1.0 / scenario.sensors.rate_hz
+    sonar_period = 1.0 / sensors.rate_hz
     next_sonar = 0.0
-    ranges = np.full(scenario.sensors.count, np.nan)
+    ranges = np.full(sensors.count, np.nan)
 
     times: list[float] = []
     positions: list[np.ndarray] = []
     modes: list[str] = []
-    collision_points: list[tuple[float, float]] = []
+    torques: list[tuple[float, float]] = []
     path_length = 0.0
-    min_clearance = math.inf
-    local_minima = 0
-    escapes = 0
-    steps = 0
+    local_minima = escapes = steps = 0
     time_to_goal = None
-    outcome = "timeout"
-    message = ""
+    outcome, message = "timeout", ""
 
     def note(text: str) -> None:
         for observer in observers:
             observer.on_event(data.time, text)
 
     start_wall = time.perf_counter()
-    position = data.xpos[base][:2].copy()
+    position = base_xpos[:2].copy()
+    clearance.add(position[None, :])
     while True:
         if not np.all(np.isfinite(data.qpos)):
             outcome, message = "error", "the simulation diverged (non-finite state)"
             note(message)
             break
-        xmat = data.xmat[base]
-        yaw = math.atan2(xmat[3], xmat[0])
-        distance = float(np.hypot(*(goal - position)))
-        if distance <= scenario.robot.goal_tolerance:
+        yaw = math.atan2(base_xmat[3], base_xmat[0])
+        if math.hypot(goal[0] - position[0], goal[1] - position[1]) <= scenario.robot.goal_tolerance:
             outcome, time_to_goal = "reached", data.time
             note("goal reached")
             break
@@ -161,49 +190,59 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
             note("time limit reached")
             break
         if data.time >= next_sonar - 1e-9:
-            ranges = sonar.read(data.sensordata)
+            ranges = sonar.read(rays)
             next_sonar += sonar_period
-        obs = Observation(
-            time_s=data.time, position=position.copy(), yaw=yaw, goal=goal,
-            goal_tolerance=scenario.robot.goal_tolerance, bearings=layout.bearings, ranges=ranges,
+        decision = planner.step(
+            Observation(
+                time_s=data.time,
+                position=position,
+                yaw=yaw,
+                goal=goal,
+                goal_tolerance=scenario.robot.goal_tolerance,
+                bearings=layout.bearings,
+                ranges=ranges,
+            )
         )
-        decision = planner.step(obs)
         local_minima += decision.local_minimum
         escapes += decision.escape_completed
         for text in decision.events:
             note(text)
-        speed = math.hypot(data.qvel[root_dof], data.qvel[root_dof + 1])
         command = heading_command(float(decision.force[0]), float(decision.force[1]), yaw, gains)
         times.append(data.time)
-        positions.append(position.copy())
+        positions.append(position)
         modes.append(decision.mode)
-        tick = Tick(data.time, position.copy(), yaw, speed, ranges, decision, command)
-        for observer in observers:
-            observer.on_tick(tick)
+        if observers:
+            speed = math.hypot(qvel[root_dof], qvel[root_dof + 1])
+            tick = Tick(data.time, position, yaw, speed, ranges, decision, command)
+            for observer in observers:
+                observer.on_tick(tick)
         if decision.gave_up:
             outcome = "stuck"
             break
 
-        targets = wheel_targets(
+        left_target, right_target = wheel_targets(
             *command, geometry["track_m"], geometry["wheel_radius_m"], gains.max_wheel_speed
         )
-        chunk_positions = np.empty((chunks_per_tick + 1, 2))
-        chunk_positions[0] = position
-        motor_dt = motor_steps * dt
+        trace = np.empty((chunks_per_tick, 2))
+        x, y = position
         for chunk in range(chunks_per_tick):
-            for pi, motor, dof, target in zip(wheels, motors, wheel_dofs, targets, strict=True):
-                data.ctrl[motor] = pi.torque(target, data.qvel[dof], motor_dt)
+            left = left_pi.torque(left_target, qvel[left_dof], motor_dt)
+            right = right_pi.torque(right_target, qvel[right_dof], motor_dt)
+            ctrl[left_motor], ctrl[right_motor] = left, right
+            torques.append((left, right))
             mujoco.mj_step(model, data, nstep=motor_steps)
-            steps += motor_steps
-            chunk_positions[chunk + 1] = data.xpos[base][:2]
-            point = contacts.update(data)
-            if point is not None:
-                collision_points.append(point)
-                note(f"collision at ({point[0]:.2f}, {point[1]:.2f})")
-        position = chunk_positions[-1].copy()
-        path_length += float(np.sum(np.hypot(*np.diff(chunk_positions, axis=0).T)))
-        min_clearance = min(min_clearance, float(field_of_obstacles.distance(chunk_positions).min()))
+            new_x, new_y = base_xpos[0], base_xpos[1]
+            path_length += math.hypot(new_x - x, new_y - y)
+            x, y = trace[chunk] = new_x, new_y
+            if found[0] > 0 or collisions.touching:
+                point = collisions.update(data)
+                if point is not None:
+                    note(f"collision at ({point[0]:.2f}, {point[1]:.2f})")
+        steps += motor_steps * chunks_per_tick
+        clearance.add(trace)
+        position = np.array([x, y])
     wall_time = time.perf_counter() - start_wall
+    clearance.flush()
 
     radius = geometry["radius_m"]
     reached = outcome == "reached"
@@ -214,20 +253,20 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         "seed": scenario.run.seed,
         "outcome": outcome,
         "reached": reached,
-        "success": reached and contacts.episodes == 0,
-        "time_to_goal_s": time_to_goal,
-        "sim_time_s": data.time,
+        "success": reached and not collisions.points,
+        "time_to_goal_s": None if time_to_goal is None else round(time_to_goal, 9),
+        "sim_time_s": round(data.time, 9),
         "steps": steps,
         "physics_dt_s": dt,
         "control_hz": scenario.run.control_hz,
         "wall_time_s": wall_time,
         "path_length_m": path_length,
-        "collisions": contacts.episodes,
-        "min_clearance_m": (min_clearance - radius) if math.isfinite(min_clearance) else None,
+        "collisions": len(collisions.points),
+        "min_clearance_m": None if math.isinf(clearance.minimum) else clearance.minimum - radius,
         "local_minima": local_minima,
         "escapes": escapes,
         "robot_radius_m": radius,
-        "final_distance_to_goal_m": float(np.hypot(*(goal - position))),
+        "final_distance_to_goal_m": math.hypot(goal[0] - position[0], goal[1] - position[1]),
         "message": message,
         "planner_params": planner.params,
         "version": __version__,
@@ -238,5 +277,6 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         positions=np.array(positions).reshape(-1, 2),
         modes=modes,
         final_qpos=data.qpos.copy(),
-        collision_points=collision_points,
+        torques=np.array(torques).reshape(-1, 2),
+        collision_points=collisions.points,
     )

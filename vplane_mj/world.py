@@ -1,7 +1,8 @@
 """Build the MuJoCo world of a scenario with dm_control.mjcf: arena, border, obstacles, robot, sonar.
 
 Element names are predictable: obstacle geoms are `obstacle<i>_<part>` (parts per kind
-in PART_NAMES), border walls `border_<side>`, sonar rays `robot/sonar<k>_ray<j>`.
+in PART_NAMES) and border walls `border_<side>`, all in the static body `obstacles`;
+sonar rays are `robot/sonar<k>_ray<j>`, in order, so their readings are contiguous.
 """
 
 from __future__ import annotations
@@ -20,6 +21,10 @@ from vplane_mj.scenario import Scenario, SensorSpec
 
 OBSTACLE_HEIGHT_M = 0.5
 ROBOT_PREFIX = "robot/"
+OBSTACLES_BODY = "obstacles"
+"""The static body that holds every obstacle and border geom."""
+BUMP_SENSOR = "bump"
+"""Contact sensor: number of contacts between the robot's subtree and the obstacles body."""
 PART_NAMES: dict[type, tuple[str, ...]] = {
     shapes.Box: ("body",),
     shapes.Wall: ("wall",),
@@ -55,13 +60,14 @@ def build_mjcf(scenario: Scenario) -> mjcf.RootElement:
     arena = mjcf.from_path(str(model_path("arena.xml")))
     arena.option.timestep = scenario.run.physics_dt_s
     _size_camera(arena, scenario.world.size)
+    statics = arena.worldbody.add("body", name=OBSTACLES_BODY)
     if scenario.world.border:
         for side, rect in zip(BORDER_SIDES, shapes.border_footprint(scenario.world.size), strict=True):
-            _add_piece(arena.worldbody, f"border_{side}", rect, "border")
+            _add_piece(statics, f"border_{side}", rect, "border")
     for index, obstacle in enumerate(scenario.world.obstacles):
         parts = PART_NAMES[type(obstacle)]
         for part, piece in zip(parts, obstacle.footprint(), strict=True):
-            _add_piece(arena.worldbody, f"obstacle{index}_{part}", piece, "obstacle")
+            _add_piece(statics, f"obstacle{index}_{part}", piece, "obstacle")
 
     robot = mjcf.from_path(str(model_path("robot.xml")))
     robot.model = ROBOT_PREFIX.rstrip("/")
@@ -72,6 +78,15 @@ def build_mjcf(scenario: Scenario) -> mjcf.RootElement:
     frame.pos = (x, y, 0.0)
     yaw = scenario.robot.start_yaw
     frame.quat = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
+    # Counts robot-obstacle contacts inside MuJoCo, so the run loop reads one number per check.
+    arena.sensor.add(
+        "contact",
+        name=BUMP_SENSOR,
+        subtree1=ROBOT_PREFIX + BASE_BODY,
+        body2=OBSTACLES_BODY,
+        data="found",
+        reduce="mindist",
+    )
     return arena
 
 
@@ -108,13 +123,22 @@ def _add_piece(body: mjcf.Element, name: str, piece: shapes.Piece, material: str
     half_z = OBSTACLE_HEIGHT_M / 2
     if isinstance(piece, shapes.Disc):
         body.add(
-            "geom", name=name, type="cylinder", size=(piece.radius, half_z),
-            pos=(*piece.center, half_z), material=material,
+            "geom",
+            name=name,
+            type="cylinder",
+            size=(piece.radius, half_z),
+            pos=(*piece.center, half_z),
+            material=material,
         )
         return
     body.add(
-        "geom", name=name, type="box", size=(*piece.half, half_z),
-        pos=(*piece.center, half_z), euler=(0.0, 0.0, piece.yaw), material=material,
+        "geom",
+        name=name,
+        type="box",
+        size=(*piece.half, half_z),
+        pos=(*piece.center, half_z),
+        euler=(0.0, 0.0, piece.yaw),
+        material=material,
     )
 
 
@@ -136,10 +160,17 @@ def _add_sonar_ring(robot: mjcf.RootElement, spec: SensorSpec) -> None:
             angle = bearing + offset
             name = f"sonar{k}_ray{j}"
             base.add(
-                "site", name=name, pos=pos, size=(0.004,), rgba=(0.1, 0.7, 0.2, 0.6),
+                "site",
+                name=name,
+                pos=pos,
+                size=(0.004,),
+                rgba=(0.1, 0.7, 0.2, 0.6),
                 zaxis=(math.cos(angle), math.sin(angle), 0.0),
             )
             robot.sensor.add(
-                "rangefinder", name=name, site=name, cutoff=spec.range_max,
+                "rangefinder",
+                name=name,
+                site=name,
+                cutoff=spec.range_max,
                 interval=(1.0 / spec.rate_hz, 0.0),
             )

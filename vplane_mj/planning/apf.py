@@ -34,8 +34,7 @@ MINIMUM_PARAMS: dict[str, Param] = {
 INFO = PlannerInfo(
     name="apf",
     summary="Khatib's artificial potential field from the sonar ring, no escape",
-    citation="O. Khatib, Real-time obstacle avoidance for manipulators and mobile robots, "
-    "IJRR 5(1), 1986",
+    citation="O. Khatib, Real-time obstacle avoidance for manipulators and mobile robots, IJRR 5(1), 1986",
     params={**FIELD_PARAMS, **MINIMUM_PARAMS},
 )
 

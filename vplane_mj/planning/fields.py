@@ -29,9 +29,7 @@ def attractive_force(position: np.ndarray, goal: np.ndarray, gain: float, radius
     return -2.0 * gain * radius * d / dist
 
 
-def repulsive_potential(
-    position: np.ndarray, points: np.ndarray, gain: float, influence: float
-) -> float:
+def repulsive_potential(position: np.ndarray, points: np.ndarray, gain: float, influence: float) -> float:
     """Eq. 4 summed over obstacle points: 1/2 eta (1/f - 1/f0)^2 for f <= f0, else 0.
 
     `points` (N, 2) are obstacle points (sonar echoes); f is clamped to MIN_DISTANCE_M.
@@ -41,9 +39,7 @@ def repulsive_potential(
     return float(0.5 * gain * np.sum((1.0 / f[near] - 1.0 / influence) ** 2))
 
 
-def repulsive_force(
-    position: np.ndarray, points: np.ndarray, gain: float, influence: float
-) -> np.ndarray:
+def repulsive_force(position: np.ndarray, points: np.ndarray, gain: float, influence: float) -> np.ndarray:
     """Eq. 5 summed over obstacle points: eta (1/f - 1/f0) (1/f^2) (x - x_obs)/f for f <= f0.
 
     Each sonar echo is one obstacle point, so the force is the negative gradient of

@@ -12,6 +12,7 @@ is one detection.
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from dataclasses import dataclass
 
@@ -35,7 +36,7 @@ class LocalMinimumDetector:
         self.displacement_m = displacement_m
         self.speed_mps = speed_mps
         self.startup_s = startup_s
-        self._samples: deque[tuple[float, np.ndarray]] = deque()
+        self._samples: deque[tuple[float, float, float, float]] = deque()  # t, x, y, speed
         self._trap_position: np.ndarray | None = None
         self._trap_time = 0.0
 
@@ -45,10 +46,16 @@ class LocalMinimumDetector:
         self._trap_position = None
 
     def update(self, time_s: float, position: np.ndarray, near_goal: bool) -> MinimumState:
-        position = np.array(position, dtype=float)
-        self._samples.append((time_s, position))
-        while self._samples and self._samples[0][0] < time_s - self.window_s - 1e-9:
+        x, y = float(position[0]), float(position[1])
+        speed = math.inf  # unknown for the first sample
+        if self._samples:
+            t0, x0, y0, _ = self._samples[-1]
+            if time_s > t0:
+                speed = math.hypot(x - x0, y - y0) / (time_s - t0)
+        self._samples.append((time_s, x, y, speed))
+        while self._samples[0][0] < time_s - self.window_s - 1e-9:
             self._samples.popleft()
+        position = np.array([x, y])
 
         if self._trap_position is not None:
             if near_goal or np.hypot(*(position - self._trap_position)) > 2 * self.displacement_m:
@@ -69,14 +76,12 @@ class LocalMinimumDetector:
 
     def _displacement(self) -> float:
         """d_t: net distance (m) between the oldest and newest sample of the window."""
-        return float(np.hypot(*(self._samples[-1][1] - self._samples[0][1])))
+        _, x0, y0, _ = self._samples[0]
+        _, x1, y1, _ = self._samples[-1]
+        return math.hypot(x1 - x0, y1 - y0)
 
     def _slow_throughout(self) -> bool:
         """v_r <= v_th at every step of the window (speeds from successive samples, m/s)."""
-        times = np.array([t for t, _ in self._samples])
-        points = np.array([p for _, p in self._samples])
-        dt = np.diff(times)
-        if len(dt) == 0 or np.any(dt <= 0):
-            return False
-        speeds = np.hypot(*np.diff(points, axis=0).T) / dt
-        return bool(np.max(speeds) <= self.speed_mps)
+        samples = iter(self._samples)
+        next(samples)  # the oldest sample's speed belongs to the step before the window
+        return max(s[3] for s in samples) <= self.speed_mps

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -25,7 +26,7 @@ class Param:
             return f"must be a number, got {type(value).__name__}"
         if self.integer and not isinstance(value, int):
             return f"must be an integer, got {value!r}"
-        if not math.isfinite(value):
+        if (isinstance(value, int) and abs(value) > sys.float_info.max) or not math.isfinite(value):
             return f"must be finite, got {value!r}"
         if self.gt is not None and not value > self.gt:
             return f"must be greater than {self.gt:g}, got {value!r}"

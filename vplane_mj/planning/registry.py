@@ -1,20 +1,31 @@
-"""The planners a scenario can name, with their parameter tables."""
+"""The planners a scenario can name, with their parameter tables and constructors."""
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
+from typing import Protocol
 
-from vplane_mj.planning import apf
+from vplane_mj.planning import apf, vplane
 from vplane_mj.planning.params import PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
 
-Planner = Callable[[Observation], Decision]
 
-PLANNERS: dict[str, tuple[PlannerInfo, Callable[[Mapping[str, float]], object]]] = {
-    apf.INFO.name: (apf.INFO, apf.ApfPlanner),
+class Planner(Protocol):
+    """A planner: resolved parameters, and one decision per control tick."""
+
+    params: dict[str, float]
+
+    def step(self, obs: Observation) -> Decision: ...
+
+
+Factory = Callable[[Mapping[str, float], float], Planner]
+
+PLANNERS: dict[str, tuple[PlannerInfo, Factory]] = {
+    apf.INFO.name: (apf.INFO, lambda params, _radius: apf.ApfPlanner(params)),
+    vplane.INFO.name: (vplane.INFO, vplane.VPlanePlanner),
 }
 
-DEFAULT_PLANNER = "vplane"
+DEFAULT_PLANNER = vplane.INFO.name
 
 
 def planner_info(name: str) -> PlannerInfo:
@@ -22,7 +33,7 @@ def planner_info(name: str) -> PlannerInfo:
     return PLANNERS[name][0]
 
 
-def make_planner(name: str, params: Mapping[str, float]):
-    """A fresh planner `name` with its parameters resolved against the defaults."""
+def make_planner(name: str, params: Mapping[str, float], robot_radius_m: float) -> Planner:
+    """A fresh planner `name`, its parameters resolved against the defaults."""
     info, factory = PLANNERS[name]
-    return factory(info.resolve(params))
+    return factory(info.resolve(params), robot_radius_m)

@@ -1,0 +1,25 @@
+"""Shared fixtures: scenarios from text, and quick access to the shipped ones."""
+
+import pytest
+
+from vplane_mj.scenario import load_scenario, parse_scenario
+
+
+@pytest.fixture
+def scenario_from():
+    """Build a Scenario from TOML text (validated like a file)."""
+
+    def build(text: str, overrides=()):
+        return parse_scenario(text, "test.toml", list(overrides))
+
+    return build
+
+
+@pytest.fixture
+def shipped():
+    """Load a shipped scenario by name, with optional --set style overrides."""
+
+    def load(name: str, *overrides: str):
+        return load_scenario(name, list(overrides))
+
+    return load

@@ -1,0 +1,152 @@
+"""The command line of INTERFACE.md section 2: outputs, exit codes, and nothing written on bad input."""
+
+import json
+import subprocess
+import sys
+
+import matplotlib.image
+import mujoco
+import numpy as np
+import pytest
+
+from vplane_mj.cli import main
+
+BAD_SCENARIO = """
+format = 1
+name = "bad"
+[world]
+size = [4.0, 4.0]
+[[world.obstacles]]
+kind = "u"
+center = [2.0, 2.0]
+width = 0.08
+depth = 1.0
+[robot]
+start = [0.5, 0.5]
+goal = [3.5, 3.5]
+"""
+
+
+def run_cli(capsys, *argv):
+    code = main(list(argv))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_run_writes_summary_and_render_and_exits_0_on_reach(tmp_path, capsys):
+    code, out, _ = run_cli(capsys, "run", "open_field", "--planner", "apf", "--out", str(tmp_path))
+    assert code == 0
+    summary = json.loads((tmp_path / "open_field-apf-0.json").read_text())
+    assert summary["format"] == 1 and summary["reached"] and summary["outcome"] == "reached"
+    image = matplotlib.image.imread(tmp_path / "open_field-apf-0.png")
+    assert image.shape[0] >= 500 and image.shape[1] >= 500
+    assert "reached" in out and str(tmp_path / "open_field-apf-0.json") in out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["open_field-apf-0.json", "open_field-apf-0.png"]
+
+
+def test_render_shows_the_path_in_its_colour(tmp_path, capsys):
+    run_cli(capsys, "run", "open_field", "--planner", "apf", "--out", str(tmp_path))
+    image = matplotlib.image.imread(tmp_path / "open_field-apf-0.png")[..., :3]
+    red = (image[..., 0] > 0.7) & (image[..., 1] < 0.3) & (image[..., 2] < 0.3)
+    # The diagonal path from (1, 1) to (5, 5) in a 6 x 6 arena: red pixels on the diagonal.
+    rows, cols = np.nonzero(red)
+    assert len(rows) > 200
+    h, w = red.shape
+    assert np.corrcoef(cols / w, 1 - rows / h)[0, 1] > 0.95
+
+
+def test_run_exits_1_when_the_goal_is_not_reached(tmp_path, capsys):
+    code, _, _ = run_cli(
+        capsys, "run", "paper_c_escape", "--planner", "apf", "--no-render", "--out", str(tmp_path)
+    )
+    assert code == 1
+    summary = json.loads((tmp_path / "paper_c_escape-apf-0.json").read_text())
+    assert summary["outcome"] == "stuck" and not summary["reached"]
+    assert not (tmp_path / "paper_c_escape-apf-0.png").exists()
+
+
+def test_seed_and_set_name_the_outputs(tmp_path, capsys):
+    code, _, _ = run_cli(
+        capsys,
+        "run",
+        "open_field",
+        "--seed",
+        "7",
+        "--set",
+        "run.time_limit_s=1",
+        "--no-render",
+        "--out",
+        str(tmp_path),
+    )
+    assert code == 1
+    summary = json.loads((tmp_path / "open_field-vplane-7.json").read_text())
+    assert summary["seed"] == 7 and summary["outcome"] == "timeout"
+
+
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (["run", "no_such_scenario"], "no_such_scenario"),
+        (["run", "open_field", "--set", "run.time_limit_s=-1"], "run.time_limit_s"),
+        (["run", "open_field", "--set", "planner.no_such_param=1"], "planner.no_such_param"),
+        (["run", "open_field", "--planner", "nope"], "planner.name"),
+        (["run", "open_field", "--set", "novalue"], "--set"),
+    ],
+)
+def test_invalid_input_exits_2_and_writes_nothing(tmp_path, capsys, argv, fragment):
+    code, _, err = run_cli(capsys, *argv, "--out", str(tmp_path))
+    assert code == 2
+    assert err.startswith("error: ") and fragment in err
+    assert "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_invalid_scenario_file_is_named_with_key_and_reason(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(BAD_SCENARIO)
+    out_dir = tmp_path / "out"
+    out_dir.mkdir()
+    code, _, err = run_cli(capsys, "run", str(bad), "--out", str(out_dir))
+    assert code == 2
+    assert f"{bad}: world.obstacles[0].width: must be greater than 2*thickness" in err
+    assert list(out_dir.iterdir()) == []
+
+
+def test_missing_output_directory_is_an_error(tmp_path, capsys):
+    code, _, err = run_cli(capsys, "run", "open_field", "--out", str(tmp_path / "missing"))
+    assert code == 2 and "no such directory" in err
+
+
+def test_check_exit_codes(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(BAD_SCENARIO)
+    assert run_cli(capsys, "check", "open_field", "paper_h_escape")[0] == 0
+    code, out, err = run_cli(capsys, "check", "open_field", str(bad))
+    assert code == 2 and "ok: open_field" in out and "world.obstacles[0].width" in err
+
+
+def test_mjcf_writes_a_loadable_world(tmp_path, capsys):
+    target = tmp_path / "world.xml"
+    code, _, _ = run_cli(capsys, "mjcf", "paper_c_avoid", "-o", str(target))
+    assert code == 0
+    model = mujoco.MjModel.from_xml_path(str(target))
+    assert model.nu == 2 and model.nsensor == 49
+
+
+def test_list_shows_scenarios_and_planner_parameters(capsys):
+    code, out, _ = run_cli(capsys, "list")
+    assert code == 0
+    for expected in ("paper_c_escape", "open_field", "apf", "vplane", "repulse_gain", "plane_gain"):
+        assert expected in out
+
+
+def test_usage_error_exits_2(capsys):
+    assert run_cli(capsys, "run")[0] == 2
+    assert run_cli(capsys, "frobnicate")[0] == 2
+
+
+@pytest.mark.parametrize("launcher", [["vplane-mj"], [sys.executable, "-m", "vplane_mj"]])
+def test_installed_entry_points(launcher):
+    done = subprocess.run([*launcher, "check", "single_box"], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert "ok: single_box" in done.stdout

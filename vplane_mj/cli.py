@@ -1,0 +1,152 @@
+"""The `vplane-mj` command line (INTERFACE.md section 2). `main(argv) -> exit status`."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import mujoco
+
+from vplane_mj.errors import VPlaneError
+from vplane_mj.outputs import prepare_out_dir, write_atomically, write_json
+from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
+from vplane_mj.scenario import Scenario, builtin_scenarios, load_scenario
+
+DEFAULT_OUT = Path("logs")
+EXIT_REACHED, EXIT_NOT_REACHED, EXIT_INVALID = 0, 1, 2
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = _parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # argparse: usage errors exit 2, --help exits 0
+        return int(exc.code or 0)
+    try:
+        return args.handler(args)
+    except VPlaneError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_INVALID
+    except KeyboardInterrupt:
+        print("interrupted: no partial output was written", file=sys.stderr)
+        return 130
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="vplane-mj",
+        description="Artificial potential fields and the virtual-plane escape, in MuJoCo.",
+    )
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    run = commands.add_parser("run", help="one headless run of a scenario")
+    run.add_argument("scenario", metavar="SCENARIO", help="a TOML file or a built-in scenario name")
+    run.add_argument("--planner", help="planner name (same as --set planner.name=NAME)")
+    run.add_argument("--seed", type=int, help="random seed (same as --set run.seed=N)")
+    run.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a scenario key by dotted path, e.g. planner.influence=0.6",
+    )
+    run.add_argument("--out", type=Path, help=f"output directory (default {DEFAULT_OUT}/)")
+    run.add_argument("--no-log", action="store_true", help="do not write the .mcap log")
+    run.add_argument("--no-render", action="store_true", help="do not write the .png render")
+    run.set_defaults(handler=_run)
+
+    check = commands.add_parser("check", help="validate scenarios only")
+    check.add_argument("scenarios", nargs="+", metavar="SCENARIO")
+    check.set_defaults(handler=_check)
+
+    export = commands.add_parser("mjcf", help="write the compiled world as one MJCF file")
+    export.add_argument("scenario", metavar="SCENARIO")
+    export.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.xml")
+    export.set_defaults(handler=_mjcf)
+
+    listing = commands.add_parser("list", help="built-in scenarios and planners")
+    listing.set_defaults(handler=_list)
+    return parser
+
+
+def _overrides(args: argparse.Namespace) -> list[str]:
+    extra = []
+    if args.planner is not None:
+        extra.append(f"planner.name={args.planner}")
+    if args.seed is not None:
+        extra.append(f"run.seed={args.seed}")
+    return [*args.set, *extra]
+
+
+def _run(args: argparse.Namespace) -> int:
+    # Imported here so that `check` and `list` stay quick.
+    from vplane_mj.render import render_top_view, write_png
+    from vplane_mj.sim import run_scenario
+
+    scenario = load_scenario(args.scenario, _overrides(args))
+    out_dir = prepare_out_dir(args.out or DEFAULT_OUT, create=args.out is None)
+    base = out_dir / f"{scenario.name}-{scenario.planner}-{scenario.run.seed}"
+    if not args.no_log:
+        print("note: MCAP logging is not available in this version; running as with --no-log")
+
+    result = run_scenario(scenario)
+    written = [write_json(base.with_suffix(".json"), result.summary)]
+    if not args.no_render:
+        image = render_top_view(scenario, result)
+        written.append(write_atomically(base.with_suffix(".png"), lambda tmp: write_png(image, tmp)))
+    print(_summary_line(scenario, result.summary))
+    for path in written:
+        print(f"wrote {path}")
+    return EXIT_REACHED if result.summary["reached"] else EXIT_NOT_REACHED
+
+
+def _summary_line(scenario: Scenario, s: dict) -> str:
+    clearance = "n/a" if s["min_clearance_m"] is None else f"{s['min_clearance_m']:.3f} m"
+    return (
+        f"{scenario.name} [{s['planner']}, seed {s['seed']}]: {s['outcome']} after "
+        f"{s['sim_time_s']:.2f} s simulated, path {s['path_length_m']:.2f} m, "
+        f"collisions {s['collisions']}, min clearance {clearance}, "
+        f"local minima {s['local_minima']}, escapes {s['escapes']}, wall {s['wall_time_s']:.2f} s"
+    )
+
+
+def _check(args: argparse.Namespace) -> int:
+    status = 0
+    for ref in args.scenarios:
+        try:
+            scenario = load_scenario(ref)
+        except VPlaneError as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            status = EXIT_INVALID
+        else:
+            print(f"ok: {ref} ({scenario.name}, planner {scenario.planner})")
+    return status
+
+
+def _mjcf(args: argparse.Namespace) -> int:
+    from vplane_mj.world import standalone_xml
+
+    scenario = load_scenario(args.scenario)
+    xml = standalone_xml(scenario)
+    mujoco.MjModel.from_xml_string(xml)  # what we write must load on its own
+    target = args.output
+    if not target.parent.is_dir():
+        raise VPlaneError(f"{target}: no such directory: {target.parent}")
+    write_atomically(target, lambda tmp: tmp.write_text(xml, encoding="utf-8"))
+    print(f"wrote {target}")
+    return 0
+
+
+def _list(args: argparse.Namespace) -> int:
+    print("Built-in scenarios:")
+    for name, description in builtin_scenarios():
+        print(f"  {name:<20} {description}")
+    print("\nPlanners (parameters: default, unit, meaning):")
+    for name, (info, _) in sorted(PLANNERS.items()):
+        default = " (default)" if name == DEFAULT_PLANNER else ""
+        print(f"  {name}{default}: {info.summary}")
+        print(f"    after: {info.citation}")
+        for key, param in info.params.items():
+            print(f"    {key:<22} {param.default:<8g} {param.unit:<5} {param.doc}")
+    return 0

@@ -1,0 +1,94 @@
+"""VFH polar histogram of the local map, its valleys and their widths (paper Algorithm 1, fig. 6).
+
+Angles in radians, world frame; sector k covers [k, k+1) * sector width from +x. Each map
+cell within `window_m` adds c^2 (window_m - d) to the sectors it blocks (Borenstein and
+Koren's VFH magnitude); as in VFH+ a cell is enlarged by the robot radius plus a clearance,
+so it blocks every sector within asin(enlarge / d) of its bearing, and any free sector is a
+direction the robot's disc fits through.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Valley:
+    """A run of free sectors: first and last sector (inclusive, counter-clockwise) and count."""
+
+    first: int
+    last: int
+    count: int
+
+    def center(self, sector: float) -> float:
+        """Bearing (rad) of the middle of the valley."""
+        return (self.first + (self.count - 1) / 2 + 0.5) * sector
+
+
+def polar_histogram(
+    origin: np.ndarray,
+    cells: np.ndarray,
+    certainty: np.ndarray,
+    n_sectors: int,
+    window_m: float,
+    enlarge_m: float,
+) -> np.ndarray:
+    """Obstacle density per sector (n_sectors,) around `origin` from map cells (N, 2)."""
+    h = np.zeros(n_sectors)
+    if len(cells) == 0:
+        return h
+    rel = np.asarray(cells, float) - origin
+    d = np.hypot(rel[:, 0], rel[:, 1])
+    inside = d < window_m
+    rel, d, c = rel[inside], d[inside], np.asarray(certainty, float)[inside]
+    sector = 2 * math.pi / n_sectors
+    bearing = np.arctan2(rel[:, 1], rel[:, 0])
+    half = np.arcsin(np.minimum(1.0, enlarge_m / np.maximum(d, 1e-6)))
+    magnitude = c * c * (window_m - d)
+    centers = (np.arange(n_sectors) + 0.5) * sector
+    # Angular distance from every sector centre to every cell's bearing: (n_sectors, N).
+    delta = np.abs((centers[:, None] - bearing[None, :] + math.pi) % (2 * math.pi) - math.pi)
+    h += np.where(delta <= half[None, :] + sector / 2, magnitude[None, :], 0.0).sum(axis=1)
+    return h
+
+
+def sector_of(bearing: float, n_sectors: int) -> int:
+    """The sector that holds `bearing` (rad)."""
+    return int((bearing % (2 * math.pi)) // (2 * math.pi / n_sectors)) % n_sectors
+
+
+def find_valleys(blocked: np.ndarray) -> list[Valley]:
+    """Circular runs of free (not blocked) sectors; one valley of all sectors when none is blocked."""
+    n = len(blocked)
+    if not blocked.any():
+        return [Valley(0, n - 1, n)]
+    start = int(np.argmax(blocked))  # begin the scan on a blocked sector so no run is split
+    valleys, run_start = [], None
+    for step in range(1, n + 1):
+        k = (start + step) % n
+        if not blocked[k] and run_start is None:
+            run_start = k
+        if blocked[k] and run_start is not None:
+            count = (k - run_start) % n
+            valleys.append(Valley(run_start, (k - 1) % n, count))
+            run_start = None
+    return valleys
+
+
+def nearest_wide_valley(
+    valleys: list[Valley], bearing: float, n_sectors: int, min_sectors: int
+) -> Valley | None:
+    """The valley at least `min_sectors` wide whose nearest sector is closest to `bearing`."""
+    target = sector_of(bearing, n_sectors)
+    best, best_gap = None, n_sectors
+    for valley in valleys:
+        if valley.count < min_sectors:
+            continue
+        offset = (target - valley.first) % n_sectors
+        gap = 0 if offset < valley.count else min(offset - valley.count + 1, n_sectors - offset)
+        if gap < best_gap:
+            best, best_gap = valley, gap
+    return best

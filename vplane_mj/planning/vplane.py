@@ -1,0 +1,279 @@
+"""The paper's planner (`vplane`): APF, histogram avoidance, virtual new objective, virtual plane.
+
+Algorithm 3 of the paper, as a state machine with three modes:
+- `normal`: F = F_A(goal) + F_R(echoes) + F_P(planes) (eqs. 3, 5, 8-10);
+- `avoiding` (Algorithm 1): a concave obstacle blocks the goal and no wide-enough valley
+  leads to the goal, so the robot is attracted past the cup's nearer edge instead;
+- `escaping` (Algorithm 2): after a local minimum the robot is attracted by the virtual
+  new objective (eq. 7); on reaching it (`tempGoal` cleared) the target is re-activated
+  and the virtual plane e1-e2 is added to the list L.
+
+The rules the paper leaves open: a plane is retired once the robot is nearer the goal
+than any point of the plane, or when more than `max_planes` exist (the oldest goes); a
+local minimum while escaping, or an escape that takes longer than `escape_timeout_s`,
+starts a new escape from where the robot is; after `max_escapes` escapes the planner
+gives up (outcome `stuck`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import numpy as np
+
+from vplane_mj.planning import fields, histogram
+from vplane_mj.planning.apf import FIELD_PARAMS, MINIMUM_PARAMS, detector_from, firas_components
+from vplane_mj.planning.localmap import LocalMap, angular_extremes, cluster_points
+from vplane_mj.planning.params import Param, PlannerInfo
+from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.planning.vplane_geometry import (
+    VirtualPlane,
+    make_plane,
+    plane_force,
+    unit,
+    virtual_objective,
+)
+
+PARAMS: dict[str, Param] = {
+    **FIELD_PARAMS,
+    **{k: v for k, v in MINIMUM_PARAMS.items() if k != "patience_s"},
+    "map_cell_m": Param(0.1, "m", "cell size of the local sonar map", gt=0),
+    "map_keep_m": Param(4.0, "m", "map cells farther than this from the robot are forgotten", gt=0),
+    "sector_deg": Param(5.0, "deg", "polar histogram sector width", gt=0, le=45),
+    "window_m": Param(2.0, "m", "radius of the histogram's active window", gt=0),
+    "histogram_threshold": Param(1.0, "", "sector density above which a sector is blocked", gt=0),
+    "clearance_m": Param(
+        0.08, "m", "clearance added to the robot radius (gap width, VFH+ enlargement)", ge=0
+    ),
+    "min_gap_deg": Param(10.0, "deg", "narrowest valley that counts as a passage", gt=0),
+    "concave_depth_m": Param(0.3, "m", "depth behind the chord e1-e2 that makes an obstacle concave", gt=0),
+    "lookahead_m": Param(2.5, "m", "how far ahead toward the goal obstacles are examined", gt=0),
+    "vno_gain": Param(0.5, "1/m", "gamma of eq. 7, attraction of the virtual new objective", gt=0),
+    "vno_tolerance_m": Param(0.15, "m", "distance at which the virtual objective counts as reached", gt=0),
+    "escape_margin_m": Param(0.15, "m", "objective lies at least radius + this outside the trap", ge=0),
+    "escape_timeout_s": Param(25.0, "s", "an escape that takes longer starts over", gt=0),
+    "max_escapes": Param(4, "", "escapes tried before giving up", ge=1, integer=True),
+    "plane_gain": Param(0.05, "m", "eta of eqs. 8-10, virtual plane repulsion gain", gt=0),
+    "plane_influence_m": Param(0.6, "m", "r of eq. 8, the virtual plane's radius of influence", gt=0),
+    "plane_step_m": Param(0.05, "m", "spacing of the points p_i on the plane (eqs. 9-10)", gt=0),
+    "plane_margin_m": Param(0.3, "m", "the corridor extends this far past the plane's ends", ge=0),
+    "slide_gain": Param(1.0, "", "tangential force along the plane, relative to its normal force", ge=0),
+    "max_planes": Param(4, "", "virtual planes kept at most (list L)", ge=1, integer=True),
+}
+
+INFO = PlannerInfo(
+    name="vplane",
+    summary="APF with histogram avoidance, virtual new objective and virtual plane (the paper)",
+    citation="A Novel Approach to Local Minima Problem in Robot Path Planning Using Artificial "
+    "Potential Field (virtual plane method)",
+    params=PARAMS,
+)
+
+
+class VPlanePlanner:
+    """Algorithm 3 with its flags: `temp_goal` (escaping) and the list L of virtual planes."""
+
+    info = INFO
+
+    def __init__(self, params: Mapping[str, float], robot_radius_m: float):
+        self.params = dict(params)
+        self.radius = robot_radius_m
+        p = self.params
+        self.detector = detector_from(p)
+        self.map = LocalMap(p["map_cell_m"], p["map_keep_m"])
+        self.n_sectors = max(8, round(360.0 / p["sector_deg"]))
+        self.planes: list[VirtualPlane] = []
+        self.temp_goal: np.ndarray | None = None  # the virtual new objective while escaping
+        self.pending_plane: VirtualPlane | None = None
+        self.escape_started_s = 0.0
+        self.escapes_tried = 0
+        self.avoid_waypoint: np.ndarray | None = None
+
+    # -- the loop -------------------------------------------------------------------------
+    def step(self, obs: Observation) -> Decision:
+        p = self.params
+        self.map.add_echoes(obs.echo_points())
+        self.map.forget_far(obs.position)
+        decision = Decision(force=np.zeros(2), mode="normal")
+        self._retire_planes(obs, decision)
+
+        near_goal = obs.distance_to_goal() <= obs.goal_tolerance
+        state = self.detector.update(obs.time_s, obs.position, near_goal)
+        if state.new:
+            decision.local_minimum = True
+            decision.events.append("local minimum detected")
+            if not self._start_escape(obs, decision):
+                return decision
+        elif self.temp_goal is not None and obs.time_s - self.escape_started_s > p["escape_timeout_s"]:
+            decision.events.append("escape timed out")
+            if not self._start_escape(obs, decision):
+                return decision
+
+        if self.temp_goal is not None and np.hypot(*(obs.position - self.temp_goal)) <= p["vno_tolerance_m"]:
+            self._finish_escape(decision)
+
+        components = firas_components(obs, p)
+        if self.temp_goal is not None:
+            decision.mode = "escaping"
+            components["attractive"] = -2.0 * p["vno_gain"] * (obs.position - self.temp_goal)  # eq. 7
+        else:
+            self._update_avoidance(obs, decision)
+            if self.avoid_waypoint is not None:
+                decision.mode = "avoiding"
+                components["attractive"] = fields.attractive_force(
+                    obs.position, self.avoid_waypoint, p["attract_gain"], p["attract_radius"]
+                )
+        components["virtual"] = self._planes_force(obs.position)
+        decision.components = components
+        decision.force = sum(components.values(), np.zeros(2))
+        return decision
+
+    # -- Algorithm 2: escaping ---------------------------------------------------------------
+    def _start_escape(self, obs: Observation, decision: Decision) -> bool:
+        """Place a virtual new objective; False (and gave_up) when escapes are exhausted."""
+        self.avoid_waypoint = None
+        if self.escapes_tried >= self.params["max_escapes"]:
+            decision.gave_up = True
+            decision.events.append(f"gave up after {self.escapes_tried} escapes")
+            return False
+        trap = self._trap_cluster(obs.position, obs.goal)
+        if trap is None:
+            decision.events.append("local minimum without mapped obstacles: no escape possible")
+            decision.gave_up = True
+            return False
+        i1, i2, _ = angular_extremes(obs.position, trap)
+        e1, e2 = trap[i1], trap[i2]
+        plane = make_plane(e1, e2, trap, obs.position, obs.goal)
+        clearance = self.radius + self.params["escape_margin_m"]
+        self.temp_goal = virtual_objective(obs.position, e1, e2, obs.goal, plane, clearance)
+        self.pending_plane = plane
+        self.escape_started_s = obs.time_s
+        self.escapes_tried += 1
+        self.detector.reset()
+        decision.events.append(
+            f"escape started: e1=({e1[0]:.2f}, {e1[1]:.2f}) e2=({e2[0]:.2f}, {e2[1]:.2f}) "
+            f"objective=({self.temp_goal[0]:.2f}, {self.temp_goal[1]:.2f})"
+        )
+        return True
+
+    def _finish_escape(self, decision: Decision) -> None:
+        """Objective reached: re-activate the target and add the virtual plane to L."""
+        self.temp_goal = None
+        self.planes.append(self.pending_plane)
+        self.pending_plane = None
+        if len(self.planes) > self.params["max_planes"]:
+            self.planes.pop(0)
+            decision.events.append("oldest virtual plane retired")
+        self.detector.reset()
+        decision.escape_completed = True
+        decision.events.append("objective reached: virtual plane created, target re-activated")
+
+    def _trap_cluster(self, position: np.ndarray, goal: np.ndarray) -> np.ndarray | None:
+        """Map cells of the obstacle that traps the robot: the cluster nearest toward the goal."""
+        cells, _ = self.map.cells()
+        if len(cells) == 0:
+            return None
+        labels = cluster_points(cells, 2 * self.radius + self.params["clearance_m"])
+        rel = cells - position
+        toward_goal = rel @ unit(goal - position)
+        distance = np.hypot(rel[:, 0], rel[:, 1])
+        ahead = toward_goal > 0.5 * distance  # within 60 degrees of the goal direction
+        pool = np.flatnonzero(ahead) if ahead.any() else np.arange(len(cells))
+        nearest = pool[np.argmin(distance[pool])]
+        return cells[labels == labels[nearest]]
+
+    # -- the virtual planes -------------------------------------------------------------------
+    def _planes_force(self, position: np.ndarray) -> np.ndarray:
+        p = self.params
+        total = np.zeros(2)
+        for plane in self.planes:
+            if plane.in_corridor(position, p["plane_influence_m"], p["plane_margin_m"]):
+                total += plane_force(
+                    position,
+                    plane,
+                    p["plane_gain"],
+                    p["plane_influence_m"],
+                    p["plane_step_m"],
+                    p["slide_gain"],
+                )
+        return total
+
+    def _retire_planes(self, obs: Observation, decision: Decision) -> None:
+        """Drop the planes the robot has left behind on its way to the goal."""
+        to_goal = obs.distance_to_goal()
+        kept = []
+        for plane in self.planes:
+            nearest_to_goal = min(np.hypot(*(plane.e1 - obs.goal)), np.hypot(*(plane.e2 - obs.goal)))
+            if to_goal < nearest_to_goal - self.radius:
+                decision.events.append("virtual plane retired: the trap is behind")
+            else:
+                kept.append(plane)
+        self.planes = kept
+
+    # -- Algorithm 1: histogram avoidance -------------------------------------------------------
+    def _update_avoidance(self, obs: Observation, decision: Decision) -> None:
+        """Enter, keep or leave the avoiding mode (steering past a concave obstacle's edge)."""
+        p = self.params
+        cells, certainty = self.map.cells()
+        goal_bearing = math.atan2(*(obs.goal - obs.position)[::-1])
+        if len(cells) == 0:
+            self.avoid_waypoint = None
+            return
+        h = histogram.polar_histogram(
+            obs.position, cells, certainty, self.n_sectors, p["window_m"], self.radius + p["clearance_m"]
+        )
+        blocked = h > p["histogram_threshold"]
+        goal_free = not blocked[histogram.sector_of(goal_bearing, self.n_sectors)]
+        if goal_free:
+            if self.avoid_waypoint is not None:
+                decision.events.append("avoidance finished: the way to the goal is free")
+            self.avoid_waypoint = None
+            return
+        if self.avoid_waypoint is not None:
+            if np.hypot(*(obs.position - self.avoid_waypoint)) < 2 * self.radius:
+                self.avoid_waypoint = None
+                decision.events.append("avoidance finished: edge passed")
+            return
+        min_sectors = max(1, math.ceil(p["min_gap_deg"] / p["sector_deg"]))
+        valley = histogram.nearest_wide_valley(
+            histogram.find_valleys(blocked), goal_bearing, self.n_sectors, min_sectors
+        )
+        waypoint = self._concave_edge_waypoint(obs, cells)
+        if waypoint is not None and valley is not None:
+            self.avoid_waypoint = waypoint
+            decision.events.append(
+                f"concave obstacle ahead: passing its edge via ({waypoint[0]:.2f}, {waypoint[1]:.2f})"
+            )
+
+    def _concave_edge_waypoint(self, obs: Observation, cells: np.ndarray) -> np.ndarray | None:
+        """A point just past the nearer edge of a concave obstacle ahead, or None."""
+        p = self.params
+        heading = unit(obs.goal - obs.position)
+        rel = cells - obs.position
+        forward = rel @ heading
+        lateral = np.abs(rel @ np.array([-heading[1], heading[0]]))
+        reach = min(p["lookahead_m"], obs.distance_to_goal())
+        ahead = (forward > 0) & (forward < reach) & (lateral < self.radius + p["clearance_m"])
+        if not ahead.any():
+            return None
+        labels = cluster_points(cells, 2 * self.radius + p["clearance_m"])
+        nearest = np.flatnonzero(ahead)[np.argmin(forward[ahead])]
+        cluster = cells[labels == labels[nearest]]
+        i1, i2, span = angular_extremes(obs.position, cluster)
+        if span >= math.pi:  # it surrounds the robot: that is a trap, not an obstacle ahead
+            return None
+        e1, e2 = cluster[i1], cluster[i2]
+        chord = unit(e2 - e1)
+        away = np.array([-chord[1], chord[0]])
+        if (e1 - obs.position) @ away < 0:
+            away = -away
+        depth = float(np.max((cluster - e1) @ away))
+        if depth < p["concave_depth_m"]:
+            return None
+        via = [np.hypot(*(e - obs.position)) + np.hypot(*(obs.goal - e)) for e in (e1, e2)]
+        edge = e1 if via[0] <= via[1] else e2
+        outward = unit(edge - (e1 + e2) / 2)
+        waypoint = edge + outward * (self.radius + p["clearance_m"] + 0.15)
+        free = np.min(np.hypot(*(cells - waypoint).T)) > self.radius + p["clearance_m"]
+        return waypoint if free else None

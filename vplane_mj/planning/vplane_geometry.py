@@ -1,0 +1,134 @@
+"""Geometry of the paper's escape: extreme points, the virtual new objective, the virtual plane.
+
+Every test is made in the plane's own frame (t along e1 -> e2, n normal to it, pointing
+away from the trap), never with fixed x/y comparisons, so it holds for any orientation.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from vplane_mj.planning.fields import MIN_DISTANCE_M
+
+
+def unit(v: np.ndarray) -> np.ndarray:
+    """v / |v|, or zeros for a (near) zero vector."""
+    norm = float(np.hypot(v[0], v[1]))
+    return v / norm if norm > 1e-12 else np.zeros(2)
+
+
+@dataclass(frozen=True)
+class VirtualPlane:
+    """The segment e1-e2 that closes a trap, with its frame and escape side.
+
+    `normal` points away from the trap's interior; `slide` (+1 or -1) is the direction
+    along `tangent` toward the end with the shorter way to the goal.
+    """
+
+    e1: np.ndarray
+    e2: np.ndarray
+    normal: np.ndarray
+    slide: float
+
+    @property
+    def tangent(self) -> np.ndarray:
+        return unit(self.e2 - self.e1)
+
+    @property
+    def length(self) -> float:
+        return float(np.hypot(*(self.e2 - self.e1)))
+
+    def frame_coordinates(self, point: np.ndarray) -> tuple[float, float]:
+        """(along, out): position along e1 -> e2 (m from e1) and signed distance outward (m)."""
+        rel = np.asarray(point, float) - self.e1
+        return float(rel @ self.tangent), float(rel @ self.normal)
+
+    def in_corridor(self, point: np.ndarray, influence: float, margin: float) -> bool:
+        """Inside the activation corridor: along the segment (+- margin), at most `influence` out."""
+        along, out = self.frame_coordinates(point)
+        return -margin <= along <= self.length + margin and out <= influence
+
+
+def make_plane(
+    e1: np.ndarray, e2: np.ndarray, trap_points: np.ndarray, robot: np.ndarray, goal: np.ndarray
+) -> VirtualPlane:
+    """The plane e1-e2 whose normal points away from the trap's obstacle points (their mean)."""
+    tangent = unit(e2 - e1)
+    normal = np.array([-tangent[1], tangent[0]])
+    if (np.mean(trap_points, axis=0) - e1) @ normal > 0:
+        normal = -normal
+    via_e1 = np.hypot(*(e1 - robot)) + np.hypot(*(goal - e1))
+    via_e2 = np.hypot(*(e2 - robot)) + np.hypot(*(goal - e2))
+    return VirtualPlane(e1=e1, e2=e2, normal=normal, slide=1.0 if via_e2 <= via_e1 else -1.0)
+
+
+def escape_direction(robot: np.ndarray, e1: np.ndarray, e2: np.ndarray, goal: np.ndarray) -> np.ndarray:
+    """Unit bisector of the angle e1-robot-e2, turned to point away from the goal (Algorithm 2).
+
+    When the two directions cancel (the robot on the segment) the normal of e1-e2 that
+    points away from the goal is used instead.
+    """
+    bisector = unit(unit(e1 - robot) + unit(e2 - robot))
+    if not bisector.any():
+        t = unit(e2 - e1)
+        bisector = np.array([-t[1], t[0]])
+    if bisector @ (goal - robot) > 0:
+        bisector = -bisector
+    return bisector
+
+
+def virtual_objective(
+    robot: np.ndarray,
+    e1: np.ndarray,
+    e2: np.ndarray,
+    goal: np.ndarray,
+    plane: VirtualPlane,
+    clearance: float,
+) -> np.ndarray:
+    """Algorithm 2: at dis = max(l1, l2) along the escape bisector, then pushed out of the trap.
+
+    Step 3 of the paper moves the objective until it lies outside the trap; here "outside"
+    means at least `clearance` (robot radius plus margin) on the plane's outer side.
+    """
+    direction = escape_direction(robot, e1, e2, goal)
+    dis = max(float(np.hypot(*(e1 - robot))), float(np.hypot(*(e2 - robot))))
+    objective = robot + dis * direction
+    _, out = plane.frame_coordinates(objective)
+    if out < clearance:
+        push = direction if direction @ plane.normal > 0.2 else plane.normal
+        objective = objective + push * (clearance - out) / float(push @ plane.normal)
+    return objective
+
+
+def plane_force(
+    robot: np.ndarray,
+    plane: VirtualPlane,
+    gain: float,
+    influence: float,
+    step: float,
+    slide_gain: float,
+) -> np.ndarray:
+    """Eqs. 8-10: FIRAS repulsion summed over points p_i spaced `step` along the plane.
+
+    Each point's force is weighted by `step` (a line integral), so the total does not grow
+    with the number of points. Only the outward (normal) part is kept, computed as if the
+    robot stood at least MIN_DISTANCE_M outside, so inside the trap it pushes outward
+    hardest. A tangential part `slide_gain` times as large moves the robot along the plane
+    toward the end with the shorter way to the goal, so a head-on approach cannot stall.
+    """
+    along, out = plane.frame_coordinates(robot)
+    n_points = max(2, math.ceil(plane.length / step) + 1)
+    positions = np.linspace(0.0, plane.length, n_points)
+    weight = plane.length / (n_points - 1)
+    normal_distance = max(out, MIN_DISTANCE_M)
+    f = np.hypot(along - positions, normal_distance)
+    near = f <= influence
+    if not near.any():
+        return np.zeros(2)
+    f = f[near]
+    magnitude = gain * (1.0 / f - 1.0 / influence) / (f * f) * weight
+    outward = float(np.sum(magnitude * normal_distance / f))
+    return outward * plane.normal + slide_gain * outward * plane.slide * plane.tangent
