@@ -157,6 +157,7 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
     qvel, ctrl, base_xpos, base_xmat = data.qvel, data.ctrl, data.xpos[base], data.xmat[base]
     goal = np.asarray(scenario.robot.goal, float)
     sonar_period = 1.0 / sensors.rate_hz
+    beam = math.radians(sensors.beam_deg)
     next_sonar = 0.0
     ranges = np.full(sensors.count, np.nan)
 
@@ -201,6 +202,7 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
                 goal_tolerance=scenario.robot.goal_tolerance,
                 bearings=layout.bearings,
                 ranges=ranges,
+                beam_width=beam,
             )
         )
         local_minima += decision.local_minimum

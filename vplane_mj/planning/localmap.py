@@ -1,10 +1,14 @@
 """A small local map accumulated from sonar echoes (a VFH-style certainty grid).
 
-Cells are `cell_m` squares in the world frame, keyed by integer indices; each echo adds
-one unit of certainty to the cell it falls in, up to `max_certainty`. Cells farther
-than `keep_radius_m` from the robot are forgotten, so memory stays bounded however
-long the run. The map is the planner's only memory of obstacles: it is built from the
-sonar ring and the robot's pose alone.
+The grid is a square of `size_m` around the robot with cells of `cell_m`, anchored to
+the world (it shifts by whole cells when the robot nears its edge; cells that fall off
+are forgotten). Each sonar reading is treated as a real sonar's: the echo lies somewhere
+on the arc of the beam at the measured range, and the cone in front of the arc is free.
+Arc cells gain `hit` certainty (up to `max_certainty`), cone cells lose `miss`; so
+phantom echoes (a wide beam grazing a corridor wall) are erased by later readings while
+real surfaces accumulate (Borenstein and Koren's histogramic in-motion mapping, HIMM).
+A reading with no echo carries no information here: it may be a lost reading. The map
+is the planner's only memory of obstacles, built from the sonar ring and the pose alone.
 """
 
 from __future__ import annotations
@@ -12,66 +16,92 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy import ndimage
 
 
 class LocalMap:
     """Certainty grid of obstacle cells around the robot (see the module docstring)."""
 
-    def __init__(self, cell_m: float, keep_radius_m: float, max_certainty: int = 15):
+    def __init__(self, cell_m: float, size_m: float, hit: int = 3, miss: int = 1, max_certainty: int = 15):
         self.cell_m = cell_m
-        self.keep_radius_m = keep_radius_m
-        self.max_certainty = max_certainty
-        self._cells: dict[tuple[int, int], int] = {}
+        self.n = max(8, math.ceil(size_m / cell_m))
+        self.hit, self.miss, self.max_certainty = hit, miss, max_certainty
+        self.grid = np.zeros((self.n, self.n), dtype=np.int16)
+        self.origin: np.ndarray | None = None  # world cell index of grid[0, 0]
 
-    def __len__(self) -> int:
-        return len(self._cells)
-
-    def add_echoes(self, points: np.ndarray) -> None:
-        """Raise the certainty of the cells that hold the echo points (N, 2) (m)."""
-        for i, j in np.floor(np.asarray(points, float).reshape(-1, 2) / self.cell_m).astype(int):
-            key = (int(i), int(j))
-            self._cells[key] = min(self.max_certainty, self._cells.get(key, 0) + 1)
-
-    def forget_far(self, position: np.ndarray) -> None:
-        """Drop cells whose centre is farther than keep_radius_m from `position`."""
-        limit = (self.keep_radius_m / self.cell_m) ** 2
-        ci, cj = position[0] / self.cell_m - 0.5, position[1] / self.cell_m - 0.5
-        far = [key for key in self._cells if (key[0] - ci) ** 2 + (key[1] - cj) ** 2 > limit]
-        for key in far:
-            del self._cells[key]
+    def update(
+        self, position: np.ndarray, yaw: float, bearings: np.ndarray, ranges: np.ndarray, beam: float
+    ) -> None:
+        """Fold one scan of the sonar ring (ranges in m from the robot's centre) into the grid."""
+        self._follow(position)
+        centres = self._cell_centres()
+        rel_x = centres[0][:, None] - position[0]
+        rel_y = centres[1][None, :] - position[1]
+        distance = np.hypot(rel_x, rel_y)
+        bearing = np.arctan2(rel_y, rel_x) - yaw
+        spacing = 2 * math.pi / len(bearings)
+        sonar = np.round((bearing - bearings[0]) / spacing).astype(int) % len(bearings)
+        offset = (bearing - bearings[sonar] + math.pi) % (2 * math.pi) - math.pi
+        reading = ranges[sonar]
+        in_cone = (np.abs(offset) <= beam / 2) & np.isfinite(reading)
+        reading = np.where(in_cone, reading, 0.0)
+        free = in_cone & (distance < reading - self.cell_m)
+        arc = in_cone & (np.abs(distance - reading) <= 0.75 * self.cell_m)
+        self.grid[free] = np.maximum(self.grid[free] - self.miss, 0)
+        self.grid[arc] = np.minimum(self.grid[arc] + self.hit, self.max_certainty)
 
     def cells(self, min_certainty: int = 1) -> tuple[np.ndarray, np.ndarray]:
-        """Centres (N, 2) in metres and certainties (N,) of the cells at or above a certainty."""
-        kept = [(key, c) for key, c in self._cells.items() if c >= min_certainty]
-        if not kept:
+        """Centres (N, 2) in metres and certainties (N,) of cells at or above a certainty."""
+        i, j = np.nonzero(self.grid >= min_certainty)
+        if self.origin is None or len(i) == 0:
             return np.empty((0, 2)), np.empty(0, dtype=int)
-        keys = np.array([key for key, _ in kept], dtype=float)
-        return (keys + 0.5) * self.cell_m, np.array([c for _, c in kept])
+        centres = (np.column_stack((i, j)) + self.origin + 0.5) * self.cell_m
+        return centres, self.grid[i, j].astype(int)
 
+    def clusters(self, min_certainty: int, link_m: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Cell centres (N, 2), their cluster labels (N,) and the label grid (n, n).
 
-def cluster_points(points: np.ndarray, link_m: float) -> np.ndarray:
-    """Label points (N, 2) so that points closer than `link_m` share a cluster (single linkage).
+        Cells closer than `link_m` share a label (label 0 is free space). Two obstacle cells
+        closer than the robot's width form one barrier, so `link_m` is normally the robot's
+        diameter plus a clearance.
+        """
+        occupied = self.grid >= min_certainty
+        reach = max(1, round(link_m / (2 * self.cell_m)))
+        disk = np.hypot(*np.mgrid[-reach : reach + 1, -reach : reach + 1]) <= reach
+        grid_labels, _ = ndimage.label(ndimage.binary_dilation(occupied, structure=disk))
+        i, j = np.nonzero(occupied)
+        if self.origin is None or len(i) == 0:
+            return np.empty((0, 2)), np.empty(0, dtype=int), grid_labels
+        centres = (np.column_stack((i, j)) + self.origin + 0.5) * self.cell_m
+        return centres, grid_labels[i, j], grid_labels
 
-    Two obstacle points closer than the robot's width form one barrier, so `link_m` is
-    normally the robot's diameter plus a clearance. Returns labels 0..K-1 (N,).
-    """
-    n = len(points)
-    labels = np.full(n, -1)
-    if n == 0:
-        return labels
-    near = np.hypot(*(points[:, None, :] - points[None, :, :]).transpose(2, 0, 1)) < link_m
-    current = 0
-    for seed in range(n):
-        if labels[seed] >= 0:
-            continue
-        labels[seed] = current
-        frontier = [seed]
-        while frontier:
-            members = np.flatnonzero(near[frontier].any(axis=0) & (labels < 0))
-            labels[members] = current
-            frontier = list(members)
-        current += 1
-    return labels
+    def lookup(self, grid_values: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """The value of a grid-shaped array at world points (N, 2); 0 outside the grid."""
+        index = np.floor(np.asarray(points, float) / self.cell_m).astype(int) - self.origin
+        inside = np.all((index >= 0) & (index < self.n), axis=1)
+        values = np.zeros(len(index), dtype=grid_values.dtype)
+        values[inside] = grid_values[index[inside, 0], index[inside, 1]]
+        return values
+
+    def _cell_centres(self) -> tuple[np.ndarray, np.ndarray]:
+        index = np.arange(self.n) + 0.5
+        return (self.origin[0] + index) * self.cell_m, (self.origin[1] + index) * self.cell_m
+
+    def _follow(self, position: np.ndarray) -> None:
+        """Keep the robot in the grid's middle half, shifting the grid by whole cells."""
+        centre_cell = np.floor(np.asarray(position) / self.cell_m).astype(int) - self.n // 2
+        if self.origin is None:
+            self.origin = centre_cell
+            return
+        shift = centre_cell - self.origin
+        if np.max(np.abs(shift)) < self.n // 4:
+            return
+        moved = np.zeros_like(self.grid)
+        src = [slice(max(0, s), self.n + min(0, s)) for s in shift]
+        dst = [slice(max(0, -s), self.n + min(0, -s)) for s in shift]
+        moved[dst[0], dst[1]] = self.grid[src[0], src[1]]
+        self.grid = moved
+        self.origin = centre_cell
 
 
 def angular_extremes(origin: np.ndarray, points: np.ndarray) -> tuple[int, int, float]:

@@ -12,7 +12,8 @@ class Observation:
     """The planner's whole view of the world: its pose, its goal and its sonar ring.
 
     `ranges` (m) are measured from the robot's centre along `bearings` (rad, robot
-    frame, counter-clockwise from the heading); NaN means no echo.
+    frame, counter-clockwise from the heading, evenly spaced); NaN means no echo.
+    `beam_width` (rad) is each sonar's beam: an echo lies somewhere within it.
     """
 
     time_s: float
@@ -22,6 +23,7 @@ class Observation:
     goal_tolerance: float
     bearings: np.ndarray
     ranges: np.ndarray
+    beam_width: float
 
     def echo_points(self) -> np.ndarray:
         """World-frame points (N, 2) of the sonar echoes; no-echo readings are dropped."""

@@ -8,6 +8,10 @@ Algorithm 3 of the paper, as a state machine with three modes:
   new objective (eq. 7); on reaching it (`tempGoal` cleared) the target is re-activated
   and the virtual plane e1-e2 is added to the list L.
 
+One departure from the paper: within `goal_fade_m` of the goal the echo repulsion fades
+linearly to zero (after Ge and Cui's fix of "goal not reachable with obstacles nearby",
+which the paper names but does not treat), so a goal close to a wall can be reached.
+
 The rules the paper leaves open: a plane is retired once the robot is nearer the goal
 than any point of the plane, or when more than `max_planes` exist (the oldest goes); a
 local minimum while escaping, or an escape that takes longer than `escape_timeout_s`,
@@ -18,13 +22,14 @@ gives up (outcome `stuck`).
 from __future__ import annotations
 
 import math
+from collections import deque
 from collections.abc import Mapping
 
 import numpy as np
 
 from vplane_mj.planning import fields, histogram
 from vplane_mj.planning.apf import FIELD_PARAMS, MINIMUM_PARAMS, detector_from, firas_components
-from vplane_mj.planning.localmap import LocalMap, angular_extremes, cluster_points
+from vplane_mj.planning.localmap import LocalMap, angular_extremes
 from vplane_mj.planning.params import Param, PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.planning.vplane_geometry import (
@@ -39,7 +44,9 @@ PARAMS: dict[str, Param] = {
     **FIELD_PARAMS,
     **{k: v for k, v in MINIMUM_PARAMS.items() if k != "patience_s"},
     "map_cell_m": Param(0.1, "m", "cell size of the local sonar map", gt=0),
-    "map_keep_m": Param(4.0, "m", "map cells farther than this from the robot are forgotten", gt=0),
+    "map_size_m": Param(8.0, "m", "side of the square local map that follows the robot", gt=0),
+    "echo_memory": Param(100, "", "sonar scans kept for the extreme points e1, e2", ge=1, integer=True),
+    "map_threshold": Param(4, "", "certainty at which a map cell counts as an obstacle", ge=1, integer=True),
     "sector_deg": Param(5.0, "deg", "polar histogram sector width", gt=0, le=45),
     "window_m": Param(2.0, "m", "radius of the histogram's active window", gt=0),
     "histogram_threshold": Param(1.0, "", "sector density above which a sector is blocked", gt=0),
@@ -48,7 +55,10 @@ PARAMS: dict[str, Param] = {
     ),
     "min_gap_deg": Param(10.0, "deg", "narrowest valley that counts as a passage", gt=0),
     "concave_depth_m": Param(0.3, "m", "depth behind the chord e1-e2 that makes an obstacle concave", gt=0),
-    "lookahead_m": Param(2.5, "m", "how far ahead toward the goal obstacles are examined", gt=0),
+    "lookahead_m": Param(2.0, "m", "how far ahead toward the goal obstacles are examined", gt=0),
+    "goal_fade_m": Param(
+        0.6, "m", "echo repulsion fades linearly to zero within this distance of the goal", ge=0
+    ),
     "vno_gain": Param(0.5, "1/m", "gamma of eq. 7, attraction of the virtual new objective", gt=0),
     "vno_tolerance_m": Param(0.15, "m", "distance at which the virtual objective counts as reached", gt=0),
     "escape_margin_m": Param(0.15, "m", "objective lies at least radius + this outside the trap", ge=0),
@@ -81,7 +91,7 @@ class VPlanePlanner:
         self.radius = robot_radius_m
         p = self.params
         self.detector = detector_from(p)
-        self.map = LocalMap(p["map_cell_m"], p["map_keep_m"])
+        self.map = LocalMap(p["map_cell_m"], p["map_size_m"])
         self.n_sectors = max(8, round(360.0 / p["sector_deg"]))
         self.planes: list[VirtualPlane] = []
         self.temp_goal: np.ndarray | None = None  # the virtual new objective while escaping
@@ -89,12 +99,13 @@ class VPlanePlanner:
         self.escape_started_s = 0.0
         self.escapes_tried = 0
         self.avoid_waypoint: np.ndarray | None = None
+        self.echoes: deque[np.ndarray] = deque(maxlen=max(1, round(p["echo_memory"])))
 
     # -- the loop -------------------------------------------------------------------------
     def step(self, obs: Observation) -> Decision:
         p = self.params
-        self.map.add_echoes(obs.echo_points())
-        self.map.forget_far(obs.position)
+        self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
+        self.echoes.append(obs.echo_points())
         decision = Decision(force=np.zeros(2), mode="normal")
         self._retire_planes(obs, decision)
 
@@ -114,6 +125,8 @@ class VPlanePlanner:
             self._finish_escape(decision)
 
         components = firas_components(obs, p)
+        if p["goal_fade_m"] > 0:  # goals near obstacles stay reachable (GNRON)
+            components["repulsive"] *= min(1.0, obs.distance_to_goal() / p["goal_fade_m"])
         if self.temp_goal is not None:
             decision.mode = "escaping"
             components["attractive"] = -2.0 * p["vno_gain"] * (obs.position - self.temp_goal)  # eq. 7
@@ -144,7 +157,7 @@ class VPlanePlanner:
             return False
         i1, i2, _ = angular_extremes(obs.position, trap)
         e1, e2 = trap[i1], trap[i2]
-        plane = make_plane(e1, e2, trap, obs.position, obs.goal)
+        plane = make_plane(e1, e2, trap, obs.position, obs.goal, extend=self._link_m())
         clearance = self.radius + self.params["escape_margin_m"]
         self.temp_goal = virtual_objective(obs.position, e1, e2, obs.goal, plane, clearance)
         self.pending_plane = plane
@@ -170,18 +183,28 @@ class VPlanePlanner:
         decision.events.append("objective reached: virtual plane created, target re-activated")
 
     def _trap_cluster(self, position: np.ndarray, goal: np.ndarray) -> np.ndarray | None:
-        """Map cells of the obstacle that traps the robot: the cluster nearest toward the goal."""
-        cells, _ = self.map.cells()
+        """Echo points of the obstacle that traps the robot: the cluster nearest toward the goal.
+
+        The map's clusters say which echoes belong together; the extreme points are then
+        taken from the echoes themselves (the sonar's acoustic axis), not from the map's
+        beam-wide arcs, so the plane spans the trap's true mouth.
+        """
+        cells, labels, grid_labels = self.map.clusters(self.params["map_threshold"], self._link_m())
         if len(cells) == 0:
             return None
-        labels = cluster_points(cells, 2 * self.radius + self.params["clearance_m"])
         rel = cells - position
         toward_goal = rel @ unit(goal - position)
         distance = np.hypot(rel[:, 0], rel[:, 1])
         ahead = toward_goal > 0.5 * distance  # within 60 degrees of the goal direction
         pool = np.flatnonzero(ahead) if ahead.any() else np.arange(len(cells))
-        nearest = pool[np.argmin(distance[pool])]
-        return cells[labels == labels[nearest]]
+        trap_label = labels[pool[np.argmin(distance[pool])]]
+        echoes = np.vstack(self.echoes)
+        trap = echoes[self.map.lookup(grid_labels, echoes) == trap_label]
+        return trap if len(trap) >= 2 else cells[labels == trap_label]
+
+    def _link_m(self) -> float:
+        """Obstacle cells closer than this leave no gap for the robot: one cluster."""
+        return 2 * self.radius + self.params["clearance_m"]
 
     # -- the virtual planes -------------------------------------------------------------------
     def _planes_force(self, position: np.ndarray) -> np.ndarray:
@@ -215,7 +238,7 @@ class VPlanePlanner:
     def _update_avoidance(self, obs: Observation, decision: Decision) -> None:
         """Enter, keep or leave the avoiding mode (steering past a concave obstacle's edge)."""
         p = self.params
-        cells, certainty = self.map.cells()
+        cells, certainty = self.map.cells(p["map_threshold"])
         goal_bearing = math.atan2(*(obs.goal - obs.position)[::-1])
         if len(cells) == 0:
             self.avoid_waypoint = None
@@ -239,16 +262,17 @@ class VPlanePlanner:
         valley = histogram.nearest_wide_valley(
             histogram.find_valleys(blocked), goal_bearing, self.n_sectors, min_sectors
         )
-        waypoint = self._concave_edge_waypoint(obs, cells)
+        waypoint = self._concave_edge_waypoint(obs)
         if waypoint is not None and valley is not None:
             self.avoid_waypoint = waypoint
             decision.events.append(
                 f"concave obstacle ahead: passing its edge via ({waypoint[0]:.2f}, {waypoint[1]:.2f})"
             )
 
-    def _concave_edge_waypoint(self, obs: Observation, cells: np.ndarray) -> np.ndarray | None:
+    def _concave_edge_waypoint(self, obs: Observation) -> np.ndarray | None:
         """A point just past the nearer edge of a concave obstacle ahead, or None."""
         p = self.params
+        cells, labels, _ = self.map.clusters(p["map_threshold"], self._link_m())
         heading = unit(obs.goal - obs.position)
         rel = cells - obs.position
         forward = rel @ heading
@@ -257,7 +281,6 @@ class VPlanePlanner:
         ahead = (forward > 0) & (forward < reach) & (lateral < self.radius + p["clearance_m"])
         if not ahead.any():
             return None
-        labels = cluster_points(cells, 2 * self.radius + p["clearance_m"])
         nearest = np.flatnonzero(ahead)[np.argmin(forward[ahead])]
         cluster = cells[labels == labels[nearest]]
         i1, i2, span = angular_extremes(obs.position, cluster)
@@ -275,5 +298,11 @@ class VPlanePlanner:
         edge = e1 if via[0] <= via[1] else e2
         outward = unit(edge - (e1 + e2) / 2)
         waypoint = edge + outward * (self.radius + p["clearance_m"] + 0.15)
-        free = np.min(np.hypot(*(cells - waypoint).T)) > self.radius + p["clearance_m"]
-        return waypoint if free else None
+        return waypoint if self._reachable(obs.position, waypoint, cells) else None
+
+    def _reachable(self, start: np.ndarray, end: np.ndarray, cells: np.ndarray) -> bool:
+        """No known obstacle cell within the robot's radius plus clearance of the segment."""
+        span = end - start
+        t = np.clip((cells - start) @ span / max(float(span @ span), 1e-12), 0.0, 1.0)
+        nearest = start + t[:, None] * span
+        return bool(np.min(np.hypot(*(cells - nearest).T)) > self.radius + self.params["clearance_m"])

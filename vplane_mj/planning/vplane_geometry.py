@@ -53,10 +53,20 @@ class VirtualPlane:
 
 
 def make_plane(
-    e1: np.ndarray, e2: np.ndarray, trap_points: np.ndarray, robot: np.ndarray, goal: np.ndarray
+    e1: np.ndarray,
+    e2: np.ndarray,
+    trap_points: np.ndarray,
+    robot: np.ndarray,
+    goal: np.ndarray,
+    extend: float = 0.0,
 ) -> VirtualPlane:
-    """The plane e1-e2 whose normal points away from the trap's obstacle points (their mean)."""
+    """The plane e1-e2 whose normal points away from the trap's obstacle points (their mean).
+
+    Sonar sees a trap's mouth only at its sampled points, so the extreme points lie a
+    little inside the true ends: the plane is lengthened by `extend` (m) at both ends.
+    """
     tangent = unit(e2 - e1)
+    e1, e2 = e1 - extend * tangent, e2 + extend * tangent
     normal = np.array([-tangent[1], tangent[0]])
     if (np.mean(trap_points, axis=0) - e1) @ normal > 0:
         normal = -normal

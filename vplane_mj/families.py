@@ -1,0 +1,168 @@
+"""Generated scenario families, as TOML documents: the trap suite of U/C and H obstacles.
+
+Each case places its trap(s) in a 10 x 10 m arena at some orientation, with the start in
+front of the mouth or inside the cup and the goal behind the trap, so that the straight
+line from start to goal runs into the cup. Rotating a case (every obstacle, the start and
+the goal together about the arena's centre) gives the same problem at another angle.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import tomli_w
+
+ARENA = 10.0
+CENTER = (ARENA / 2, ARENA / 2)
+
+
+@dataclass(frozen=True)
+class Case:
+    """One generated scenario: its name, the TOML document, and the traps' footprints."""
+
+    name: str
+    document: dict
+    traps: list[dict] = field(default_factory=list)
+
+    def toml(self) -> str:
+        return tomli_w.dumps(self.document)
+
+
+def _polar(origin: tuple[float, float], radius: float, angle_deg: float) -> list[float]:
+    a = math.radians(angle_deg)
+    return [round(origin[0] + radius * math.cos(a), 6), round(origin[1] + radius * math.sin(a), 6)]
+
+
+def _rotate(point: list[float], angle_deg: float) -> list[float]:
+    """Rotate `point` about the arena's centre."""
+    a = math.radians(angle_deg)
+    x, y = point[0] - CENTER[0], point[1] - CENTER[1]
+    return [
+        round(CENTER[0] + x * math.cos(a) - y * math.sin(a), 6),
+        round(CENTER[1] + x * math.sin(a) + y * math.cos(a), 6),
+    ]
+
+
+def rotated(case: Case, angle_deg: float) -> Case:
+    """The same case with obstacles, start and goal rotated together about the arena centre."""
+    doc = {**case.document, "name": f"{case.name}_rot{round(angle_deg) % 360}"}
+    obstacles = []
+    for ob in case.document["world"].get("obstacles", []):
+        turned = dict(ob)
+        for key in ("center", "from", "to"):
+            if key in turned:
+                turned[key] = _rotate(turned[key], angle_deg)
+        if turned["kind"] in ("box", "u", "c", "h"):
+            turned["yaw_deg"] = round(turned.get("yaw_deg", 0.0) + angle_deg, 6)
+        obstacles.append(turned)
+    doc["world"] = {**case.document["world"], "obstacles": obstacles}
+    doc["robot"] = {
+        **case.document["robot"],
+        "start": _rotate(case.document["robot"]["start"], angle_deg),
+        "goal": _rotate(case.document["robot"]["goal"], angle_deg),
+    }
+    return Case(doc["name"], doc, case.traps)
+
+
+def _document(name: str, obstacles: list[dict], start: list[float], goal: list[float]) -> dict:
+    return {
+        "format": 1,
+        "name": name,
+        "description": "generated trap case",
+        "world": {"size": [ARENA, ARENA], "obstacles": obstacles},
+        "robot": {"start": start, "goal": goal},
+        "run": {"time_limit_s": 180.0},
+    }
+
+
+def cup_case(
+    name: str,
+    yaw_deg: float,
+    width: float = 1.6,
+    depth: float = 1.2,
+    inside: bool = False,
+    kind: str = "u",
+) -> Case:
+    """A U (or H) trap at the centre, the mouth toward the start, the goal behind it."""
+    mouth = yaw_deg + 180.0
+    if kind == "h":
+        obstacle = {
+            "kind": "h",
+            "center": list(CENTER),
+            "length": 2 * depth,
+            "width": width,
+            "yaw_deg": yaw_deg,
+            "thickness": 0.1,
+        }
+        inside_offset = depth / 2  # the middle of the cup that opens toward the start
+    else:
+        obstacle = {
+            "kind": kind,
+            "center": list(CENTER),
+            "width": width,
+            "depth": depth,
+            "yaw_deg": yaw_deg,
+            "thickness": 0.1,
+        }
+        inside_offset = 0.1
+    start = _polar(CENTER, inside_offset if inside else 3.5, mouth)
+    goal = _polar(CENTER, 3.8, yaw_deg)
+    return Case(name, _document(name, [obstacle], start, goal), [obstacle])
+
+
+def asymmetric_case(name: str, yaw_deg: float) -> Case:
+    """A cup built of walls whose arms differ in length (1.6 m and 0.8 m)."""
+
+    def local(x: float, y: float) -> list[float]:
+        a = math.radians(yaw_deg)
+        return [
+            round(CENTER[0] + x * math.cos(a) - y * math.sin(a), 6),
+            round(CENTER[1] + x * math.sin(a) + y * math.cos(a), 6),
+        ]
+
+    walls = [
+        {"kind": "wall", "from": local(0.6, -0.8), "to": local(0.6, 0.8), "thickness": 0.1},
+        {"kind": "wall", "from": local(-1.0, 0.75), "to": local(0.6, 0.75), "thickness": 0.1},
+        {"kind": "wall", "from": local(-0.2, -0.75), "to": local(0.6, -0.75), "thickness": 0.1},
+    ]
+    start = _polar(CENTER, 3.5, yaw_deg + 180.0)
+    goal = _polar(CENTER, 3.8, yaw_deg)
+    return Case(name, _document(name, walls, start, goal), walls)
+
+
+def two_traps_case(name: str, yaw_deg: float) -> Case:
+    """Two cups in a row on the line from start to goal, both opening toward the start."""
+    a = math.radians(yaw_deg)
+    cups = []
+    for offset in (-1.4, 1.6):
+        center = [round(CENTER[0] + offset * math.cos(a), 6), round(CENTER[1] + offset * math.sin(a), 6)]
+        cups.append(
+            {"kind": "u", "center": center, "width": 1.4, "depth": 1.0, "yaw_deg": yaw_deg, "thickness": 0.1}
+        )
+    start = _polar(CENTER, 4.2, yaw_deg + 180.0)
+    goal = _polar(CENTER, 4.2, yaw_deg)
+    return Case(name, _document(name, cups, start, goal), cups)
+
+
+def goal_near_wall_case(name: str) -> Case:
+    """A cup with the goal 0.3 m from the border wall behind it."""
+    obstacle = {"kind": "u", "center": [6.5, 5.0], "width": 1.6, "depth": 1.2, "thickness": 0.1}
+    return Case(name, _document(name, [obstacle], [2.0, 5.0], [9.7, 5.0]), [obstacle])
+
+
+def trap_suite() -> list[Case]:
+    """The trap suite: orientations off the axes, mouths narrow and wide, starts in and out."""
+    cases = []
+    for yaw in (0, 23, 75, 130, 200, 287):
+        cases.append(cup_case(f"u_front_{yaw}", yaw))
+        cases.append(cup_case(f"u_inside_{yaw}", yaw, inside=True))
+        cases.append(cup_case(f"h_front_{yaw}", yaw, kind="h"))
+    for yaw in (40, 160, 250):
+        cases.append(cup_case(f"h_inside_{yaw}", yaw, kind="h", inside=True))
+        cases.append(cup_case(f"u_narrow_{yaw}", yaw, width=0.9, depth=1.0))
+        cases.append(cup_case(f"u_wide_{yaw}", yaw, width=2.6, depth=1.6))
+        cases.append(asymmetric_case(f"asym_{yaw}", yaw))
+        cases.append(two_traps_case(f"two_{yaw}", yaw))
+    cases.append(goal_near_wall_case("goal_near_wall"))
+    return cases
