@@ -43,16 +43,23 @@ def polar_histogram(
     rel = np.asarray(cells, float) - origin
     d = np.hypot(rel[:, 0], rel[:, 1])
     inside = d < window_m
+    if not inside.any():
+        return h
     rel, d, c = rel[inside], d[inside], np.asarray(certainty, float)[inside]
     sector = 2 * math.pi / n_sectors
-    bearing = np.arctan2(rel[:, 1], rel[:, 0])
+    bearing = np.arctan2(rel[:, 1], rel[:, 0]) % (2 * math.pi)
     half = np.arcsin(np.minimum(1.0, enlarge_m / np.maximum(d, 1e-6)))
     magnitude = c * c * (window_m - d)
-    centers = (np.arange(n_sectors) + 0.5) * sector
-    # Angular distance from every sector centre to every cell's bearing: (n_sectors, N).
-    delta = np.abs((centers[:, None] - bearing[None, :] + math.pi) % (2 * math.pi) - math.pi)
-    h += np.where(delta <= half[None, :] + sector / 2, magnitude[None, :], 0.0).sum(axis=1)
-    return h
+    # Each cell adds its magnitude to the run of sectors [first, last] (indices may wrap):
+    # a difference array over two laps of the circle, folded back onto one.
+    first = np.floor((bearing - half) / sector).astype(int) + n_sectors
+    last = np.floor((bearing + half) / sector).astype(int) + n_sectors
+    last = np.minimum(last, first + n_sectors - 1)
+    steps = np.zeros(3 * n_sectors + 1)
+    np.add.at(steps, first, magnitude)
+    np.add.at(steps, last + 1, -magnitude)
+    laps = np.cumsum(steps)[: 3 * n_sectors].reshape(3, n_sectors)
+    return laps.sum(axis=0)
 
 
 def sector_of(bearing: float, n_sectors: int) -> int:
@@ -80,8 +87,11 @@ def find_valleys(blocked: np.ndarray) -> list[Valley]:
 
 def nearest_wide_valley(
     valleys: list[Valley], bearing: float, n_sectors: int, min_sectors: int
-) -> Valley | None:
-    """The valley at least `min_sectors` wide whose nearest sector is closest to `bearing`."""
+) -> tuple[Valley | None, int]:
+    """The valley at least `min_sectors` wide nearest to `bearing`, and how many sectors away.
+
+    The distance is 0 when `bearing` lies in the valley; (None, n_sectors) when none is wide.
+    """
     target = sector_of(bearing, n_sectors)
     best, best_gap = None, n_sectors
     for valley in valleys:
@@ -91,4 +101,4 @@ def nearest_wide_valley(
         gap = 0 if offset < valley.count else min(offset - valley.count + 1, n_sectors - offset)
         if gap < best_gap:
             best, best_gap = valley, gap
-    return best
+    return best, best_gap

@@ -13,6 +13,7 @@ is the planner's only memory of obstacles, built from the sonar ring and the pos
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -34,21 +35,29 @@ class LocalMap:
     ) -> None:
         """Fold one scan of the sonar ring (ranges in m from the robot's centre) into the grid."""
         self._follow(position)
-        centres = self._cell_centres()
-        rel_x = centres[0][:, None] - position[0]
-        rel_y = centres[1][None, :] - position[1]
-        distance = np.hypot(rel_x, rel_y)
-        bearing = np.arctan2(rel_y, rel_x) - yaw
+        if not np.isfinite(ranges).any():
+            return
+        # Only the cells within the longest reading can change: work on that window.
+        reach = math.ceil(float(np.nanmax(ranges)) / self.cell_m) + 1
+        centre = np.floor(np.asarray(position) / self.cell_m).astype(int) - self.origin
+        lo = np.maximum(centre - reach, 0)
+        hi = np.minimum(centre + reach + 1, self.n)
+        if np.any(hi <= lo):
+            return
+        rel_x = (self.origin[0] + np.arange(lo[0], hi[0]) + 0.5) * self.cell_m - position[0]
+        rel_y = (self.origin[1] + np.arange(lo[1], hi[1]) + 0.5) * self.cell_m - position[1]
+        distance = np.hypot(rel_x[:, None], rel_y[None, :])
+        bearing = np.arctan2(rel_y[None, :], rel_x[:, None]) - (yaw + bearings[0])
         spacing = 2 * math.pi / len(bearings)
-        sonar = np.round((bearing - bearings[0]) / spacing).astype(int) % len(bearings)
-        offset = (bearing - bearings[sonar] + math.pi) % (2 * math.pi) - math.pi
+        sonar = np.round(bearing / spacing).astype(int) % len(bearings)
+        offset = (bearing - sonar * spacing + math.pi) % (2 * math.pi) - math.pi
         reading = ranges[sonar]
         in_cone = (np.abs(offset) <= beam / 2) & np.isfinite(reading)
-        reading = np.where(in_cone, reading, 0.0)
-        free = in_cone & (distance < reading - self.cell_m)
-        arc = in_cone & (np.abs(distance - reading) <= 0.75 * self.cell_m)
-        self.grid[free] = np.maximum(self.grid[free] - self.miss, 0)
-        self.grid[arc] = np.minimum(self.grid[arc] + self.hit, self.max_certainty)
+        reading = np.where(in_cone, reading, -1.0)
+        window = self.grid[lo[0] : hi[0], lo[1] : hi[1]]  # a view: updated in place
+        window -= self.miss * (in_cone & (distance < reading - self.cell_m))
+        window += self.hit * (np.abs(distance - reading) <= 0.75 * self.cell_m)
+        np.clip(window, 0, self.max_certainty, out=window)
 
     def cells(self, min_certainty: int = 1) -> tuple[np.ndarray, np.ndarray]:
         """Centres (N, 2) in metres and certainties (N,) of cells at or above a certainty."""
@@ -66,9 +75,9 @@ class LocalMap:
         diameter plus a clearance.
         """
         occupied = self.grid >= min_certainty
-        reach = max(1, round(link_m / (2 * self.cell_m)))
-        disk = np.hypot(*np.mgrid[-reach : reach + 1, -reach : reach + 1]) <= reach
-        grid_labels, _ = ndimage.label(ndimage.binary_dilation(occupied, structure=disk))
+        grid_labels, _ = ndimage.label(
+            ndimage.binary_dilation(occupied, structure=_disk(link_m / 2, self.cell_m))
+        )
         i, j = np.nonzero(occupied)
         if self.origin is None or len(i) == 0:
             return np.empty((0, 2)), np.empty(0, dtype=int), grid_labels
@@ -102,6 +111,13 @@ class LocalMap:
         moved[dst[0], dst[1]] = self.grid[src[0], src[1]]
         self.grid = moved
         self.origin = centre_cell
+
+
+@functools.cache
+def _disk(radius_m: float, cell_m: float) -> np.ndarray:
+    """A disc-shaped structuring element of `radius_m` in cells (at least one cell)."""
+    reach = max(1, round(radius_m / cell_m))
+    return np.hypot(*np.mgrid[-reach : reach + 1, -reach : reach + 1]) <= reach
 
 
 def angular_extremes(origin: np.ndarray, points: np.ndarray) -> tuple[int, int, float]:

@@ -40,6 +40,12 @@ from vplane_mj.planning.vplane_geometry import (
     virtual_objective,
 )
 
+CONCAVITY_CHECK_PERIOD_S = 0.2
+"""How often (s) the map is examined for a concave obstacle ahead (cheap checks run every tick)."""
+
+EDGE_OFFSETS_M = (0.05, 0.3, 0.6)
+"""Distances beyond the robot's width at which a waypoint past a concave obstacle's edge is tried."""
+
 PARAMS: dict[str, Param] = {
     **FIELD_PARAMS,
     **{k: v for k, v in MINIMUM_PARAMS.items() if k != "patience_s"},
@@ -99,6 +105,7 @@ class VPlanePlanner:
         self.escape_started_s = 0.0
         self.escapes_tried = 0
         self.avoid_waypoint: np.ndarray | None = None
+        self.next_concavity_check_s = 0.0
         self.echoes: deque[np.ndarray] = deque(maxlen=max(1, round(p["echo_memory"])))
 
     # -- the loop -------------------------------------------------------------------------
@@ -258,16 +265,31 @@ class VPlanePlanner:
                 self.avoid_waypoint = None
                 decision.events.append("avoidance finished: edge passed")
             return
-        min_sectors = max(1, math.ceil(p["min_gap_deg"] / p["sector_deg"]))
-        valley = histogram.nearest_wide_valley(
-            histogram.find_valleys(blocked), goal_bearing, self.n_sectors, min_sectors
-        )
+        if obs.time_s < self.next_concavity_check_s:
+            return
+        self.next_concavity_check_s = obs.time_s + CONCAVITY_CHECK_PERIOD_S
         waypoint = self._concave_edge_waypoint(obs)
-        if waypoint is not None and valley is not None:
+        if waypoint is not None and self._passage_is_wide(blocked, waypoint - obs.position):
             self.avoid_waypoint = waypoint
             decision.events.append(
                 f"concave obstacle ahead: passing its edge via ({waypoint[0]:.2f}, {waypoint[1]:.2f})"
             )
+
+    def _passage_is_wide(self, blocked: np.ndarray, direction: np.ndarray) -> bool:
+        """Algorithm 1 step 5: a valley of at least `min_gap_deg` opens next to `direction`.
+
+        The waypoint just past an edge is seen along the edge itself, so the valley may
+        begin up to `min_gap_deg` beside its bearing.
+        """
+        p = self.params
+        min_sectors = max(1, math.ceil(p["min_gap_deg"] / p["sector_deg"]))
+        _, distance = histogram.nearest_wide_valley(
+            histogram.find_valleys(blocked),
+            math.atan2(direction[1], direction[0]),
+            self.n_sectors,
+            min_sectors,
+        )
+        return distance <= min_sectors
 
     def _concave_edge_waypoint(self, obs: Observation) -> np.ndarray | None:
         """A point just past the nearer edge of a concave obstacle ahead, or None."""
@@ -296,9 +318,18 @@ class VPlanePlanner:
             return None
         via = [np.hypot(*(e - obs.position)) + np.hypot(*(obs.goal - e)) for e in (e1, e2)]
         edge = e1 if via[0] <= via[1] else e2
-        outward = unit(edge - (e1 + e2) / 2)
-        waypoint = edge + outward * (self.radius + p["clearance_m"] + 0.15)
-        return waypoint if self._reachable(obs.position, waypoint, cells) else None
+        # Beside the edge as seen from the robot, on the side away from the obstacle's middle,
+        # so the straight way there passes the edge at that distance.
+        sight = unit(edge - obs.position)
+        outward = np.array([-sight[1], sight[0]])
+        if outward @ (edge - (e1 + e2) / 2) < 0:
+            outward = -outward
+        # Just past the edge; farther out when the straight way there grazes the obstacle.
+        for offset in EDGE_OFFSETS_M:
+            waypoint = edge + outward * (self._link_m() + offset)
+            if self._reachable(obs.position, waypoint, cells):
+                return waypoint
+        return None
 
     def _reachable(self, start: np.ndarray, end: np.ndarray, cells: np.ndarray) -> bool:
         """No known obstacle cell within the robot's radius plus clearance of the segment."""
