@@ -67,7 +67,7 @@ PARAMS: dict[str, Param] = {
     ),
     "vno_gain": Param(0.5, "1/m", "gamma of eq. 7, attraction of the virtual new objective", gt=0),
     "vno_tolerance_m": Param(0.15, "m", "distance at which the virtual objective counts as reached", gt=0),
-    "escape_margin_m": Param(0.15, "m", "objective lies at least radius + this outside the trap", ge=0),
+    "escape_margin_m": Param(0.3, "m", "objective lies at least radius + this outside the trap", ge=0),
     "escape_timeout_s": Param(25.0, "s", "an escape that takes longer starts over", gt=0),
     "max_escapes": Param(4, "", "escapes tried before giving up", ge=1, integer=True),
     "plane_gain": Param(0.05, "m", "eta of eqs. 8-10, virtual plane repulsion gain", gt=0),

@@ -63,13 +63,16 @@ def make_plane(
     """The plane e1-e2 whose normal points away from the trap's obstacle points (their mean).
 
     Sonar sees a trap's mouth only at its sampled points, so the extreme points lie a
-    little inside the true ends: the plane is lengthened by `extend` (m) at both ends.
+    little inside the true ends: the plane is lengthened by `extend` (m) at both ends and
+    moved out along its normal to the trap's outermost point, so that it closes the mouth.
     """
     tangent = unit(e2 - e1)
-    e1, e2 = e1 - extend * tangent, e2 + extend * tangent
     normal = np.array([-tangent[1], tangent[0]])
     if (np.mean(trap_points, axis=0) - e1) @ normal > 0:
         normal = -normal
+    outermost = max(0.0, float(np.max((np.asarray(trap_points) - e1) @ normal)))
+    shift = outermost * normal
+    e1, e2 = e1 - extend * tangent + shift, e2 + extend * tangent + shift
     via_e1 = np.hypot(*(e1 - robot)) + np.hypot(*(goal - e1))
     via_e2 = np.hypot(*(e2 - robot)) + np.hypot(*(goal - e2))
     return VirtualPlane(e1=e1, e2=e2, normal=normal, slide=1.0 if via_e2 <= via_e1 else -1.0)

@@ -1,0 +1,69 @@
+"""The VFH polar histogram: enlargement, valleys (circular), wide-enough gaps."""
+
+import math
+
+import numpy as np
+import pytest
+
+from vplane_mj.planning.histogram import (
+    Valley,
+    find_valleys,
+    nearest_wide_valley,
+    polar_histogram,
+    sector_of,
+)
+
+N = 72  # 5 degree sectors
+ENLARGE = 0.19  # robot radius 0.11 + clearance 0.08
+
+
+def blocked_by(cells, window=3.0):
+    cells = np.array(cells, float)
+    h = polar_histogram(np.zeros(2), cells, np.full(len(cells), 4), N, window, ENLARGE)
+    return h > 1.0
+
+
+def test_a_point_blocks_the_sectors_its_enlarged_disc_covers():
+    blocked = blocked_by([[1.0, 0.0]])
+    half = math.degrees(math.asin(ENLARGE / 1.0))  # 11 degrees either side
+    expected = {k % N for k in range(-math.ceil(half / 5), math.ceil(half / 5))}
+    assert set(np.flatnonzero(blocked)) == expected
+
+
+def test_cells_beyond_the_window_do_not_count():
+    assert not blocked_by([[3.5, 0.0]]).any()
+
+
+def test_valleys_are_circular_runs_of_free_sectors():
+    blocked = np.zeros(12, bool)
+    blocked[[2, 3, 8]] = True
+    valleys = find_valleys(blocked)
+    assert {(v.first, v.last, v.count) for v in valleys} == {(4, 7, 4), (9, 1, 5)}
+    assert find_valleys(np.zeros(6, bool)) == [Valley(0, 5, 6)]
+    assert find_valleys(np.ones(6, bool)) == []
+
+
+def gap_cells(gap):
+    """Two walls 1.5 m ahead, along y, leaving a gap of `gap` metres around y = 0."""
+    ys = np.concatenate([np.arange(gap / 2, 1.5, 0.05), -np.arange(gap / 2, 1.5, 0.05)])
+    return [[1.5, y] for y in ys]
+
+
+@pytest.mark.parametrize("gap, passable", [(0.25, False), (0.35, False), (0.9, True), (1.4, True)])
+def test_a_gap_is_a_valley_only_when_the_robot_fits(gap, passable):
+    blocked = blocked_by(gap_cells(gap))
+    valley, distance = nearest_wide_valley(find_valleys(blocked), 0.0, N, min_sectors=2)
+    ahead_is_free = not blocked[sector_of(0.0, N)]
+    assert ahead_is_free == passable
+    if passable:
+        assert distance == 0 and valley.count >= 2
+
+
+def test_nearest_wide_valley_skips_narrow_ones_and_measures_distance():
+    blocked = np.ones(36, bool)
+    blocked[[5]] = False  # one free sector: too narrow
+    blocked[10:14] = False  # four free sectors
+    valleys = find_valleys(blocked)
+    valley, distance = nearest_wide_valley(valleys, math.radians(5 * 10), 36, min_sectors=3)
+    assert (valley.first, valley.count) == (10, 4) and distance == 5
+    assert nearest_wide_valley(valleys, 0.0, 36, min_sectors=5) == (None, 36)

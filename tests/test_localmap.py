@@ -1,0 +1,96 @@
+"""The sonar certainty grid: beam arcs, free-cone carving, clusters and extreme points."""
+
+import math
+
+import numpy as np
+import pytest
+
+from synthetic import BEAM, BEARINGS, scan
+from vplane_mj import shapes
+from vplane_mj.planning.localmap import LocalMap, angular_extremes
+
+WALL = shapes.Footprints(shapes.Wall((2.0, -1.0), (2.0, 1.0), 0.1).footprint())
+
+
+def mapped(footprints, position, yaw=0.0, scans=3):
+    grid = LocalMap(cell_m=0.1, size_m=8.0)
+    for _ in range(scans):
+        grid.update(np.array(position), yaw, BEARINGS, scan(footprints, position, yaw), BEAM)
+    return grid
+
+
+def test_echoes_mark_the_wall_and_nothing_well_in_front_of_it():
+    grid = mapped(WALL, (0.0, 0.0))
+    cells, certainty = grid.cells(min_certainty=4)
+    assert len(cells) > 5
+    # The wall's near face is at x = 1.95. A 20 degree beam places its echo anywhere on its
+    # arc, so oblique beams mark cells up to 2 r sin^2(10 deg) ~ 0.3 m in front of the face.
+    assert np.median(cells[:, 0]) == pytest.approx(1.95, abs=0.1)
+    assert np.all((cells[:, 0] > 1.95 - 0.35) & (cells[:, 0] < 1.95 + 0.15))
+    assert certainty.max() <= 15
+
+
+def test_a_phantom_echo_is_carved_away_by_later_readings():
+    grid = LocalMap(cell_m=0.1, size_m=8.0)
+    ranges = np.full(16, np.nan)
+    ranges[0] = 1.0  # something at 1 m ahead, once
+    grid.update(np.zeros(2), 0.0, BEARINGS, ranges, BEAM)
+    assert len(grid.cells(3)[0]) > 0
+    ranges[0] = 2.5  # then the beam sees past it, again and again
+    for _ in range(3):
+        grid.update(np.zeros(2), 0.0, BEARINGS, ranges, BEAM)
+    cells, _ = grid.cells(1)
+    assert not np.any(np.hypot(*cells.T) < 2.3)
+
+
+def test_no_echo_leaves_the_map_unchanged():
+    grid = mapped(WALL, (0.0, 0.0))
+    before = grid.grid.copy()
+    grid.update(np.zeros(2), 0.0, BEARINGS, np.full(16, np.nan), BEAM)
+    np.testing.assert_array_equal(grid.grid, before)
+
+
+def test_the_grid_follows_the_robot_and_keeps_what_it_saw():
+    grid = mapped(WALL, (0.0, 0.0))
+    count = len(grid.cells(4)[0])
+    grid.update(np.array([2.5, 0.0]) - [1.8, 0.0], 0.0, BEARINGS, np.full(16, np.nan), BEAM)
+    grid.update(np.array([-2.0, 0.0]), 0.0, BEARINGS, np.full(16, np.nan), BEAM)
+    assert len(grid.cells(4)[0]) == count  # shifted, not lost: the wall is still within 4 m
+    grid.update(np.array([-9.0, 0.0]), 0.0, BEARINGS, np.full(16, np.nan), BEAM)
+    assert len(grid.cells(1)[0]) == 0  # far away: forgotten
+
+
+def test_cells_closer_than_the_link_distance_form_one_cluster():
+    two_walls = shapes.Footprints(
+        [*shapes.Wall((2.0, -1.0), (2.0, -0.1), 0.1).footprint(),
+         *shapes.Wall((2.0, 0.5), (2.0, 1.5), 0.1).footprint()]
+    )
+    grid = mapped(two_walls, (0.0, 0.0), scans=5)
+    _, labels_narrow, _ = grid.clusters(4, link_m=0.3)
+    _, labels_wide, _ = grid.clusters(4, link_m=1.0)
+    assert len(set(labels_narrow)) == 2  # a 0.6 m gap is wider than 0.3 m
+    assert len(set(labels_wide)) == 1
+
+
+def test_extreme_points_of_a_cup_seen_from_inside_are_the_mouth():
+    # A cup opening toward -x around the origin, the robot inside it.
+    cup = shapes.Cup((0.0, 0.0), width=1.6, depth=1.2, thickness=0.1)
+    points = []
+    for piece in cup.footprint():  # sample each wall along its long axis
+        long_x = piece.half[0] > piece.half[1]
+        for t in np.linspace(-1, 1, 15):
+            offset = (t * piece.half[0], 0.0) if long_x else (0.0, t * piece.half[1])
+            points.append((piece.center[0] + offset[0], piece.center[1] + offset[1]))
+    points = np.array(points)
+    i1, i2, span = angular_extremes(np.array([0.0, 0.0]), points)
+    assert span > math.pi
+    mouth = {tuple(np.round(points[i1], 2)), tuple(np.round(points[i2], 2))}
+    assert mouth == {(-0.6, 0.75), (-0.6, -0.75)}
+
+
+def test_extreme_points_of_an_obstacle_ahead():
+    points = np.array([[2.0, y] for y in np.linspace(-1.0, 1.0, 11)])
+    i1, i2, span = angular_extremes(np.zeros(2), points)
+    assert points[i1] == pytest.approx([2.0, -1.0])  # clockwise end first
+    assert points[i2] == pytest.approx([2.0, 1.0])
+    assert span == pytest.approx(2 * math.atan(0.5))
