@@ -4,8 +4,8 @@ import math
 
 import numpy as np
 import pytest
-
 from synthetic import BEAM, BEARINGS, scan
+
 from vplane_mj import shapes
 from vplane_mj.planning.localmap import LocalMap, angular_extremes
 
@@ -62,13 +62,16 @@ def test_the_grid_follows_the_robot_and_keeps_what_it_saw():
 
 def test_cells_closer_than_the_link_distance_form_one_cluster():
     two_walls = shapes.Footprints(
-        [*shapes.Wall((2.0, -1.0), (2.0, -0.1), 0.1).footprint(),
-         *shapes.Wall((2.0, 0.5), (2.0, 1.5), 0.1).footprint()]
+        [
+            *shapes.Wall((2.0, -1.0), (2.0, -0.1), 0.1).footprint(),
+            *shapes.Wall((2.0, 1.4), (2.0, 2.5), 0.1).footprint(),
+        ]
     )
     grid = mapped(two_walls, (0.0, 0.0), scans=5)
     _, labels_narrow, _ = grid.clusters(4, link_m=0.3)
-    _, labels_wide, _ = grid.clusters(4, link_m=1.0)
-    assert len(set(labels_narrow)) == 2  # a 0.6 m gap is wider than 0.3 m
+    _, labels_wide, _ = grid.clusters(4, link_m=2.0)
+    # A 1.5 m gap, narrowed by the beams' arcs (a 20 degree beam is 0.7 m wide at 2 m)
+    assert len(set(labels_narrow)) == 2
     assert len(set(labels_wide)) == 1
 
 

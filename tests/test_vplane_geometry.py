@@ -26,8 +26,9 @@ def cup_in_frame(angle, offset=(3.0, 4.0)):
     rot, shift = rotation(angle), np.array(offset)
     e1 = rot @ [-0.6, -0.75] + shift
     e2 = rot @ [-0.6, 0.75] + shift
-    walls = np.array([rot @ [x, y] + shift for x, y in
-                      [(0.6, -0.7), (0.6, 0.0), (0.6, 0.7), (0.0, 0.75), (0.0, -0.75)]])
+    walls = np.array(
+        [rot @ [x, y] + shift for x, y in [(0.6, -0.7), (0.6, 0.0), (0.6, 0.7), (0.0, 0.75), (0.0, -0.75)]]
+    )
     robot = rot @ [0.1, 0.0] + shift  # inside, near the back
     goal = rot @ [4.0, 0.3] + shift  # behind the back wall
     return e1, e2, walls, robot, goal
@@ -57,7 +58,7 @@ def test_objective_lies_outside_the_trap_for_any_orientation(angle):
     e1, e2, walls, robot, goal = cup_in_frame(angle)
     plane = make_plane(e1, e2, walls, robot, goal)
     objective = virtual_objective(robot, e1, e2, goal, plane, clearance=0.26)
-    along, out = plane.frame_coordinates(objective)
+    _, out = plane.frame_coordinates(objective)
     assert out >= 0.26 - 1e-9
     # the normal points away from the trap: the back wall is on the inner side
     assert plane.frame_coordinates(walls[1])[1] < 0
@@ -85,8 +86,9 @@ def test_plane_is_extended_and_slides_toward_the_shorter_way():
 
 
 def test_corridor_activation_in_the_plane_frame():
-    plane = make_plane(np.array([0.0, -1.0]), np.array([0.0, 1.0]), np.array([[1.0, 0.0]]),
-                       np.zeros(2), np.array([4.0, 0.0]))
+    plane = make_plane(
+        np.array([0.0, -1.0]), np.array([0.0, 1.0]), np.array([[1.0, 0.0]]), np.zeros(2), np.array([4.0, 0.0])
+    )
     assert plane.in_corridor(np.array([-0.3, 0.0]), influence=0.6, margin=0.3)
     assert plane.in_corridor(np.array([-0.3, 1.25]), influence=0.6, margin=0.3)
     assert not plane.in_corridor(np.array([-0.3, 1.4]), influence=0.6, margin=0.3)
@@ -95,8 +97,9 @@ def test_corridor_activation_in_the_plane_frame():
 
 
 def straight_plane():
-    return make_plane(np.array([0.0, -1.0]), np.array([0.0, 1.0]), np.array([[1.0, 0.0]]),
-                      np.zeros(2), np.array([4.0, 0.5]))
+    return make_plane(
+        np.array([0.0, -1.0]), np.array([0.0, 1.0]), np.array([[1.0, 0.0]]), np.zeros(2), np.array([4.0, 0.5])
+    )
 
 
 def test_plane_force_points_outward_with_a_tangential_slide():
@@ -118,8 +121,10 @@ def test_plane_force_does_not_grow_with_the_number_of_points():
 
 def test_plane_force_grows_toward_the_plane_and_vanishes_beyond_influence():
     plane = straight_plane()
-    magnitudes = [np.linalg.norm(plane_force(np.array([-d, 0.0]), plane, 0.05, 0.6, 0.05, 0.0))
-                  for d in (0.1, 0.2, 0.4, 0.59)]
+    magnitudes = [
+        np.linalg.norm(plane_force(np.array([-d, 0.0]), plane, 0.05, 0.6, 0.05, 0.0))
+        for d in (0.1, 0.2, 0.4, 0.59)
+    ]
     assert magnitudes == sorted(magnitudes, reverse=True)
     assert plane_force(np.array([-0.7, 0.0]), plane, 0.05, 0.6, 0.05, 1.0) == pytest.approx([0, 0])
 

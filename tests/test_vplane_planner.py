@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
 from synthetic import BEAM, BEARINGS, scan
+
 from vplane_mj import shapes
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Observation
@@ -28,8 +28,13 @@ def to_local(point, rot):
 
 def observe(footprints, position, yaw, goal, time_s):
     return Observation(
-        time_s=time_s, position=np.asarray(position, float), yaw=yaw, goal=np.asarray(goal, float),
-        goal_tolerance=0.15, bearings=BEARINGS, ranges=scan(footprints, position, yaw),
+        time_s=time_s,
+        position=np.asarray(position, float),
+        yaw=yaw,
+        goal=np.asarray(goal, float),
+        goal_tolerance=0.15,
+        bearings=BEARINGS,
+        ranges=scan(footprints, position, yaw),
         beam_width=BEAM,
     )
 
@@ -106,8 +111,9 @@ def test_planner_never_returns_non_finite_forces():
     for k in range(40):  # an echo at (almost) zero range every tick, robot not moving
         ranges = np.full(16, np.nan)
         ranges[k % 16] = 1e-9
-        obs = Observation(k * 0.05, np.array([1.0, 1.0]), 0.0, np.array([1.0, 1.0 + 1e-12]), 0.15,
-                          BEARINGS, ranges, BEAM)
+        obs = Observation(
+            k * 0.05, np.array([1.0, 1.0]), 0.0, np.array([1.0, 1.0 + 1e-12]), 0.15, BEARINGS, ranges, BEAM
+        )
         decision = planner.step(obs)
         assert np.all(np.isfinite(decision.force))
 

@@ -70,7 +70,8 @@ class LocalMap:
     def clusters(self, min_certainty: int, link_m: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Cell centres (N, 2), their cluster labels (N,) and the label grid (n, n).
 
-        Cells closer than `link_m` share a label (label 0 is free space). Two obstacle cells
+        Cells closer than about `link_m` (rounded up to whole cells) share a label; label 0
+        is free space. Two obstacle cells
         closer than the robot's width form one barrier, so `link_m` is normally the robot's
         diameter plus a clearance.
         """
@@ -116,7 +117,7 @@ class LocalMap:
 @functools.cache
 def _disk(radius_m: float, cell_m: float) -> np.ndarray:
     """A disc-shaped structuring element of `radius_m` in cells (at least one cell)."""
-    reach = max(1, round(radius_m / cell_m))
+    reach = max(1, math.ceil(radius_m / cell_m - 1e-9))
     return np.hypot(*np.mgrid[-reach : reach + 1, -reach : reach + 1]) <= reach
 
 
