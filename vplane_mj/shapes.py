@@ -122,6 +122,11 @@ class Cup:
         ]
         return _place(local, self.center, self.yaw)
 
+    def interior(self) -> tuple[Rect, ...]:
+        """The open space inside the cup, from the mouth to the back wall (the trap)."""
+        w, d, t = self.width, self.depth, self.thickness
+        return _place([_span(-d / 2, d / 2 - t, -w / 2 + t, w / 2 - t)], self.center, self.yaw)
+
 
 @dataclass(frozen=True)
 class HShape:
@@ -139,6 +144,15 @@ class HShape:
             _span(-ln / 2, ln / 2, w / 2 - t, w / 2),  # post at +y
             _span(-ln / 2, ln / 2, -w / 2, -w / 2 + t),  # post at -y
             _span(-t / 2, t / 2, -w / 2, w / 2),  # crossbar
+        ]
+        return _place(local, self.center, self.yaw)
+
+    def interior(self) -> tuple[Rect, ...]:
+        """The open space of both cups, each between the crossbar and the posts' ends."""
+        ln, w, t = self.length, self.width, self.thickness
+        local = [
+            _span(-ln / 2, -t / 2, -w / 2 + t, w / 2 - t),
+            _span(t / 2, ln / 2, -w / 2 + t, w / 2 - t),
         ]
         return _place(local, self.center, self.yaw)
 

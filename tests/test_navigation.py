@@ -1,0 +1,98 @@
+"""Navigation outcomes in MuJoCo (fixed seeds): vplane against apf on the paper's traps."""
+
+import math
+import statistics
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from vplane_mj import shapes
+from vplane_mj.families import cup_case, rotated, trap_suite
+from vplane_mj.scenario import parse_scenario
+from vplane_mj.sim import run_scenario
+
+PAPER = ["paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape"]
+
+
+class Events:
+    def __init__(self):
+        self.events = []
+
+    def on_tick(self, tick):
+        pass
+
+    def on_event(self, time_s, text):
+        self.events.append((time_s, text))
+
+
+def inside_trap(scenario, positions):
+    """For each position: is the robot's centre inside a cup's open interior?"""
+    interiors = [r for ob in scenario.world.obstacles if hasattr(ob, "interior") for r in ob.interior()]
+    return shapes.Footprints(interiors).distance(positions) < 0
+
+
+@pytest.mark.parametrize("name", PAPER)
+def test_vplane_reaches_the_goal_in_the_paper_scenarios(shipped, name):
+    scenario = shipped(name)
+    summary = run_scenario(scenario).summary
+    straight = math.dist(scenario.robot.start, scenario.robot.goal)
+    assert summary["outcome"] == "reached" and summary["success"], summary
+    assert summary["collisions"] == 0
+    assert straight - 0.2 < summary["path_length_m"] < 2.0 * straight
+    assert summary["min_clearance_m"] > 0.05
+
+
+@pytest.mark.parametrize("name", ["paper_c_avoid", "paper_h_avoid"])
+def test_histogram_avoidance_passes_the_cup_without_entering(shipped, name):
+    scenario = shipped(name)
+    result = run_scenario(scenario)
+    assert result.summary["reached"] and result.summary["local_minima"] == 0
+    assert not inside_trap(scenario, result.positions).any()
+    assert "avoiding" in result.modes
+
+
+@pytest.mark.parametrize("name", ["paper_c_escape", "paper_h_escape"])
+def test_after_the_escape_the_robot_never_reenters_the_trap(shipped, name):
+    scenario = shipped(name)
+    watcher = Events()
+    result = run_scenario(scenario, observers=(watcher,))
+    assert result.summary["reached"] and result.summary["escapes"] >= 1
+    escaped_at = min(t for t, text in watcher.events if text.startswith("objective reached"))
+    before = result.times < escaped_at
+    assert inside_trap(scenario, result.positions[before]).any()  # it was trapped
+    assert not inside_trap(scenario, result.positions[~before]).any()  # and never went back
+
+
+def _run_case(job):
+    toml, name, planner = job
+    summary = run_scenario(parse_scenario(toml, name, [f"planner.name={planner}"])).summary
+    return name, planner, summary["success"], summary["time_to_goal_s"], summary["path_length_m"]
+
+
+def test_trap_suite_vplane_succeeds_where_apf_is_trapped():
+    cases = trap_suite()
+    jobs = [(case.toml(), case.name, planner) for case in cases for planner in ("vplane", "apf")]
+    with ProcessPoolExecutor(max_workers=2) as pool:
+        rows = list(pool.map(_run_case, jobs))
+    rate = {p: np.mean([ok for _, planner, ok, _, _ in rows if planner == p]) for p in ("vplane", "apf")}
+    times = [t for _, planner, ok, t, _ in rows if planner == "vplane" and ok]
+    print(
+        f"\ntrap suite of {len(cases)}: vplane {rate['vplane']:.0%}, apf {rate['apf']:.0%}, "
+        f"vplane median time to goal {statistics.median(times):.1f} s"
+    )
+    assert rate["vplane"] >= 0.95
+    assert rate["apf"] <= 0.1
+
+
+@settings(max_examples=4, deadline=None)
+@given(st.floats(min_value=0.0, max_value=360.0))
+def test_a_rotated_trap_gives_the_same_outcome(angle):
+    case = cup_case("u_front", 0.0)
+    base = run_scenario(parse_scenario(case.toml(), "base.toml")).summary
+    turned = run_scenario(parse_scenario(rotated(case, angle).toml(), "rotated.toml")).summary
+    assert base["success"] and turned["success"]
+    assert turned["escapes"] == base["escapes"]
+    assert turned["path_length_m"] == pytest.approx(base["path_length_m"], rel=0.2)
