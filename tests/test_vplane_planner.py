@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from synthetic import BEAM, BEARINGS, scan
 
 from vplane_mj import shapes
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Observation
+from vplane_mj.synthetic import BEAM, BEARINGS, scan
 
 RADIUS = 0.11
 

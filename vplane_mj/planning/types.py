@@ -42,7 +42,9 @@ class Decision:
 
     `components` names the parts of the force (attractive, repulsive, ...) for the log;
     `events` are short human-readable notes of what happened this tick;
-    `local_minimum` and `escape_completed` mark a detection and a finished escape.
+    `local_minimum` and `escape_completed` mark a detection and a finished escape;
+    `objective` is the virtual new objective while one exists (world frame, m) and
+    `planes` the virtual planes in force, each as its two end points.
     """
 
     force: np.ndarray
@@ -52,3 +54,5 @@ class Decision:
     local_minimum: bool = False
     escape_completed: bool = False
     gave_up: bool = False
+    objective: np.ndarray | None = None
+    planes: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)

@@ -147,6 +147,8 @@ class VPlanePlanner:
         components["virtual"] = self._planes_force(obs.position)
         decision.components = components
         decision.force = sum(components.values(), np.zeros(2))
+        decision.objective = self.temp_goal
+        decision.planes = [(plane.e1, plane.e2) for plane in self.planes]
         return decision
 
     # -- Algorithm 2: escaping ---------------------------------------------------------------

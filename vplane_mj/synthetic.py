@@ -1,4 +1,8 @@
-"""Synthetic sonar scans for the planners' pure tests: exact ray casts against footprints."""
+"""Synthetic sonar scans without physics: exact ray casts against obstacle footprints.
+
+The default 16-sonar ring with 3 rays over a 20 degree beam, like the simulator's, for
+exercising the planners in pure numpy (tests, figures). Ranges are from the robot's centre.
+"""
 
 import math
 
