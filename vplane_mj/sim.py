@@ -190,9 +190,10 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         if data.time >= scenario.run.time_limit_s - 1e-9:
             note("time limit reached")
             break
-        if data.time >= next_sonar - 1e-9:
+        if data.time >= next_sonar - 1e-9:  # a new sonar scan is due
             ranges = sonar.read(rays)
-            next_sonar += sonar_period
+            while next_sonar <= data.time + 1e-9:
+                next_sonar += sonar_period
         decision = planner.step(
             Observation(
                 time_s=data.time,
