@@ -114,48 +114,95 @@ class _Clearance:
         self._pending.clear()
 
 
+class _Drive:
+    """The robot in MuJoCo: its pose, and its wheels driven by PI loops at the motor rate.
+
+    One control tick is `chunks_per_tick` motor periods of `motor_steps` physics steps;
+    every wheel torque applied is recorded (for replay by the overhead benchmark).
+    """
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, control_hz: float):
+        self.model, self.data = model, data
+        self.gains = ControllerGains()
+        self.geometry = robot_geometry()
+        dt = model.opt.timestep
+        self.motor_steps = max(1, round(1.0 / (self.gains.motor_rate_hz * dt)))
+        self.motor_dt = self.motor_steps * dt
+        self.chunks_per_tick = max(1, round(1.0 / (control_hz * self.motor_dt)))
+        base = model.body(ROBOT_PREFIX + BASE_BODY).id
+        self.xpos, self.xmat = data.xpos[base], data.xmat[base]
+        free_joint = int(np.flatnonzero(model.jnt_type == mujoco.mjtJoint.mjJNT_FREE)[0])
+        self.root_dof = model.jnt_dofadr[free_joint]
+        self.wheel_dofs = [model.jnt_dofadr[model.joint(ROBOT_PREFIX + j).id] for j in WHEEL_JOINTS]
+        self.motors = [model.actuator(ROBOT_PREFIX + a).id for a in WHEEL_MOTORS]
+        limit = self.geometry["torque_limit_nm"]
+        self.wheels = [WheelPI(self.gains.wheel_kp, self.gains.wheel_ki, limit) for _ in self.motors]
+        self.torques: list[tuple[float, float]] = []
+        self.steps = 0
+
+    def yaw(self) -> float:
+        return math.atan2(self.xmat[3], self.xmat[0])
+
+    def planar_speed(self) -> float:
+        qvel = self.data.qvel
+        return math.hypot(qvel[self.root_dof], qvel[self.root_dof + 1])
+
+    def command(self, force: np.ndarray) -> tuple[float, float]:
+        """(v, omega) that heading control derives from a planner's force."""
+        return heading_command(float(force[0]), float(force[1]), self.yaw(), self.gains)
+
+    def run_tick(self, command: tuple[float, float], after_step) -> np.ndarray:
+        """Drive one control tick; return base_link's xy after every motor period (chunks, 2)."""
+        targets = wheel_targets(
+            *command,
+            self.geometry["track_m"],
+            self.geometry["wheel_radius_m"],
+            self.gains.max_wheel_speed,
+        )
+        (left_pi, right_pi), (left_dof, right_dof) = self.wheels, self.wheel_dofs
+        left_motor, right_motor = self.motors
+        qvel, ctrl, xpos = self.data.qvel, self.data.ctrl, self.xpos
+        trace = np.empty((self.chunks_per_tick, 2))
+        for chunk in range(self.chunks_per_tick):
+            left = left_pi.torque(targets[0], qvel[left_dof], self.motor_dt)
+            right = right_pi.torque(targets[1], qvel[right_dof], self.motor_dt)
+            ctrl[left_motor], ctrl[right_motor] = left, right
+            self.torques.append((left, right))
+            mujoco.mj_step(self.model, self.data, nstep=self.motor_steps)
+            trace[chunk] = xpos[0], xpos[1]
+            after_step()
+        self.steps += self.motor_steps * self.chunks_per_tick
+        return trace
+
+
 def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> RunResult:
     """Simulate one scenario to the goal, the time limit, or the planner giving up."""
     model = build_model(scenario)
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
-    geometry = robot_geometry()
-    gains = ControllerGains()
+    drive = _Drive(model, data, scenario.run.control_hz)
     sensors = scenario.sensors
     layout = SonarLayout.from_spec(sensors)
-    rng = np.random.default_rng(scenario.run.seed)
     sonar = SonarRing(
         sensors.count,
         sensors.rays_per_sonar,
         sensors.range_max,
         sensors.noise_std,
         sensors.dropout,
-        rng,
+        np.random.default_rng(scenario.run.seed),
     )
     first_ray = model.sensor_adr[model.sensor(ROBOT_PREFIX + "sonar0_ray0").id]
     rays = data.sensordata[first_ray : first_ray + sensors.count * sensors.rays_per_sonar]
-    planner = make_planner(scenario.planner, scenario.planner_params, geometry["radius_m"])
+    radius = drive.geometry["radius_m"]
+    planner = make_planner(scenario.planner, scenario.planner_params, radius)
     clearance = _Clearance(
         shapes.scene_footprints(
             scenario.world.obstacles, scenario.world.size if scenario.world.border else None
         )
     )
     collisions = _CollisionCounter(model, data)
-    found = collisions.found  # robot-obstacle contact count, a view into sensordata
-
-    dt = model.opt.timestep
-    motor_steps = max(1, round(1.0 / (gains.motor_rate_hz * dt)))
-    motor_dt = motor_steps * dt
-    chunks_per_tick = max(1, round(1.0 / (scenario.run.control_hz * motor_dt)))
-    base = model.body(ROBOT_PREFIX + BASE_BODY).id
-    root_dof = model.jnt_dofadr[int(np.flatnonzero(model.jnt_type == mujoco.mjtJoint.mjJNT_FREE)[0])]
-    left_dof, right_dof = (model.jnt_dofadr[model.joint(ROBOT_PREFIX + j).id] for j in WHEEL_JOINTS)
-    left_motor, right_motor = (model.actuator(ROBOT_PREFIX + a).id for a in WHEEL_MOTORS)
-    left_pi, right_pi = (
-        WheelPI(gains.wheel_kp, gains.wheel_ki, geometry["torque_limit_nm"]) for _ in range(2)
-    )
-    qvel, ctrl, base_xpos, base_xmat = data.qvel, data.ctrl, data.xpos[base], data.xmat[base]
     goal = np.asarray(scenario.robot.goal, float)
+    tolerance = scenario.robot.goal_tolerance
     sonar_period = 1.0 / sensors.rate_hz
     beam = math.radians(sensors.beam_deg)
     next_sonar = 0.0
@@ -164,9 +211,8 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
     times: list[float] = []
     positions: list[np.ndarray] = []
     modes: list[str] = []
-    torques: list[tuple[float, float]] = []
     path_length = 0.0
-    local_minima = escapes = steps = 0
+    local_minima = escapes = 0
     time_to_goal = None
     outcome, message = "timeout", ""
 
@@ -174,16 +220,23 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         for observer in observers:
             observer.on_event(data.time, text)
 
+    found = collisions.found  # robot-obstacle contact count, a view into sensordata
+
+    def check_contacts() -> None:
+        if found[0] > 0 or collisions.touching:
+            point = collisions.update(data)
+            if point is not None:
+                note(f"collision at ({point[0]:.2f}, {point[1]:.2f})")
+
     start_wall = time.perf_counter()
-    position = base_xpos[:2].copy()
+    position = drive.xpos[:2].copy()
     clearance.add(position[None, :])
     while True:
         if not np.all(np.isfinite(data.qpos)):
             outcome, message = "error", "the simulation diverged (non-finite state)"
             note(message)
             break
-        yaw = math.atan2(base_xmat[3], base_xmat[0])
-        if math.hypot(goal[0] - position[0], goal[1] - position[1]) <= scenario.robot.goal_tolerance:
+        if math.hypot(goal[0] - position[0], goal[1] - position[1]) <= tolerance:
             outcome, time_to_goal = "reached", data.time
             note("goal reached")
             break
@@ -194,60 +247,33 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
             ranges = sonar.read(rays)
             while next_sonar <= data.time + 1e-9:
                 next_sonar += sonar_period
+        yaw = drive.yaw()
         decision = planner.step(
-            Observation(
-                time_s=data.time,
-                position=position,
-                yaw=yaw,
-                goal=goal,
-                goal_tolerance=scenario.robot.goal_tolerance,
-                bearings=layout.bearings,
-                ranges=ranges,
-                beam_width=beam,
-            )
+            Observation(data.time, position, yaw, goal, tolerance, layout.bearings, ranges, beam)
         )
         local_minima += decision.local_minimum
         escapes += decision.escape_completed
         for text in decision.events:
             note(text)
-        command = heading_command(float(decision.force[0]), float(decision.force[1]), yaw, gains)
+        command = drive.command(decision.force)
         times.append(data.time)
         positions.append(position)
         modes.append(decision.mode)
         if observers:
-            speed = math.hypot(qvel[root_dof], qvel[root_dof + 1])
-            tick = Tick(data.time, position, yaw, speed, ranges, decision, command)
+            tick = Tick(data.time, position, yaw, drive.planar_speed(), ranges, decision, command)
             for observer in observers:
                 observer.on_tick(tick)
         if decision.gave_up:
             outcome = "stuck"
             break
-
-        left_target, right_target = wheel_targets(
-            *command, geometry["track_m"], geometry["wheel_radius_m"], gains.max_wheel_speed
-        )
-        trace = np.empty((chunks_per_tick, 2))
-        x, y = position
-        for chunk in range(chunks_per_tick):
-            left = left_pi.torque(left_target, qvel[left_dof], motor_dt)
-            right = right_pi.torque(right_target, qvel[right_dof], motor_dt)
-            ctrl[left_motor], ctrl[right_motor] = left, right
-            torques.append((left, right))
-            mujoco.mj_step(model, data, nstep=motor_steps)
-            new_x, new_y = base_xpos[0], base_xpos[1]
-            path_length += math.hypot(new_x - x, new_y - y)
-            x, y = trace[chunk] = new_x, new_y
-            if found[0] > 0 or collisions.touching:
-                point = collisions.update(data)
-                if point is not None:
-                    note(f"collision at ({point[0]:.2f}, {point[1]:.2f})")
-        steps += motor_steps * chunks_per_tick
+        trace = drive.run_tick(command, check_contacts)
         clearance.add(trace)
-        position = np.array([x, y])
+        path_length += math.hypot(*(trace[0] - position))
+        path_length += float(np.sum(np.hypot(*np.diff(trace, axis=0).T)))
+        position = trace[-1].copy()
     wall_time = time.perf_counter() - start_wall
     clearance.flush()
 
-    radius = geometry["radius_m"]
     reached = outcome == "reached"
     summary = {
         "format": SUMMARY_FORMAT,
@@ -259,8 +285,8 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         "success": reached and not collisions.points,
         "time_to_goal_s": None if time_to_goal is None else round(time_to_goal, 9),
         "sim_time_s": round(data.time, 9),
-        "steps": steps,
-        "physics_dt_s": dt,
+        "steps": drive.steps,
+        "physics_dt_s": model.opt.timestep,
         "control_hz": scenario.run.control_hz,
         "wall_time_s": wall_time,
         "path_length_m": path_length,
@@ -280,6 +306,6 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         positions=np.array(positions).reshape(-1, 2),
         modes=modes,
         final_qpos=data.qpos.copy(),
-        torques=np.array(torques).reshape(-1, 2),
+        torques=np.array(drive.torques).reshape(-1, 2),
         collision_points=collisions.points,
     )
