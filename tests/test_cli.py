@@ -1,8 +1,10 @@
 """The command line of INTERFACE.md section 2: outputs, exit codes, and nothing written on bad input."""
 
 import json
+import signal
 import subprocess
 import sys
+import time
 
 import matplotlib.image
 import mujoco
@@ -10,6 +12,7 @@ import numpy as np
 import pytest
 
 from vplane_mj.cli import main
+from vplane_mj.log_mcap import read_log
 
 BAD_SCENARIO = """
 format = 1
@@ -41,7 +44,13 @@ def test_run_writes_summary_and_render_and_exits_0_on_reach(tmp_path, capsys):
     image = matplotlib.image.imread(tmp_path / "open_field-apf-0.png")
     assert image.shape[0] >= 500 and image.shape[1] >= 500
     assert "reached" in out and str(tmp_path / "open_field-apf-0.json") in out
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["open_field-apf-0.json", "open_field-apf-0.png"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "open_field-apf-0.json",
+        "open_field-apf-0.mcap",
+        "open_field-apf-0.png",
+    ]
+    log = read_log(tmp_path / "open_field-apf-0.mcap")
+    assert log.complete and log.summary["path_length_m"] == summary["path_length_m"]
 
 
 def test_render_shows_the_path_in_its_colour(tmp_path, capsys):
@@ -166,3 +175,64 @@ def test_installed_entry_points(launcher):
     done = subprocess.run([*launcher, "check", "single_box"], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert "ok: single_box" in done.stdout
+
+
+def start_long_run(tmp_path):
+    """A vplane-mj run in its own process that lasts a while: apf trapped for up to 600 s."""
+    return subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "vplane_mj",
+            "run",
+            "paper_c_escape",
+            "--planner",
+            "apf",
+            "--set",
+            "planner.patience_s=1000",
+            "--set",
+            "run.time_limit_s=600",
+            "--out",
+            str(tmp_path),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def wait_for_partial_log(tmp_path, process, seconds=60.0):
+    """Wait until the run has flushed a few simulated seconds of log."""
+    partial = tmp_path / ".paper_c_escape-apf-0.mcap.partial"
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline and process.poll() is None:
+        if partial.exists() and partial.stat().st_size > 20_000:
+            return partial
+        time.sleep(0.05)
+    raise AssertionError("the run did not start writing its log")
+
+
+@pytest.mark.parametrize("signum, status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_interrupted_run_closes_its_log_and_writes_nothing_else(tmp_path, signum, status):
+    process = start_long_run(tmp_path)
+    wait_for_partial_log(tmp_path, process)
+    process.send_signal(signum)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == status
+    assert "interrupted by" in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["paper_c_escape-apf-0.mcap"]
+    log = read_log(tmp_path / "paper_c_escape-apf-0.mcap")
+    assert log.complete and len(log.times_ns) > 20
+    assert np.all(np.diff(log.times_ns) > 0)
+
+
+def test_killed_run_leaves_a_recoverable_partial_log(tmp_path):
+    process = start_long_run(tmp_path)
+    partial = wait_for_partial_log(tmp_path, process)
+    process.kill()
+    process.communicate(timeout=60)
+    assert not (tmp_path / "paper_c_escape-apf-0.mcap").exists()
+    assert not (tmp_path / "paper_c_escape-apf-0.json").exists()
+    log = read_log(partial)
+    assert not log.complete and len(log.times_ns) > 20
+    assert np.all(np.diff(log.times_ns) > 0)

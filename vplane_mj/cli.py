@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
 import mujoco
 
 from vplane_mj.errors import VPlaneError
+from vplane_mj.interrupts import Interrupted, signals_raise_interrupted
 from vplane_mj.outputs import prepare_out_dir, write_atomically, write_json
 from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
 from vplane_mj.scenario import Scenario, builtin_scenarios, load_scenario
@@ -87,11 +89,24 @@ def _run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario, _overrides(args))
     out_dir = prepare_out_dir(args.out or DEFAULT_OUT, create=args.out is None)
     base = out_dir / f"{scenario.name}-{scenario.planner}-{scenario.run.seed}"
-    if not args.no_log:
-        print("note: MCAP logging is not available in this version; running as with --no-log")
-
-    result = run_scenario(scenario)
-    written = [write_json(base.with_suffix(".json"), result.summary)]
+    mcap_path = base.with_suffix(".mcap")
+    log = None if args.no_log else _open_log(scenario, mcap_path)
+    try:
+        with signals_raise_interrupted():
+            result = run_scenario(scenario, observers=(log,) if log else ())
+    except Interrupted as exc:
+        written = [_finish_log(log, mcap_path, None)] if log else []
+        print(f"interrupted by {exc}: the run was stopped, no summary was written", file=sys.stderr)
+        for path in written:
+            print(f"wrote {path} (closed cleanly, up to the interruption)", file=sys.stderr)
+        return exc.exit_status
+    except BaseException:
+        if log:  # keep nothing half-written
+            log.close()
+            log.path.unlink(missing_ok=True)
+        raise
+    written = [_finish_log(log, mcap_path, result.summary)] if log else []
+    written.append(write_json(base.with_suffix(".json"), result.summary))
     if not args.no_render:
         image = render_top_view(scenario, result)
         written.append(write_atomically(base.with_suffix(".png"), lambda tmp: write_png(image, tmp)))
@@ -99,6 +114,28 @@ def _run(args: argparse.Namespace) -> int:
     for path in written:
         print(f"wrote {path}")
     return EXIT_REACHED if result.summary["reached"] else EXIT_NOT_REACHED
+
+
+def _open_log(scenario: Scenario, target: Path):
+    """An MCAP log written under a temporary name beside `target` (renamed when finished).
+
+    A process killed outright leaves that `.partial` file: its flushed part (all but
+    about the last simulated second) is readable with `vplane_mj.log_mcap.read_log`.
+    """
+    from vplane_mj.log_mcap import McapLog
+    from vplane_mj.robot import robot_radius_m
+    from vplane_mj.world import SonarLayout
+
+    bearings = SonarLayout.from_spec(scenario.sensors).bearings
+    partial = target.with_name(f".{target.name}.partial")
+    return McapLog(partial, scenario, robot_radius_m(), bearings, scenario.sensors.range_max, {})
+
+
+def _finish_log(log, target: Path, summary: dict | None) -> Path:
+    """Close the log (with the summary when the run finished) and give it its final name."""
+    log.close(summary)
+    os.replace(log.path, target)
+    return target
 
 
 def _summary_line(scenario: Scenario, s: dict) -> str:

@@ -1,0 +1,386 @@
+"""The MCAP log (INTERFACE.md section 4): a real short run written, read back and checked."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from mcap.records import Chunk
+from mcap.stream_reader import StreamReader
+
+from vplane_mj.log_mcap import (
+    ARROW_M_PER_UNIT,
+    ARROW_MAX_M,
+    METADATA_NAME,
+    McapLog,
+    iter_messages,
+    read_log,
+    time_ns,
+)
+from vplane_mj.robot import robot_radius_m
+from vplane_mj.scenario import load_scenario, parse_scenario
+from vplane_mj.sim import run_scenario
+from vplane_mj.world import OBSTACLE_HEIGHT_M, SonarLayout
+
+TIME_LIMIT_S = 12.0  # vplane detects the trap at ~5.5 s and finishes its escape at ~10.5 s
+
+EXPECTED_SCHEMAS = {
+    "/robot/pose": "foxglove.PoseInFrame",
+    "/tf": "foxglove.FrameTransforms",
+    "/scan": "foxglove.LaserScan",
+    "/world": "foxglove.SceneUpdate",
+    "/forces": "foxglove.SceneUpdate",
+    "/virtual": "foxglove.SceneUpdate",
+    "/path": "foxglove.SceneUpdate",
+    "/events": "foxglove.Log",
+}
+
+
+class Recorder:
+    """Keeps what the sonar and the planner produced at each tick, to compare with the log."""
+
+    def __init__(self):
+        self.ranges: list[np.ndarray] = []
+        self.forces: list[np.ndarray] = []
+
+    def on_tick(self, tick):
+        self.ranges.append(np.array(tick.ranges, dtype=float))
+        self.forces.append(np.array(tick.decision.force, dtype=float))
+
+    def on_event(self, time_s, text):
+        pass
+
+
+def make_log(path: Path, scenario, metadata=None) -> McapLog:
+    bearings = SonarLayout.from_spec(scenario.sensors).bearings
+    return McapLog(path, scenario, robot_radius_m(), bearings, scenario.sensors.range_max, metadata or {})
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    scenario = load_scenario("paper_c_escape", [f"run.time_limit_s={TIME_LIMIT_S}"])
+    path = tmp_path_factory.mktemp("mcap") / "run.mcap"
+    log = make_log(path, scenario, {"command": "pytest"})
+    recorder = Recorder()
+    result = run_scenario(scenario, observers=(log, recorder))
+    log.close(result.summary)
+    return {
+        "scenario": scenario,
+        "path": path,
+        "result": result,
+        "recorder": recorder,
+        "contents": read_log(path),
+    }
+
+
+def test_every_topic_with_its_schema(run):
+    topics = run["contents"].topics
+    for topic, schema in EXPECTED_SCHEMAS.items():
+        assert topic in topics, topic
+        assert topics[topic][0] == schema
+        assert topics[topic][1] > 0
+    assert "/metrics" in topics
+    assert run["contents"].message_encodings["/metrics"] == "json"
+    assert all(run["contents"].message_encodings[t] == "protobuf" for t in EXPECTED_SCHEMAS)
+    assert run["contents"].complete
+
+
+def test_one_pose_per_tick_in_simulated_nanoseconds(run):
+    contents, result = run["contents"], run["result"]
+    n = len(result.times)
+    assert n > 100
+    assert contents.topics["/robot/pose"][1] == n
+    assert contents.topics["/tf"][1] == n
+    assert contents.topics["/scan"][1] == n
+    assert contents.topics["/forces"][1] == n
+    assert contents.times_ns.dtype == np.int64
+    assert np.all(np.diff(contents.times_ns) > 0)
+    assert contents.times_ns.tolist() == [round(t * 1e9) for t in result.times]
+    np.testing.assert_array_equal(contents.positions, result.positions)
+    assert np.all(np.isfinite(contents.yaws))
+    assert contents.modes == result.modes
+
+
+def test_pose_tf_and_message_timestamps_agree(run):
+    poses = list(iter_messages(run["path"], ("/robot/pose",)))[:5]
+    tfs = list(iter_messages(run["path"], ("/tf",)))[:5]
+    for pose, tf in zip(poses, tfs, strict=True):
+        stamp = pose.message.timestamp
+        assert stamp.seconds * 10**9 + stamp.nanos == pose.log_time_ns == tf.log_time_ns
+        assert pose.message.frame_id == "world"
+        (transform,) = tf.message.transforms
+        assert (transform.parent_frame_id, transform.child_frame_id) == ("world", "base_link")
+        assert transform.translation.x == pose.message.pose.position.x
+        q = pose.message.pose.orientation
+        assert (q.x, q.y, q.z) == (0.0, 0.0, transform.rotation.z)
+        assert math.isclose(q.z**2 + q.w**2, 1.0)
+        assert pose.message.pose.position.z == 0.0
+    first = poses[0].message.pose
+    yaw = 2 * math.atan2(first.orientation.z, first.orientation.w)
+    assert math.isclose(yaw, run["scenario"].robot.start_yaw, abs_tol=0.05)
+
+
+def test_scan_has_nan_for_no_echo_and_the_ring_step(run):
+    scans = list(iter_messages(run["path"], ("/scan",)))
+    recorded = run["recorder"].ranges
+    assert len(scans) == len(recorded)
+    saw_nan = saw_echo = False
+    for scan, ranges in zip(scans, recorded, strict=True):
+        msg = scan.message
+        assert msg.frame_id == "base_link"
+        logged = np.array(msg.ranges)
+        assert len(logged) == 16
+        step = (msg.end_angle - msg.start_angle) / (len(logged) - 1)
+        assert math.isclose(step, 2 * math.pi / 16)
+        assert msg.start_angle == 0.0
+        np.testing.assert_array_equal(np.isnan(logged), ~np.isfinite(ranges))
+        np.testing.assert_array_equal(logged[np.isfinite(ranges)], ranges[np.isfinite(ranges)])
+        saw_nan |= bool(np.isnan(logged).any())
+        saw_echo |= bool(np.isfinite(logged).any())
+    assert saw_nan and saw_echo
+
+
+def test_world_once_at_time_zero(run):
+    scenario = run["scenario"]
+    assert run["contents"].topics["/world"][1] == 1
+    (world,) = iter_messages(run["path"], ("/world",))
+    assert world.log_time_ns == 0
+    entities = {entity.id: entity for entity in world.message.entities}
+    assert all(entity.frame_id == "world" for entity in entities.values())
+    pieces = sum(len(ob.footprint()) for ob in scenario.world.obstacles)
+    obstacles = [e for name, e in entities.items() if name.startswith("obstacle_")]
+    assert len(obstacles) == len(scenario.world.obstacles)
+    assert sum(len(e.cubes) + len(e.cylinders) for e in obstacles) == pieces
+    assert all(cube.size.z == OBSTACLE_HEIGHT_M for e in obstacles for cube in e.cubes)
+    assert scenario.world.border and len(entities["border"].cubes) == 4
+    (goal,) = entities["goal"].cylinders
+    assert math.isclose(goal.size.x / 2, scenario.robot.goal_tolerance)
+    assert (goal.pose.position.x, goal.pose.position.y) == scenario.robot.goal
+    assert "start" in entities
+
+
+def test_metadata_holds_the_resolved_scenario_and_versions(run):
+    scenario, metadata = run["scenario"], run["contents"].metadata
+    info = metadata[METADATA_NAME]
+    again = parse_scenario(info["scenario_toml"], "from-log.toml")
+    assert again.name == scenario.name == info["scenario"]
+    assert again.run.seed == scenario.run.seed == int(info["seed"])
+    assert again.run.time_limit_s == TIME_LIMIT_S
+    assert info["planner"] == scenario.planner == "vplane"
+    for key in ("vplane_mj_version", "mujoco_version", "numpy_version", "foxglove_sdk_version"):
+        assert info[key]
+    assert info["command"] == "pytest"
+    summary = run["contents"].summary
+    assert summary == json.loads(json.dumps(run["result"].summary))
+
+
+def test_events_and_their_levels(run):
+    events = run["contents"].events
+    texts = [text for _, _, text in events]
+    assert "local minimum detected" in texts
+    assert all(level == "INFO" for _, level, _ in events)
+    detected = next(t for t, _, text in events if text == "local minimum detected")
+    assert 2.0 < detected < TIME_LIMIT_S
+    assert run["contents"].topics["/events"][1] == len(events)
+
+
+def test_virtual_objective_deleted_after_the_escape(run):
+    events = run["contents"].events
+    finished = next(t for t, _, text in events if text.startswith("objective reached"))
+    updates = list(iter_messages(run["path"], ("/virtual",)))
+    times = [u.log_time_ns for u in updates]
+    assert times == sorted(set(times))  # logged only when something changed
+    created = [u for u in updates if any(e.id == "objective" for e in u.message.entities)]
+    assert created and created[0].log_time_ns < time_ns(finished)
+    deleted = [u for u in updates if any(d.id == "objective" for d in u.message.deletions)]
+    assert deleted and deleted[0].log_time_ns >= time_ns(finished)
+    assert any(e.id.startswith("plane_") for e in deleted[0].message.entities)
+
+
+def test_force_arrows_scale_and_clip(run):
+    updates = list(iter_messages(run["path"], ("/forces",)))
+    forces = run["recorder"].forces
+    ids = set()
+    for update, force in zip(updates, forces, strict=True):
+        arrows = {e.id: e.arrows[0] for e in update.message.entities}
+        ids |= arrows.keys()
+        total = arrows["total"]
+        length = total.shaft_length + total.head_length
+        assert math.isclose(length, min(ARROW_M_PER_UNIT * np.hypot(*force), ARROW_MAX_M), rel_tol=1e-6)
+        q = total.pose.orientation
+        assert math.isclose(2 * math.atan2(q.z, q.w), math.atan2(force[1], force[0]), abs_tol=1e-9)
+    assert {"attractive", "repulsive", "virtual", "total"} <= ids
+
+
+def test_metrics_json(run):
+    records = [m.message for m in iter_messages(run["path"], ("/metrics",))]
+    assert len(records) == len(run["result"].times)
+    keys = {
+        "time_s",
+        "speed_mps",
+        "distance_to_goal_m",
+        "force_attractive",
+        "force_repulsive",
+        "force_virtual",
+        "force_total",
+        "mode",
+        "command_v_mps",
+        "command_omega_radps",
+    }
+    assert all(set(record) == keys for record in records)
+    assert {record["mode"] for record in records} >= {"normal", "escaping"}
+    last = records[-1]
+    goal = np.array(run["scenario"].robot.goal)
+    assert math.isclose(last["distance_to_goal_m"], np.hypot(*(goal - run["result"].positions[-1])))
+
+
+def test_path_and_flushes_about_once_per_simulated_second(run):
+    paths = list(iter_messages(run["path"], ("/path",)))
+    assert TIME_LIMIT_S - 2 <= len(paths) <= TIME_LIMIT_S + 1
+    (line,) = paths[-1].message.entities[0].lines
+    end = line.points[-1]
+    assert (end.x, end.y) == tuple(run["result"].positions[-1])
+    with open(run["path"], "rb") as stream:
+        chunks = sum(isinstance(r, Chunk) for r in StreamReader(stream, emit_chunks=True).records)
+    assert TIME_LIMIT_S - 2 <= chunks <= TIME_LIMIT_S + 2
+
+
+def test_truncated_file_keeps_its_complete_chunks(run, tmp_path):
+    data = run["path"].read_bytes()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(data[: len(data) // 2])
+    full, partial = run["contents"], read_log(cut)
+    n = len(partial.times_ns)
+    assert 0 < n < len(full.times_ns)
+    assert not partial.complete and partial.summary is None
+    assert np.all(np.diff(partial.times_ns) > 0)
+    np.testing.assert_array_equal(partial.times_ns, full.times_ns[:n])
+    np.testing.assert_array_equal(partial.positions, full.positions[:n])
+    assert partial.metadata[METADATA_NAME]["scenario"] == "paper_c_escape"
+
+
+_CHILD = textwrap.dedent(
+    """
+    import sys, time
+    from pathlib import Path
+    from vplane_mj.log_mcap import McapLog
+    from vplane_mj.robot import robot_radius_m
+    from vplane_mj.scenario import load_scenario
+    from vplane_mj.sim import run_scenario
+    from vplane_mj.world import SonarLayout
+
+    class Slow:  # keep the run going until it is killed
+        def on_tick(self, tick):
+            time.sleep(0.004)
+        def on_event(self, time_s, text):
+            pass
+
+    scenario = load_scenario("paper_c_escape", ["run.time_limit_s=300"])
+    bearings = SonarLayout.from_spec(scenario.sensors).bearings
+    log = McapLog(Path(sys.argv[1]), scenario, robot_radius_m(), bearings, 3.0, {})
+    run_scenario(scenario, observers=(log, Slow()))
+    log.close()
+    """
+)
+
+
+def test_log_of_a_killed_writer_is_readable(tmp_path):
+    path = tmp_path / "killed.mcap"
+    child = subprocess.Popen([sys.executable, "-c", _CHILD, str(path)])
+    try:
+        deadline = time.monotonic() + 15
+        poses = 0
+        while poses < 40 and time.monotonic() < deadline and child.poll() is None:
+            time.sleep(0.1)
+            if path.exists():
+                poses = len(read_log(path).times_ns)
+        assert child.poll() is None, "the child ended before it could be killed"
+        os.kill(child.pid, signal.SIGKILL)
+    finally:
+        if child.poll() is None:
+            child.kill()
+        child.wait()
+    contents = read_log(path)
+    assert not contents.complete and contents.summary is None
+    assert len(contents.times_ns) >= 40
+    assert np.all(np.diff(contents.times_ns) > 0)
+    assert contents.times_ns[0] == 0
+    assert contents.topics["/world"][1] == 1
+    assert contents.metadata[METADATA_NAME]["planner"] == "vplane"
+
+
+def test_warning_levels_close_is_idempotent_and_ticks_after_close_are_ignored(tmp_path):
+    scenario = load_scenario("paper_c_escape")
+    path = tmp_path / "events.mcap"
+    log = make_log(path, scenario)
+    log.on_event(0.5, "collision at (1.00, 2.00)")
+    log.on_event(1.0, "gave up after 3 escapes")
+    log.on_event(1.5, "escape started")
+    log.close({"outcome": "stuck", "value": np.float64(1.5), "gap": [math.nan, np.int64(2)]})
+    log.close()
+    log.on_event(2.0, "ignored")
+    contents = read_log(path)
+    assert contents.events == [
+        (0.5, "WARNING", "collision at (1.00, 2.00)"),
+        (1.0, "WARNING", "gave up after 3 escapes"),
+        (1.5, "INFO", "escape started"),
+    ]
+    assert contents.summary == {"outcome": "stuck", "value": 1.5, "gap": [None, 2]}
+    assert len(contents.times_ns) == 0 and contents.complete
+
+
+CYLINDER_APF = """
+format = 1
+name = "cylinder_apf"
+[world]
+size = [4.0, 3.0]
+border = false
+[[world.obstacles]]
+kind = "cylinder"
+center = [2.0, 1.5]
+radius = 0.3
+[robot]
+start = [0.5, 1.5]
+goal = [3.5, 1.5]
+[planner]
+name = "apf"
+[run]
+time_limit_s = 1.0
+"""
+
+
+def test_cylinders_no_border_and_a_planner_without_virtual_parts(scenario_from, tmp_path):
+    scenario = scenario_from(CYLINDER_APF)
+    path = tmp_path / "apf.mcap"
+    log = make_log(path, scenario)
+    result = run_scenario(scenario, observers=(log,))
+    log.close(result.summary)
+    contents = read_log(path)
+    assert set(EXPECTED_SCHEMAS) | {"/metrics"} == set(contents.topics)
+    assert contents.topics["/virtual"][1] == 1  # the empty update at time 0 only
+    (world,) = iter_messages(path, ("/world",))
+    entities = {entity.id: entity for entity in world.message.entities}
+    assert "border" not in entities
+    (cylinder,) = entities["obstacle_0"].cylinders
+    assert math.isclose(cylinder.size.x, 0.6) and cylinder.size.z == OBSTACLE_HEIGHT_M
+    ids = {e.id for u in iter_messages(path, ("/forces",)) for e in u.message.entities}
+    assert ids <= {"attractive", "repulsive", "total"} and "total" in ids
+    metrics = [m.message for m in iter_messages(path, ("/metrics",))]
+    assert all(m["force_virtual"] is None for m in metrics)
+    assert len(contents.times_ns) == len(result.times) and contents.complete
+
+
+@pytest.mark.skipif(shutil.which("pymcap-cli") is None, reason="pymcap-cli is not installed")
+def test_pymcap_cli_doctor_accepts_the_file(run):
+    done = subprocess.run(["pymcap-cli", "doctor", str(run["path"])], capture_output=True, text=True)
+    assert done.returncode == 0, done.stdout + done.stderr
