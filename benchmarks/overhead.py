@@ -8,7 +8,10 @@ T_full / T_bare; the real-time factor is simulated time over T_full. A second ba
 steps the robot standing still (`mj_step(nstep=N)` in one call). Each measurement is
 repeated and the median reported.
 
-    python benchmarks/overhead.py [SCENARIO ...] [--repeat 3] [--planner apf]
+With `--log` every full run also writes its MCAP log (to a temporary directory), and the
+log's size per simulated minute is reported.
+
+    python benchmarks/overhead.py [SCENARIO ...] [--repeat 3] [--planner apf] [--log]
 """
 
 from __future__ import annotations
@@ -16,13 +19,17 @@ from __future__ import annotations
 import argparse
 import statistics
 import sys
+import tempfile
 import time
+from pathlib import Path
 
 import mujoco
 
+from vplane_mj.log_mcap import McapLog
+from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim import run_scenario
-from vplane_mj.world import build_model
+from vplane_mj.world import SonarLayout, build_model
 
 DEFAULT_SCENARIOS = ("open_field", "single_box", "paper_c_escape", "paper_h_avoid")
 
@@ -38,12 +45,24 @@ def replay_time(model: mujoco.MjModel, torques, steps: int) -> float:
     return time.perf_counter() - start
 
 
-def measure(name: str, planner: str, repeat: int) -> dict:
+def full_run(scenario, log_dir: Path | None):
+    """One run, with its MCAP log written into `log_dir` when given; (result, log bytes)."""
+    if log_dir is None:
+        return run_scenario(scenario), 0
+    path = log_dir / f"{scenario.name}.mcap"
+    bearings = SonarLayout.from_spec(scenario.sensors).bearings
+    log = McapLog(path, scenario, robot_radius_m(), bearings, scenario.sensors.range_max, {})
+    result = run_scenario(scenario, observers=(log,))
+    log.close(result.summary)
+    return result, path.stat().st_size
+
+
+def measure(name: str, planner: str, repeat: int, log_dir: Path | None) -> dict:
     scenario = load_scenario(name, [f"planner.name={planner}"])
     model = build_model(scenario)
     ratios, still_ratios, factors = [], [], []
     for _ in range(repeat):
-        result = run_scenario(scenario)
+        result, log_bytes = full_run(scenario, log_dir)
         steps, full = result.summary["steps"], result.summary["wall_time_s"]
         ratios.append(full / replay_time(model, result.torques, steps))
         data = mujoco.MjData(model)
@@ -59,6 +78,7 @@ def measure(name: str, planner: str, repeat: int) -> dict:
         "overhead": statistics.median(ratios),
         "overhead_still": statistics.median(still_ratios),
         "realtime": statistics.median(factors),
+        "log_mb_per_min": log_bytes / 1e6 / (result.summary["sim_time_s"] / 60.0),
     }
 
 
@@ -67,21 +87,30 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("scenarios", nargs="*", default=list(DEFAULT_SCENARIOS))
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--planner", default="apf")
+    parser.add_argument("--log", action="store_true", help="write the MCAP log in every full run")
     args = parser.parse_args(argv)
-    print(f"planner {args.planner}, median of {args.repeat} runs each, mujoco {mujoco.__version__}\n")
+    with tempfile.TemporaryDirectory() as tmp:
+        report(args, Path(tmp) if args.log else None)
+    return 0
+
+
+def report(args: argparse.Namespace, log_dir: Path | None) -> None:
+    logging = "with the MCAP log" if log_dir else "without log"
+    print(f"planner {args.planner}, {logging}, median of {args.repeat} runs each")
+    print(f"mujoco {mujoco.__version__}\n")
     print(
         "| scenario | outcome | physics steps | simulated s | overhead ratio "
-        "| ratio vs robot standing still | real-time factor |"
+        "| ratio vs robot standing still | real-time factor | log MB per simulated minute |"
     )
-    print("|---|---|---:|---:|---:|---:|---:|")
+    print("|---|---|---:|---:|---:|---:|---:|---:|")
     for name in args.scenarios:
-        row = measure(name, args.planner, args.repeat)
+        row = measure(name, args.planner, args.repeat, log_dir)
+        size = f"{row['log_mb_per_min']:.2f}" if log_dir else "-"
         print(
             f"| {row['scenario']} | {row['outcome']} | {row['steps']} | {row['sim_s']:.1f} "
-            f"| {row['overhead']:.2f} | {row['overhead_still']:.2f} | {row['realtime']:.0f}x |"
+            f"| {row['overhead']:.2f} | {row['overhead_still']:.2f} | {row['realtime']:.0f}x | {size} |"
         )
         sys.stdout.flush()
-    return 0
 
 
 if __name__ == "__main__":
