@@ -155,7 +155,7 @@ def plane_field_figure(path: Path) -> None:
 def renders(out: Path) -> None:
     for name in ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape"):
         scenario = load_scenario(name)
-        write_png(render_top_view(scenario, run_scenario(scenario)), out / f"{name}-vplane-0.png")
+        write_png(render_top_view(scenario, run_scenario(scenario).track()), out / f"{name}-vplane-0.png")
 
 
 def main() -> int:

@@ -108,7 +108,7 @@ def _run(args: argparse.Namespace) -> int:
     written = [_finish_log(log, mcap_path, result.summary)] if log else []
     written.append(write_json(base.with_suffix(".json"), result.summary))
     if not args.no_render:
-        image = render_top_view(scenario, result)
+        image = render_top_view(scenario, result.track())
         written.append(write_atomically(base.with_suffix(".png"), lambda tmp: write_png(image, tmp)))
     print(_summary_line(scenario, result.summary))
     for path in written:

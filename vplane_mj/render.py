@@ -1,31 +1,59 @@
-"""Offscreen (OSMesa by default) top-down PNG of a run: arena, obstacles, start, goal and the path."""
+"""Offscreen (OSMesa by default) top-down PNG of a run.
+
+Arena, obstacles, start and goal, the travelled path coloured by planner mode, the
+virtual objectives and planes of the paper's escape, and collision points, from the
+orthographic top camera. A `Track` holds what is drawn, from a run or from its log.
+"""
 
 from __future__ import annotations
 
 import itertools
+import math
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import matplotlib.image
 import mujoco
 import numpy as np
 
-from vplane_mj.sim import RunResult
 from vplane_mj.world import build_model
 
-PATH_RGBA = (0.85, 0.1, 0.1, 1.0)
+MODE_RGBA = {
+    "normal": (0.85, 0.1, 0.1, 1.0),  # red
+    "avoiding": (0.95, 0.5, 0.0, 1.0),  # orange
+    "escaping": (0.1, 0.35, 0.9, 1.0),  # blue
+    "trapped": (0.55, 0.0, 0.55, 1.0),  # purple
+}
+OTHER_MODE_RGBA = (0.3, 0.3, 0.3, 1.0)
 START_RGBA = (0.1, 0.6, 0.1, 1.0)
 GOAL_RGBA = (0.95, 0.75, 0.0, 1.0)
-COLLISION_RGBA = (0.6, 0.0, 0.6, 1.0)
+COLLISION_RGBA = (0.0, 0.0, 0.0, 1.0)
+OBJECTIVE_RGBA = (0.1, 0.35, 0.9, 1.0)
+PLANE_RGBA = (0.5, 0.1, 0.7, 1.0)
 MAX_PATH_SEGMENTS = 3000
 MARKER_HEIGHT_M = 0.6
 """Markers and the path are drawn above the obstacles (0.5 m) so nothing hides them."""
 
 
-def render_top_view(scenario, result: RunResult) -> np.ndarray:
+@dataclass(frozen=True)
+class Track:
+    """What a render shows of a run: the path at control ticks with the planner's modes,
+    the final pose (x, y, yaw), collision points, virtual objectives and planes (e1, e2)."""
+
+    positions: np.ndarray
+    modes: list[str]
+    final_pose: tuple[float, float, float]
+    collision_points: list[tuple[float, float]] = field(default_factory=list)
+    objectives: list[tuple[float, float]] = field(default_factory=list)
+    planes: list[tuple[tuple[float, float], tuple[float, float]]] = field(default_factory=list)
+
+
+def render_top_view(scenario, track: Track) -> np.ndarray:
     """RGB image (H, W, 3) of the whole arena from the orthographic top camera."""
     model = build_model(scenario)
     data = mujoco.MjData(model)
-    data.qpos[:] = result.final_qpos
+    x, y, yaw = track.final_pose
+    data.qpos[:7] = (x, y, 0.0, math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
     mujoco.mj_forward(model, data)
     height, width = model.vis.global_.offheight, model.vis.global_.offwidth
     with mujoco.Renderer(model, height=height, width=width, max_geom=MAX_PATH_SEGMENTS + 500) as renderer:
@@ -35,9 +63,13 @@ def render_top_view(scenario, result: RunResult) -> np.ndarray:
         scene = renderer.scene
         _add_disc(scene, scenario.robot.start, 0.12, START_RGBA)
         _add_disc(scene, scenario.robot.goal, scenario.robot.goal_tolerance, GOAL_RGBA)
-        for point in result.collision_points:
+        for e1, e2 in track.planes:
+            _add_segment(scene, e1, e2, PLANE_RGBA, width=6.0)
+        for objective in track.objectives:
+            _add_disc(scene, objective, 0.08, OBJECTIVE_RGBA)
+        _add_path(scene, track.positions, track.modes)
+        for point in track.collision_points:
             _add_disc(scene, point, 0.06, COLLISION_RGBA)
-        _add_polyline(scene, result.positions, PATH_RGBA)
         return renderer.render()
 
 
@@ -60,26 +92,33 @@ def _add_disc(scene: mujoco.MjvScene, center, radius: float, rgba) -> None:
     scene.ngeom += 1
 
 
-def _add_polyline(scene: mujoco.MjvScene, points: np.ndarray, rgba) -> None:
-    """Line geoms through `points` (N, 2), decimated to at most MAX_PATH_SEGMENTS segments."""
+def _add_segment(scene: mujoco.MjvScene, a, b, rgba, width: float = 4.0) -> None:
+    if scene.ngeom >= scene.maxgeom:
+        return
+    geom = scene.geoms[scene.ngeom]
+    mujoco.mjv_initGeom(
+        geom,
+        type=mujoco.mjtGeom.mjGEOM_LINE,
+        size=np.zeros(3),
+        pos=np.zeros(3),
+        mat=np.eye(3).flatten(),
+        rgba=np.array(rgba, dtype=np.float32),
+    )
+    z = MARKER_HEIGHT_M + 0.01
+    mujoco.mjv_connector(
+        geom, mujoco.mjtGeom.mjGEOM_LINE, width, np.array([a[0], a[1], z]), np.array([b[0], b[1], z])
+    )
+    scene.ngeom += 1
+
+
+def _add_path(scene: mujoco.MjvScene, points: np.ndarray, modes: list[str]) -> None:
+    """Line segments through `points` (N, 2), each coloured by the mode at its start,
+    decimated to at most MAX_PATH_SEGMENTS segments."""
     if len(points) < 2:
         return
     stride = max(1, int(np.ceil((len(points) - 1) / MAX_PATH_SEGMENTS)))
-    kept = np.vstack([points[::stride], points[-1:]])
-    z = MARKER_HEIGHT_M + 0.01
-    for a, b in itertools.pairwise(kept):
-        if scene.ngeom >= scene.maxgeom:
-            return
-        geom = scene.geoms[scene.ngeom]
-        mujoco.mjv_initGeom(
-            geom,
-            type=mujoco.mjtGeom.mjGEOM_LINE,
-            size=np.zeros(3),
-            pos=np.zeros(3),
-            mat=np.eye(3).flatten(),
-            rgba=np.array(rgba, dtype=np.float32),
-        )
-        mujoco.mjv_connector(
-            geom, mujoco.mjtGeom.mjGEOM_LINE, 4.0, np.array([a[0], a[1], z]), np.array([b[0], b[1], z])
-        )
-        scene.ngeom += 1
+    kept = list(range(0, len(points), stride))
+    if kept[-1] != len(points) - 1:
+        kept.append(len(points) - 1)
+    for i, j in itertools.pairwise(kept):
+        _add_segment(scene, points[i], points[j], MODE_RGBA.get(modes[i], OTHER_MODE_RGBA))

@@ -18,6 +18,7 @@ from vplane_mj import __version__, shapes
 from vplane_mj.control import ControllerGains, WheelPI, heading_command, wheel_targets
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.render import Track
 from vplane_mj.robot import BASE_BODY, WHEEL_JOINTS, WHEEL_MOTORS, robot_geometry
 from vplane_mj.scenario import Scenario
 from vplane_mj.sonar import SonarRing
@@ -61,6 +62,17 @@ class RunResult:
     torques: np.ndarray
     """(motor updates, 2) left and right wheel torques (N m), one row per motor period."""
     collision_points: list[tuple[float, float]] = field(default_factory=list)
+    objectives: list[tuple[float, float]] = field(default_factory=list)
+    """Every virtual new objective the planner placed, in order."""
+    planes: list[tuple[tuple[float, float], tuple[float, float]]] = field(default_factory=list)
+    """Every virtual plane the planner created, as (e1, e2)."""
+
+    def track(self) -> Track:
+        """What a render of this run shows."""
+        quat = self.final_qpos[3:7]
+        yaw = math.atan2(2 * (quat[0] * quat[3] + quat[1] * quat[2]), 1 - 2 * (quat[2] ** 2 + quat[3] ** 2))
+        final = (float(self.final_qpos[0]), float(self.final_qpos[1]), yaw)
+        return Track(self.positions, self.modes, final, self.collision_points, self.objectives, self.planes)
 
 
 class _CollisionCounter:
@@ -211,6 +223,8 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
     times: list[float] = []
     positions: list[np.ndarray] = []
     modes: list[str] = []
+    objectives: list[tuple[float, float]] = []
+    planes: list[tuple[tuple[float, float], tuple[float, float]]] = []
     path_length = 0.0
     local_minima = escapes = 0
     time_to_goal = None
@@ -255,6 +269,7 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         escapes += decision.escape_completed
         for text in decision.events:
             note(text)
+        _collect_virtual(decision, objectives, planes)
         command = drive.command(decision.force)
         times.append(data.time)
         positions.append(position)
@@ -308,4 +323,18 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         final_qpos=data.qpos.copy(),
         torques=np.array(drive.torques).reshape(-1, 2),
         collision_points=collisions.points,
+        objectives=objectives,
+        planes=planes,
     )
+
+
+def _collect_virtual(decision: Decision, objectives: list, planes: list) -> None:
+    """Remember each new virtual objective and virtual plane of a decision (for renders)."""
+    if decision.objective is not None:
+        objective = (float(decision.objective[0]), float(decision.objective[1]))
+        if not objectives or objectives[-1] != objective:
+            objectives.append(objective)
+    for e1, e2 in decision.planes:
+        plane = ((float(e1[0]), float(e1[1])), (float(e2[0]), float(e2[1])))
+        if plane not in planes:
+            planes.append(plane)
