@@ -97,7 +97,7 @@ def test_every_topic_with_its_schema(run):
 
 def test_one_pose_per_tick_in_simulated_nanoseconds(run):
     contents, result = run["contents"], run["result"]
-    n = len(result.times)
+    n = len(result.times) + 1  # every control tick, then the state the run ended in
     assert n > 100
     assert contents.topics["/robot/pose"][1] == n
     assert contents.topics["/tf"][1] == n
@@ -105,10 +105,12 @@ def test_one_pose_per_tick_in_simulated_nanoseconds(run):
     assert contents.topics["/forces"][1] == n
     assert contents.times_ns.dtype == np.int64
     assert np.all(np.diff(contents.times_ns) > 0)
-    assert contents.times_ns.tolist() == [round(t * 1e9) for t in result.times]
-    np.testing.assert_array_equal(contents.positions, result.positions)
+    assert contents.times_ns.tolist()[:-1] == [round(t * 1e9) for t in result.times]
+    assert contents.times_ns[-1] == round(result.summary["sim_time_s"] * 1e9)
+    np.testing.assert_array_equal(contents.positions[:-1], result.positions)
+    assert contents.positions[-1] == pytest.approx(result.track().final_pose[:2])
     assert np.all(np.isfinite(contents.yaws))
-    assert contents.modes == result.modes
+    assert contents.modes == [*result.modes, "finished"]
 
 
 def test_pose_tf_and_message_timestamps_agree(run):
@@ -214,6 +216,9 @@ def test_force_arrows_scale_and_clip(run):
     for update, force in zip(updates, forces, strict=True):
         arrows = {e.id: e.arrows[0] for e in update.message.entities}
         ids |= arrows.keys()
+        if not np.any(force):  # the final state: no force, every arrow deleted
+            assert not arrows and update.message.deletions
+            continue
         total = arrows["total"]
         length = total.shaft_length + total.head_length
         assert math.isclose(length, min(ARROW_M_PER_UNIT * np.hypot(*force), ARROW_MAX_M), rel_tol=1e-6)
@@ -224,7 +229,7 @@ def test_force_arrows_scale_and_clip(run):
 
 def test_metrics_json(run):
     records = [m.message for m in iter_messages(run["path"], ("/metrics",))]
-    assert len(records) == len(run["result"].times)
+    assert len(records) == len(run["result"].times) + 1
     keys = {
         "time_s",
         "speed_mps",
@@ -241,7 +246,9 @@ def test_metrics_json(run):
     assert {record["mode"] for record in records} >= {"normal", "escaping"}
     last = records[-1]
     goal = np.array(run["scenario"].robot.goal)
-    assert math.isclose(last["distance_to_goal_m"], np.hypot(*(goal - run["result"].positions[-1])))
+    final = np.array(run["result"].track().final_pose[:2])
+    assert math.isclose(last["distance_to_goal_m"], np.hypot(*(goal - final)), rel_tol=1e-9)
+    assert last["mode"] == "finished"
 
 
 def test_path_and_flushes_about_once_per_simulated_second(run):
@@ -249,7 +256,7 @@ def test_path_and_flushes_about_once_per_simulated_second(run):
     assert TIME_LIMIT_S - 2 <= len(paths) <= TIME_LIMIT_S + 1
     (line,) = paths[-1].message.entities[0].lines
     end = line.points[-1]
-    assert (end.x, end.y) == tuple(run["result"].positions[-1])
+    assert (end.x, end.y) == pytest.approx(run["result"].track().final_pose[:2])
     with open(run["path"], "rb") as stream:
         chunks = sum(isinstance(r, Chunk) for r in StreamReader(stream, emit_chunks=True).records)
     assert TIME_LIMIT_S - 2 <= chunks <= TIME_LIMIT_S + 2
@@ -377,7 +384,7 @@ def test_cylinders_no_border_and_a_planner_without_virtual_parts(scenario_from, 
     assert ids <= {"attractive", "repulsive", "total"} and "total" in ids
     metrics = [m.message for m in iter_messages(path, ("/metrics",))]
     assert all(m["force_virtual"] is None for m in metrics)
-    assert len(contents.times_ns) == len(result.times) and contents.complete
+    assert len(contents.times_ns) == len(result.times) + 1 and contents.complete
 
 
 @pytest.mark.skipif(shutil.which("pymcap-cli") is None, reason="pymcap-cli is not installed")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 from pathlib import Path
@@ -66,6 +67,15 @@ def _parser() -> argparse.ArgumentParser:
     export.add_argument("scenario", metavar="SCENARIO")
     export.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.xml")
     export.set_defaults(handler=_mjcf)
+
+    summary = commands.add_parser("summary", help="recompute a run's summary from its MCAP log")
+    summary.add_argument("log", type=Path, metavar="LOG.mcap")
+    summary.set_defaults(handler=_summary)
+
+    render = commands.add_parser("render", help="render a run's top-down PNG from its MCAP log")
+    render.add_argument("log", type=Path, metavar="LOG.mcap")
+    render.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.png")
+    render.set_defaults(handler=_render)
 
     listing = commands.add_parser("list", help="built-in scenarios and planners")
     listing.set_defaults(handler=_list)
@@ -168,11 +178,50 @@ def _mjcf(args: argparse.Namespace) -> int:
     xml = standalone_xml(scenario)
     mujoco.MjModel.from_xml_string(xml)  # what we write must load on its own
     target = args.output
-    if not target.parent.is_dir():
-        raise VPlaneError(f"{target}: no such directory: {target.parent}")
+    _check_parent(target)
     write_atomically(target, lambda tmp: tmp.write_text(xml, encoding="utf-8"))
     print(f"wrote {target}")
     return 0
+
+
+def _summary(args: argparse.Namespace) -> int:
+    """Print the summary recomputed from the log; exit 1 if it disagrees with the stored one."""
+    from vplane_mj.replay import disagreements, load_log, summarize
+
+    contents, scenario = load_log(args.log)
+    recomputed = summarize(contents, scenario)
+    events = recomputed.pop("events")
+    print(json.dumps(recomputed, indent=2))
+    print("events:")
+    for line in events:
+        print(f"  {line}")
+    stored = contents.summary
+    if stored is None:
+        print("the log holds no stored summary (the run was interrupted or killed)")
+        return 0
+    differing = disagreements(recomputed, stored)
+    if differing:
+        print("DISAGREES with the run's stored summary: " + "; ".join(differing))
+        return 1
+    print("agrees with the run's stored summary")
+    return 0
+
+
+def _render(args: argparse.Namespace) -> int:
+    from vplane_mj.render import render_top_view, write_png
+    from vplane_mj.replay import load_log, track_from_log
+
+    contents, scenario = load_log(args.log)
+    _check_parent(args.output)
+    image = render_top_view(scenario, track_from_log(args.log, contents))
+    write_atomically(args.output, lambda tmp: write_png(image, tmp))
+    print(f"wrote {args.output}")
+    return 0
+
+
+def _check_parent(target: Path) -> None:
+    if not target.parent.is_dir():
+        raise VPlaneError(f"{target}: no such directory: {target.parent}")
 
 
 def _list(args: argparse.Namespace) -> int:

@@ -43,7 +43,11 @@ class Tick:
 
 
 class Observer(Protocol):
-    """Something that watches a run: every control tick and every event."""
+    """Something that watches a run: every control tick and every event.
+
+    After the last control tick it sees one more tick, the state the run ended in, with
+    mode "finished" and no force (unless the run ended on a tick it already saw).
+    """
 
     def on_tick(self, tick: Tick) -> None: ...
 
@@ -58,7 +62,8 @@ class RunResult:
     times: np.ndarray
     positions: np.ndarray
     modes: list[str]
-    final_qpos: np.ndarray
+    final_pose: tuple[float, float, float]
+    """base_link's x, y (m) and yaw (rad) when the run ended."""
     torques: np.ndarray
     """(motor updates, 2) left and right wheel torques (N m), one row per motor period."""
     collision_points: list[tuple[float, float]] = field(default_factory=list)
@@ -69,10 +74,14 @@ class RunResult:
 
     def track(self) -> Track:
         """What a render of this run shows."""
-        quat = self.final_qpos[3:7]
-        yaw = math.atan2(2 * (quat[0] * quat[3] + quat[1] * quat[2]), 1 - 2 * (quat[2] ** 2 + quat[3] ** 2))
-        final = (float(self.final_qpos[0]), float(self.final_qpos[1]), yaw)
-        return Track(self.positions, self.modes, final, self.collision_points, self.objectives, self.planes)
+        return Track(
+            self.positions,
+            self.modes,
+            self.final_pose,
+            self.collision_points,
+            self.objectives,
+            self.planes,
+        )
 
 
 class _CollisionCounter:
@@ -288,6 +297,11 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         position = trace[-1].copy()
     wall_time = time.perf_counter() - start_wall
     clearance.flush()
+    if observers and (not times or data.time > times[-1]):  # the state the run ended in
+        final = Decision(force=np.zeros(2), mode="finished")
+        tick = Tick(data.time, position, drive.yaw(), drive.planar_speed(), ranges, final, (0.0, 0.0))
+        for observer in observers:
+            observer.on_tick(tick)
 
     reached = outcome == "reached"
     summary = {
@@ -320,7 +334,7 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         times=np.array(times),
         positions=np.array(positions).reshape(-1, 2),
         modes=modes,
-        final_qpos=data.qpos.copy(),
+        final_pose=(float(position[0]), float(position[1]), drive.yaw()),
         torques=np.array(drive.torques).reshape(-1, 2),
         collision_points=collisions.points,
         objectives=objectives,

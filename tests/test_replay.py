@@ -1,0 +1,79 @@
+"""A run recomputed from its MCAP log alone: `vplane-mj summary` and `vplane-mj render`."""
+
+import json
+
+import matplotlib.image
+import numpy as np
+import pytest
+
+from vplane_mj.cli import main
+
+
+def run_logged(tmp_path, capsys, *argv):
+    code = main(["run", *argv, "--out", str(tmp_path)])
+    capsys.readouterr()
+    return code
+
+
+@pytest.mark.parametrize(
+    "argv, base",
+    [
+        (["paper_c_escape"], "paper_c_escape-vplane-0"),
+        (["paper_h_avoid", "--planner", "apf"], "paper_h_avoid-apf-0"),
+        (
+            [
+                "single_box",
+                "--planner",
+                "apf",
+                "--set",
+                "planner.repulse_gain=0",
+                "--set",
+                "run.time_limit_s=20",
+            ],
+            "single_box-apf-0",
+        ),
+    ],
+)
+def test_summary_from_the_log_agrees_with_the_run(tmp_path, capsys, argv, base):
+    run_logged(tmp_path, capsys, *argv)
+    code = main(["summary", str(tmp_path / f"{base}.mcap")])
+    out = capsys.readouterr().out
+    assert code == 0 and "agrees with the run's stored summary" in out
+    recomputed = json.loads(out[: out.index("\nevents:")])
+    stored = json.loads((tmp_path / f"{base}.json").read_text())
+    for key in ("outcome", "collisions", "local_minima", "escapes", "reached"):
+        assert recomputed[key] == stored[key]
+    assert recomputed["path_length_m"] == pytest.approx(stored["path_length_m"], abs=0.01)
+    assert recomputed["min_clearance_m"] == pytest.approx(stored["min_clearance_m"], abs=0.01)
+
+
+def test_render_from_the_log_matches_the_run_render(tmp_path, capsys):
+    run_logged(tmp_path, capsys, "paper_c_escape")
+    target = tmp_path / "again.png"
+    assert main(["render", str(tmp_path / "paper_c_escape-vplane-0.mcap"), "-o", str(target)]) == 0
+    original = matplotlib.image.imread(tmp_path / "paper_c_escape-vplane-0.png")
+    again = matplotlib.image.imread(target)
+    assert original.shape == again.shape
+    differing = np.mean(np.any(np.abs(original - again) > 0.1, axis=-1))
+    assert differing < 0.002  # the same picture but for a few pixels
+
+
+def test_render_colours_the_path_by_planner_mode(tmp_path, capsys):
+    run_logged(tmp_path, capsys, "paper_c_escape")
+    image = matplotlib.image.imread(tmp_path / "paper_c_escape-vplane-0.png")[..., :3]
+    red = (image[..., 0] > 0.7) & (image[..., 1] < 0.25) & (image[..., 2] < 0.25)  # normal
+    blue = (image[..., 2] > 0.75) & (image[..., 0] < 0.25) & (image[..., 1] < 0.5)  # escaping
+    orange = (image[..., 0] > 0.85) & (image[..., 1] > 0.35) & (image[..., 1] < 0.6) & (image[..., 2] < 0.2)
+    assert red.sum() > 200 and blue.sum() > 50 and orange.sum() > 100
+
+
+@pytest.mark.parametrize("content", [None, b"not an mcap file"])
+def test_a_missing_or_foreign_log_is_a_clear_error(tmp_path, capsys, content):
+    path = tmp_path / "x.mcap"
+    if content is not None:
+        path.write_bytes(content)
+    assert main(["summary", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: {path}") and "Traceback" not in err
+    assert main(["render", str(path), "-o", str(tmp_path / "x.png")]) == 2
+    assert not (tmp_path / "x.png").exists()
