@@ -77,3 +77,14 @@ def test_a_missing_or_foreign_log_is_a_clear_error(tmp_path, capsys, content):
     assert err.startswith(f"error: {path}") and "Traceback" not in err
     assert main(["render", str(path), "-o", str(tmp_path / "x.png")]) == 2
     assert not (tmp_path / "x.png").exists()
+
+
+def test_plot_from_the_log(tmp_path, capsys):
+    run_logged(tmp_path, capsys, "paper_c_escape")
+    target = tmp_path / "plot.png"
+    assert main(["plot", str(tmp_path / "paper_c_escape-vplane-0.mcap"), "-o", str(target)]) == 0
+    image = matplotlib.image.imread(target)
+    assert image.shape[1] > 1000 and image.shape[0] > 400
+    # the field panel's colour map and the path colours are there, not a blank canvas
+    assert np.std(image[..., :3]) > 0.1
+    assert main(["plot", str(tmp_path / "paper_c_escape-vplane-0.mcap"), "-o", str(tmp_path / "no/x.png")]) == 2

@@ -77,6 +77,11 @@ def _parser() -> argparse.ArgumentParser:
     render.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.png")
     render.set_defaults(handler=_render)
 
+    plot = commands.add_parser("plot", help="plot a run (map, potential field, time series) from its log")
+    plot.add_argument("log", type=Path, metavar="LOG.mcap")
+    plot.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.png")
+    plot.set_defaults(handler=_plot)
+
     listing = commands.add_parser("list", help="built-in scenarios and planners")
     listing.set_defaults(handler=_list)
     return parser
@@ -215,6 +220,18 @@ def _render(args: argparse.Namespace) -> int:
     _check_parent(args.output)
     image = render_top_view(scenario, track_from_log(args.log, contents))
     write_atomically(args.output, lambda tmp: write_png(image, tmp))
+    print(f"wrote {args.output}")
+    return 0
+
+
+def _plot(args: argparse.Namespace) -> int:
+    from vplane_mj.plots import plot_log
+    from vplane_mj.replay import load_log, track_from_log
+
+    contents, scenario = load_log(args.log)
+    _check_parent(args.output)
+    figure = plot_log(args.log, contents, scenario, track_from_log(args.log, contents))
+    write_atomically(args.output, lambda tmp: figure.savefig(tmp, format="png", dpi=100))
     print(f"wrote {args.output}")
     return 0
 

@@ -28,6 +28,13 @@ class Rect:
     half: Vec2
     yaw: float = 0.0
 
+    def corners(self) -> np.ndarray:
+        """The four corners (4, 2) in world coordinates, counter-clockwise."""
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        hx, hy = self.half
+        local = np.array([(-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)])
+        return np.asarray(self.center) + local @ np.array([[c, s], [-s, c]])
+
 
 @dataclass(frozen=True)
 class Disc:
