@@ -87,4 +87,5 @@ def test_plot_from_the_log(tmp_path, capsys):
     assert image.shape[1] > 1000 and image.shape[0] > 400
     # the field panel's colour map and the path colours are there, not a blank canvas
     assert np.std(image[..., :3]) > 0.1
-    assert main(["plot", str(tmp_path / "paper_c_escape-vplane-0.mcap"), "-o", str(tmp_path / "no/x.png")]) == 2
+    log = str(tmp_path / "paper_c_escape-vplane-0.mcap")
+    assert main(["plot", log, "-o", str(tmp_path / "missing" / "x.png")]) == 2
