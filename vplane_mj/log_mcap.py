@@ -200,6 +200,17 @@ def _pieces_entity(
     )
 
 
+def _flat_disc(center, radius: float, rgba) -> fm.CylinderPrimitive:
+    """A 1 cm thick disc lying on the floor (start and goal markers)."""
+    return fm.CylinderPrimitive(
+        pose=_pose(center[0], center[1], 0.005),
+        size=fm.Vector3(x=2 * radius, y=2 * radius, z=0.01),
+        bottom_scale=1.0,
+        top_scale=1.0,
+        color=_colour(rgba),
+    )
+
+
 def _deletion(stamp: fm.Timestamp, entity_id: str) -> fm.SceneEntityDeletion:
     return fm.SceneEntityDeletion(timestamp=stamp, type=fm.SceneEntityDeletionType.MatchingId, id=entity_id)
 
@@ -326,15 +337,7 @@ class McapLog:
                 timestamp=stamp,
                 frame_id=WORLD_FRAME,
                 id="start",
-                cylinders=[
-                    fm.CylinderPrimitive(
-                        pose=_pose(robot.start[0], robot.start[1], 0.005),
-                        size=fm.Vector3(x=2 * radius, y=2 * radius, z=0.01),
-                        bottom_scale=1.0,
-                        top_scale=1.0,
-                        color=_colour(_COLOURS["start"]),
-                    )
-                ],
+                cylinders=[_flat_disc(robot.start, radius, _COLOURS["start"])],
                 arrows=[
                     fm.ArrowPrimitive(
                         pose=_pose(robot.start[0], robot.start[1], 0.02, robot.start_yaw),
@@ -353,15 +356,7 @@ class McapLog:
                 timestamp=stamp,
                 frame_id=WORLD_FRAME,
                 id="goal",
-                cylinders=[
-                    fm.CylinderPrimitive(
-                        pose=_pose(robot.goal[0], robot.goal[1], 0.005),
-                        size=fm.Vector3(x=2 * tol, y=2 * tol, z=0.01),
-                        bottom_scale=1.0,
-                        top_scale=1.0,
-                        color=_colour(_COLOURS["goal"]),
-                    )
-                ],
+                cylinders=[_flat_disc(robot.goal, tol, _COLOURS["goal"])],
             )
         )
         self._world_ch.log(fm.SceneUpdate(entities=entities), log_time=0)
