@@ -14,7 +14,7 @@ messages' own `timestamp` fields, is the integer nanosecond of *simulated* time,
 | `/world` | `foxglove.SceneUpdate` | once at time 0: arena, obstacles, border, start, goal |
 | `/forces` | `foxglove.SceneUpdate` | every tick: force arrows at the robot |
 | `/virtual` | `foxglove.SceneUpdate` | at time 0 (empty), then when the objective or planes change |
-| `/path` | `foxglove.SceneUpdate` | about once per simulated second and at close |
+| `/path` | `foxglove.SceneUpdate` | a new path segment about once per simulated second and at close |
 | `/events` | `foxglove.Log` | one per event, name `vplane_mj` |
 | `/metrics` | JSON (`vplane_mj.Metrics` JSON schema) | every tick |
 
@@ -23,8 +23,9 @@ their length is `ARROW_M_PER_UNIT` (0.5 m) per unit of force, clipped to
 `ARROW_MAX_M` (1.5 m); an arrow whose force is (near) zero or not finite is deleted
 until it comes back. Entity ids: `/forces` `attractive`, `repulsive`, `virtual`,
 `total`; `/virtual` `objective`, `plane_0`, `plane_1`, ... (by position in the
-planner's list); `/path` `path`; `/world` `arena`, `border`, `obstacle_<i>`, `start`,
-`goal`. Entities that vanish are removed with `SceneUpdate.deletions`.
+planner's list); `/path` `path_0`, `path_1`, ... (one segment about every simulated
+second); `/world` `arena`, `border`, `obstacle_<i>`, `start`, `goal`. Entities that
+vanish are removed with `SceneUpdate.deletions`.
 
 The file metadata: record `vplane_mj` (scenario name, resolved TOML text, seed,
 planner and its parameters, package versions, time base, plus the caller's
@@ -277,6 +278,8 @@ class McapLog:
         self._path: list[tuple[float, float]] = []
         self._path_end = (0.0, 0.0)
         self._path_dirty = False
+        self._path_sent = 0
+        self._path_segments = 0
         self._next_flush_s = FLUSH_PERIOD_S
 
     # -- metadata and the static world -------------------------------------------------------
@@ -531,9 +534,17 @@ class McapLog:
         self._path_dirty = True
 
     def _log_path(self, ns: int) -> None:
+        """Log the path travelled since the last call as a new entity `path_<k>`.
+
+        Earlier segments stay in the scene, so the whole path shows while the log grows
+        linearly with the run (re-sending the whole path every second would grow it
+        quadratically).
+        """
         if not self._path:
             return
-        strip = self._path if self._path[-1] == self._path_end else [*self._path, self._path_end]
+        strip = self._path[self._path_sent :]
+        if strip[-1] != self._path_end:
+            strip = [*strip, self._path_end]
         points = [fm.Point3(x=px, y=py, z=0.01) for px, py in strip]
         line = fm.LinePrimitive(
             type=fm.LinePrimitiveLineType.LineStrip,
@@ -543,8 +554,11 @@ class McapLog:
             points=points,
             color=_colour(_COLOURS["path"]),
         )
-        entity = fm.SceneEntity(timestamp=_stamp(ns), frame_id=WORLD_FRAME, id="path", lines=[line])
+        entity_id = f"path_{self._path_segments}"
+        entity = fm.SceneEntity(timestamp=_stamp(ns), frame_id=WORLD_FRAME, id=entity_id, lines=[line])
         self._path_ch.log(fm.SceneUpdate(entities=[entity]), log_time=ns)
+        self._path_segments += 1
+        self._path_sent = len(self._path) - 1  # the next segment starts where this one did end
         self._path_dirty = False
 
 
