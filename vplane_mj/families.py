@@ -9,7 +9,7 @@ the goal together about the arena's centre) gives the same problem at another an
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import tomli_w
 
@@ -19,11 +19,10 @@ CENTER = (ARENA / 2, ARENA / 2)
 
 @dataclass(frozen=True)
 class Case:
-    """One generated scenario: its name, the TOML document, and the traps' footprints."""
+    """One generated scenario: its name and its TOML document (as a dict)."""
 
     name: str
     document: dict
-    traps: list[dict] = field(default_factory=list)
 
     def toml(self) -> str:
         return tomli_w.dumps(self.document)
@@ -62,7 +61,7 @@ def rotated(case: Case, angle_deg: float) -> Case:
         "start": _rotate(case.document["robot"]["start"], angle_deg),
         "goal": _rotate(case.document["robot"]["goal"], angle_deg),
     }
-    return Case(doc["name"], doc, case.traps)
+    return Case(doc["name"], doc)
 
 
 def _document(name: str, obstacles: list[dict], start: list[float], goal: list[float]) -> dict:
@@ -108,7 +107,7 @@ def cup_case(
         inside_offset = 0.1
     start = _polar(CENTER, inside_offset if inside else 3.5, mouth)
     goal = _polar(CENTER, 3.8, yaw_deg)
-    return Case(name, _document(name, [obstacle], start, goal), [obstacle])
+    return Case(name, _document(name, [obstacle], start, goal))
 
 
 def asymmetric_case(name: str, yaw_deg: float) -> Case:
@@ -128,7 +127,7 @@ def asymmetric_case(name: str, yaw_deg: float) -> Case:
     ]
     start = _polar(CENTER, 3.5, yaw_deg + 180.0)
     goal = _polar(CENTER, 3.8, yaw_deg)
-    return Case(name, _document(name, walls, start, goal), walls)
+    return Case(name, _document(name, walls, start, goal))
 
 
 def two_traps_case(name: str, yaw_deg: float) -> Case:
@@ -142,13 +141,13 @@ def two_traps_case(name: str, yaw_deg: float) -> Case:
         )
     start = _polar(CENTER, 4.2, yaw_deg + 180.0)
     goal = _polar(CENTER, 4.2, yaw_deg)
-    return Case(name, _document(name, cups, start, goal), cups)
+    return Case(name, _document(name, cups, start, goal))
 
 
 def goal_near_wall_case(name: str) -> Case:
     """A cup with the goal 0.3 m from the border wall behind it."""
     obstacle = {"kind": "u", "center": [6.5, 5.0], "width": 1.6, "depth": 1.2, "thickness": 0.1}
-    return Case(name, _document(name, [obstacle], [2.0, 5.0], [9.7, 5.0]), [obstacle])
+    return Case(name, _document(name, [obstacle], [2.0, 5.0], [9.7, 5.0]))
 
 
 def trap_suite() -> list[Case]:

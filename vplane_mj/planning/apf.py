@@ -64,8 +64,6 @@ def firas_components(obs: Observation, params: Mapping[str, float]) -> dict[str,
 class ApfPlanner:
     """Follows F_T = F_A + F_R (eq. 6); reports local minima and gives up after `patience_s`."""
 
-    info = INFO
-
     def __init__(self, params: Mapping[str, float]):
         self.params = dict(params)
         self.detector = detector_from(self.params)

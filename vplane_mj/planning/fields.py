@@ -34,7 +34,7 @@ def repulsive_potential(position: np.ndarray, points: np.ndarray, gain: float, i
 
     `points` (N, 2) are obstacle points (sonar echoes); f is clamped to MIN_DISTANCE_M.
     """
-    f = _distances(position, points)
+    _, f = _offsets(position, points)
     near = f <= influence
     return float(0.5 * gain * np.sum((1.0 / f[near] - 1.0 / influence) ** 2))
 
@@ -45,11 +45,7 @@ def repulsive_force(position: np.ndarray, points: np.ndarray, gain: float, influ
     Each sonar echo is one obstacle point, so the force is the negative gradient of
     `repulsive_potential`; it points away from every point within the influence distance.
     """
-    pts = np.asarray(points, float).reshape(-1, 2)
-    if len(pts) == 0:
-        return np.zeros(2)
-    rel = np.asarray(position, float) - pts
-    f = np.maximum(np.hypot(rel[:, 0], rel[:, 1]), MIN_DISTANCE_M)
+    rel, f = _offsets(position, points)
     near = f <= influence
     if not np.any(near):
         return np.zeros(2)
@@ -59,7 +55,7 @@ def repulsive_force(position: np.ndarray, points: np.ndarray, gain: float, influ
     return (magnitude[:, None] * rel / f[:, None]).sum(axis=0)
 
 
-def _distances(position: np.ndarray, points: np.ndarray) -> np.ndarray:
-    pts = np.asarray(points, float).reshape(-1, 2)
-    rel = np.asarray(position, float) - pts
-    return np.maximum(np.hypot(rel[:, 0], rel[:, 1]), MIN_DISTANCE_M)
+def _offsets(position: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """x - x_obs for each point (N, 2), and its length f clamped to MIN_DISTANCE_M (N,)."""
+    rel = np.asarray(position, float) - np.asarray(points, float).reshape(-1, 2)
+    return rel, np.maximum(np.hypot(rel[:, 0], rel[:, 1]), MIN_DISTANCE_M)

@@ -23,10 +23,6 @@ class Valley:
     last: int
     count: int
 
-    def center(self, sector: float) -> float:
-        """Bearing (rad) of the middle of the valley."""
-        return (self.first + (self.count - 1) / 2 + 0.5) * sector
-
 
 def polar_histogram(
     origin: np.ndarray,

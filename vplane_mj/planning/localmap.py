@@ -93,10 +93,6 @@ class LocalMap:
         values[inside] = grid_values[index[inside, 0], index[inside, 1]]
         return values
 
-    def _cell_centres(self) -> tuple[np.ndarray, np.ndarray]:
-        index = np.arange(self.n) + 0.5
-        return (self.origin[0] + index) * self.cell_m, (self.origin[1] + index) * self.cell_m
-
     def _follow(self, position: np.ndarray) -> None:
         """Keep the robot in the grid's middle half, shifting the grid by whole cells."""
         centre_cell = np.floor(np.asarray(position) / self.cell_m).astype(int) - self.n // 2

@@ -90,8 +90,6 @@ INFO = PlannerInfo(
 class VPlanePlanner:
     """Algorithm 3 with its flags: `temp_goal` (escaping) and the list L of virtual planes."""
 
-    info = INFO
-
     def __init__(self, params: Mapping[str, float], robot_radius_m: float):
         self.params = dict(params)
         self.radius = robot_radius_m
