@@ -59,6 +59,15 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--no-render", action="store_true", help="do not write the .png render")
     run.set_defaults(handler=_run)
 
+    sweep = commands.add_parser("bench", help="many runs: scenarios x planners x seeds")
+    sweep.add_argument("scenarios", nargs="+", metavar="SCENARIO")
+    sweep.add_argument("--planners", help="comma-separated planner names (default: all)")
+    sweep.add_argument("--seeds", default="0", help="seeds, e.g. 0-19 or 0,3,5-7 (default 0)")
+    sweep.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="worker processes")
+    sweep.add_argument("--scheduler", metavar="ADDRESS", help="a Dask scheduler (not in this version)")
+    sweep.add_argument("--out", type=Path, help=f"output directory (default {DEFAULT_OUT}/)")
+    sweep.set_defaults(handler=_bench)
+
     check = commands.add_parser("check", help="validate scenarios only")
     check.add_argument("scenarios", nargs="+", metavar="SCENARIO")
     check.set_defaults(handler=_check)
@@ -161,6 +170,28 @@ def _summary_line(scenario: Scenario, s: dict) -> str:
         f"collisions {s['collisions']}, min clearance {clearance}, "
         f"local minima {s['local_minima']}, escapes {s['escapes']}, wall {s['wall_time_s']:.2f} s"
     )
+
+
+def _bench(args: argparse.Namespace) -> int:
+    from vplane_mj.bench import bench, parse_seeds
+
+    if args.scheduler is not None:
+        raise VPlaneError("--scheduler: running on a Dask cluster is not available in this version")
+    if args.jobs < 1:
+        raise VPlaneError(f"--jobs: must be at least 1, got {args.jobs}")
+    planners = sorted(PLANNERS) if args.planners is None else [p.strip() for p in args.planners.split(",")]
+    seeds = parse_seeds(args.seeds)
+    out_dir = prepare_out_dir(args.out or DEFAULT_OUT, create=args.out is None)
+    with signals_raise_interrupted():
+        try:
+            return bench(args.scenarios, planners, seeds, out_dir, args.jobs)
+        except Interrupted as exc:
+            print(
+                f"\ninterrupted by {exc}: finished runs are kept in {out_dir / 'bench.jsonl'}; "
+                "run the same command again to complete the sweep",
+                file=sys.stderr,
+            )
+            return exc.exit_status
 
 
 def _check(args: argparse.Namespace) -> int:

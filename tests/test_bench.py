@@ -1,0 +1,66 @@
+"""`vplane-mj bench`: the sweep, its outputs, resuming, and invalid input."""
+
+import json
+
+import pytest
+
+from vplane_mj.bench import parse_seeds
+from vplane_mj.cli import main
+
+ARGS = ["bench", "open_field", "paper_c_escape", "--planners", "apf,vplane", "--seeds", "0-1", "--jobs", "2"]
+
+
+def test_a_sweep_writes_rows_table_and_plot_and_resumes(tmp_path, capsys):
+    assert main([*ARGS, "--out", str(tmp_path)]) == 0
+    captured = capsys.readouterr()
+    assert "8 runs: 0 already done, 8 to run" in captured.err
+    document = json.loads((tmp_path / "bench.json").read_text())
+    rows, table = document["rows"], document["table"]
+    assert len(rows) == 8 and {(r["scenario"], r["planner"], r["seed"]) for r in rows} == {
+        (s, p, seed) for s in ("open_field", "paper_c_escape") for p in ("apf", "vplane") for seed in (0, 1)
+    }
+    by_planner = {row["planner"]: row for row in table}
+    assert by_planner["vplane"]["success_rate"] == 1.0
+    assert by_planner["apf"]["success_rate"] == 0.5  # trapped in the C obstacle
+    assert by_planner["apf"]["stuck"] == 2
+    assert "success_rate" in captured.out and "vplane" in captured.out
+    assert len((tmp_path / "bench.csv").read_text().splitlines()) == 9
+    assert (tmp_path / "bench.png").stat().st_size > 10_000
+
+    # Rerunning the same command runs nothing again and gives the same rows.
+    assert main([*ARGS, "--out", str(tmp_path)]) == 0
+    assert "8 already done, 0 to run" in capsys.readouterr().err
+    again = json.loads((tmp_path / "bench.json").read_text())["rows"]
+    assert [r["key"] for r in again] == [r["key"] for r in rows]
+
+    # An interrupted sweep (journal with 5 rows, the last one torn) completes the rest.
+    lines = (tmp_path / "bench.jsonl").read_text().splitlines()
+    (tmp_path / "bench.jsonl").write_text("\n".join(lines[:5]) + "\n" + lines[5][:40])
+    assert main([*ARGS, "--out", str(tmp_path)]) == 0
+    assert "5 already done, 3 to run" in capsys.readouterr().err
+    resumed = json.loads((tmp_path / "bench.json").read_text())["rows"]
+    strip = [{k: v for k, v in r.items() if k != "wall_time_s"} for r in resumed]
+    assert strip == [{k: v for k, v in r.items() if k != "wall_time_s"} for r in rows]
+
+
+@pytest.mark.parametrize(
+    "extra, fragment",
+    [
+        (["--seeds", "5-2"], "--seeds"),
+        (["--seeds", "x"], "--seeds"),
+        (["--planners", "apf,nope"], "planner.name"),
+        (["--jobs", "0"], "--jobs"),
+        (["--scheduler", "tcp://127.0.0.1:8786"], "--scheduler"),
+    ],
+)
+def test_invalid_input_exits_2_and_writes_nothing(tmp_path, capsys, extra, fragment):
+    assert main(["bench", "open_field", *extra, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and fragment in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_parse_seeds():
+    assert parse_seeds("0-3") == [0, 1, 2, 3]
+    assert parse_seeds("7") == [7]
+    assert parse_seeds("5,0-1,5") == [0, 1, 5]

@@ -1,0 +1,262 @@
+"""Sweeps: scenarios x planners x seeds in a local process pool, resumable, with a results table.
+
+Every finished run is appended at once to `bench.jsonl` in the output directory (one JSON
+summary per line), so an interrupted sweep loses nothing finished: the same command run
+again skips the runs whose rows exist (same scenario text, planner and seed) and does the
+rest. At the end `bench.csv`, `bench.json` (rows and table) and `bench.png` are written
+(each atomically) and the table is printed.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import io
+import json
+import statistics
+import sys
+import time
+from collections.abc import Iterable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+
+from vplane_mj.errors import VPlaneError
+from vplane_mj.outputs import write_atomically, write_json
+from vplane_mj.scenario import load_scenario
+
+JOURNAL = "bench.jsonl"
+TABLE_COLUMNS = (
+    "planner",
+    "runs",
+    "success_rate",
+    "collision_rate",
+    "timeouts",
+    "stuck",
+    "errors",
+    "median_time_to_goal_s",
+    "median_path_length_m",
+    "escapes",
+)
+
+
+@dataclass(frozen=True)
+class Job:
+    """One run of a sweep: the resolved scenario text and where it came from."""
+
+    scenario: str
+    planner: str
+    seed: int
+    toml: str
+
+    @property
+    def key(self) -> str:
+        """Identifies a run across invocations: scenario content, planner and seed."""
+        digest = hashlib.sha256(self.toml.encode()).hexdigest()[:16]
+        return f"{self.scenario}|{self.planner}|{self.seed}|{digest}"
+
+
+def parse_seeds(text: str) -> list[int]:
+    """Seeds from "0-19", "7" or "0,2,5-7"; a VPlaneError names the bad part."""
+    seeds: list[int] = []
+    for part in text.split(","):
+        bounds = part.strip().split("-")
+        try:
+            low, high = (int(bounds[0]), int(bounds[-1])) if len(bounds) <= 2 else (None, None)
+        except ValueError:
+            low = high = None
+        if low is None or low < 0 or high < low:
+            raise VPlaneError(f"--seeds: {part.strip()!r} is not a seed or a range like 0-19")
+        seeds.extend(range(low, high + 1))
+    return sorted(set(seeds))
+
+
+def plan_jobs(scenarios: Iterable[str], planners: Iterable[str], seeds: Iterable[int]) -> list[Job]:
+    """Every combination, each validated as `vplane-mj run` would (VPlaneError on bad input)."""
+    jobs = []
+    for ref in scenarios:
+        for planner in planners:
+            for seed in seeds:
+                scenario = load_scenario(ref, [f"planner.name={planner}", f"run.seed={seed}"])
+                jobs.append(Job(scenario.name, planner, seed, scenario.to_toml()))
+    return jobs
+
+
+def run_job(job: Job) -> dict:
+    """Run one job (in a worker process); its summary plus the job's key."""
+    from vplane_mj.scenario import parse_scenario
+    from vplane_mj.sim import run_scenario
+
+    summary = run_scenario(parse_scenario(job.toml, f"{job.scenario} (bench)")).summary
+    return {"key": job.key, **summary}
+
+
+def read_journal(path: Path) -> dict[str, dict]:
+    """Finished rows by key; a torn last line (the process was killed mid-write) is ignored."""
+    rows: dict[str, dict] = {}
+    if not path.exists():
+        return rows
+    for line in path.read_text(encoding="utf-8").splitlines():
+        try:
+            row = json.loads(line)
+        except json.JSONDecodeError:
+            continue
+        if isinstance(row, dict) and "key" in row:
+            rows[row["key"]] = row
+    return rows
+
+
+class Progress:
+    """A one-line progress bar with an ETA on stderr (a line every 10% when not a terminal)."""
+
+    def __init__(self, total: int, done: int):
+        self.total, self.done, self.started = total, done, time.monotonic()
+        self.fresh = 0
+        self.tty = sys.stderr.isatty()
+        self._last_decile = -1
+
+    def advance(self) -> None:
+        self.done += 1
+        self.fresh += 1
+        elapsed = time.monotonic() - self.started
+        remaining = (self.total - self.done) * elapsed / self.fresh
+        filled = round(30 * self.done / self.total)
+        line = (
+            f"[{'#' * filled}{'.' * (30 - filled)}] {self.done}/{self.total} runs, "
+            f"{elapsed:.0f} s elapsed, ETA {remaining:.0f} s"
+        )
+        if self.tty:
+            print(f"\r{line}", end="" if self.done < self.total else "\n", file=sys.stderr, flush=True)
+        elif (decile := 10 * self.done // self.total) != self._last_decile:
+            self._last_decile = decile
+            print(line, file=sys.stderr, flush=True)
+
+
+def run_sweep(jobs: list[Job], out_dir: Path, workers: int) -> list[dict]:
+    """Run the jobs not yet in the journal; return every row of the sweep, in job order."""
+    journal_path = out_dir / JOURNAL
+    finished = read_journal(journal_path)
+    pending = [job for job in jobs if job.key not in finished]
+    print(
+        f"{len(jobs)} runs: {len(jobs) - len(pending)} already done, {len(pending)} to run "
+        f"with {workers} worker(s)",
+        file=sys.stderr,
+    )
+    if pending:
+        progress = Progress(len(jobs), len(jobs) - len(pending))
+        with open(journal_path, "a", encoding="utf-8") as journal, ProcessPoolExecutor(workers) as pool:
+            futures = [pool.submit(run_job, job) for job in pending]
+            for future in as_completed(futures):
+                row = future.result()
+                journal.write(json.dumps(row, allow_nan=False) + "\n")
+                journal.flush()
+                finished[row["key"]] = row
+                progress.advance()
+    return [finished[job.key] for job in jobs]
+
+
+def summarize(rows: list[dict]) -> list[dict]:
+    """One table row per planner (INTERFACE bench table), in first-seen order."""
+    table = []
+    for planner in dict.fromkeys(row["planner"] for row in rows):
+        mine = [row for row in rows if row["planner"] == planner]
+        reached = [row for row in mine if row["reached"]]
+        table.append(
+            {
+                "planner": planner,
+                "runs": len(mine),
+                "success_rate": sum(row["success"] for row in mine) / len(mine),
+                "collision_rate": sum(row["collisions"] > 0 for row in mine) / len(mine),
+                "timeouts": sum(row["outcome"] == "timeout" for row in mine),
+                "stuck": sum(row["outcome"] == "stuck" for row in mine),
+                "errors": sum(row["outcome"] == "error" for row in mine),
+                "median_time_to_goal_s": statistics.median(r["time_to_goal_s"] for r in reached)
+                if reached
+                else None,
+                "median_path_length_m": statistics.median(r["path_length_m"] for r in reached)
+                if reached
+                else None,
+                "escapes": sum(row["escapes"] for row in mine),
+            }
+        )
+    return table
+
+
+def format_table(table: list[dict]) -> str:
+    """The table as aligned text for the terminal."""
+
+    def cell(value) -> str:
+        if value is None:
+            return "-"
+        return f"{value:.2f}" if isinstance(value, float) else str(value)
+
+    widths = [max(len(c), *(len(cell(row[c])) for row in table)) for c in TABLE_COLUMNS]
+    lines = ["  ".join(c.ljust(w) for c, w in zip(TABLE_COLUMNS, widths, strict=True))]
+    lines += [
+        "  ".join(cell(row[c]).ljust(w) for c, w in zip(TABLE_COLUMNS, widths, strict=True)) for row in table
+    ]
+    return "\n".join(lines)
+
+
+def write_outputs(rows: list[dict], table: list[dict], out_dir: Path) -> list[Path]:
+    """bench.csv (one row per run), bench.json (rows and table) and bench.png."""
+    columns = sorted({key for row in rows for key in row if not isinstance(row[key], dict)})
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=columns, extrasaction="ignore")
+    writer.writeheader()
+    writer.writerows(rows)
+    written = [
+        write_atomically(
+            out_dir / "bench.csv", lambda tmp: tmp.write_text(buffer.getvalue(), encoding="utf-8")
+        ),
+        write_json(out_dir / "bench.json", {"format": 1, "rows": rows, "table": table}),
+    ]
+    figure = _plot(rows)
+    written.append(
+        write_atomically(out_dir / "bench.png", lambda tmp: figure.savefig(tmp, format="png", dpi=100))
+    )
+    return written
+
+
+def _plot(rows: list[dict]):
+    """Success rate per planner and scenario, and the times to goal."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    planners = list(dict.fromkeys(row["planner"] for row in rows))
+    scenarios = list(dict.fromkeys(row["scenario"] for row in rows))
+    figure, (rates, times) = plt.subplots(1, 2, figsize=(13, 4.5))
+    width = 0.8 / len(planners)
+    for k, planner in enumerate(planners):
+        values = []
+        for name in scenarios:
+            mine = [r for r in rows if r["planner"] == planner and r["scenario"] == name]
+            values.append(sum(r["success"] for r in mine) / len(mine) if mine else 0.0)
+        rates.bar([i + k * width for i in range(len(scenarios))], values, width, label=planner)
+    rates.set_xticks(
+        [i + width * (len(planners) - 1) / 2 for i in range(len(scenarios))],
+        scenarios,
+        rotation=30,
+        ha="right",
+        fontsize=8,
+    )
+    rates.set(ylim=(0, 1.05), ylabel="success rate", title="success per planner and scenario")
+    rates.legend()
+    data = [[r["time_to_goal_s"] for r in rows if r["planner"] == p and r["reached"]] for p in planners]
+    times.boxplot([d if d else [float("nan")] for d in data], tick_labels=planners)
+    times.set(ylabel="time to goal (s)", title="time to goal of the runs that reached it")
+    figure.tight_layout()
+    return figure
+
+
+def bench(scenarios: list[str], planners: list[str], seeds: list[int], out_dir: Path, workers: int) -> int:
+    """The `vplane-mj bench` command after its arguments are parsed."""
+    jobs = plan_jobs(scenarios, planners, seeds)
+    rows = run_sweep(jobs, out_dir, workers)
+    table = summarize(rows)
+    print(format_table(table))
+    for path in write_outputs(rows, table, out_dir):
+        print(f"wrote {path}")
+    return 0
