@@ -6,6 +6,7 @@ import pytest
 
 from vplane_mj.bench import parse_seeds
 from vplane_mj.cli import main
+from vplane_mj.sim import TIMING_KEYS
 
 ARGS = ["bench", "open_field", "paper_c_escape", "--planners", "apf,vplane", "--seeds", "0-1", "--jobs", "2"]
 
@@ -39,8 +40,11 @@ def test_a_sweep_writes_rows_table_and_plot_and_resumes(tmp_path, capsys):
     assert main([*ARGS, "--out", str(tmp_path)]) == 0
     assert "5 already done, 3 to run" in capsys.readouterr().err
     resumed = json.loads((tmp_path / "bench.json").read_text())["rows"]
-    strip = [{k: v for k, v in r.items() if k != "wall_time_s"} for r in resumed]
-    assert strip == [{k: v for k, v in r.items() if k != "wall_time_s"} for r in rows]
+
+    def strip(table):
+        return [{k: v for k, v in r.items() if k not in TIMING_KEYS} for r in table]
+
+    assert strip(resumed) == strip(rows)
 
 
 @pytest.mark.parametrize(

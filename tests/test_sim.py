@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj.sim import run_scenario
+from vplane_mj.sim import TIMING_KEYS, run_scenario
 
 OPEN = """
 format = 1
@@ -114,8 +114,9 @@ def test_same_seed_gives_identical_summaries(shipped):
     scenario = shipped("paper_c_escape", "sensors.noise_std=0.02", "sensors.dropout=0.1")
     first = run_scenario(scenario)
     second = run_scenario(scenario)
-    first.summary.pop("wall_time_s")
-    second.summary.pop("wall_time_s")
+    for key in TIMING_KEYS:
+        first.summary.pop(key)
+        second.summary.pop(key)
     assert first.summary == second.summary
     np.testing.assert_array_equal(first.positions, second.positions)
 
@@ -125,3 +126,12 @@ def test_time_limit_ends_the_run(shipped):
     assert summary["outcome"] == "timeout" and not summary["reached"]
     assert summary["sim_time_s"] == pytest.approx(2.0, abs=0.06)
     assert summary["time_to_goal_s"] is None
+
+
+def test_motion_quality_metrics(shipped):
+    straight = run_scenario(shipped("open_field", "planner.name=apf")).summary
+    detour = run_scenario(shipped("paper_c_escape")).summary
+    assert straight["smoothness_rad_per_m"] < 0.05 and straight["oscillation_per_m"] < 1.0
+    assert detour["smoothness_rad_per_m"] > 5 * straight["smoothness_rad_per_m"]
+    assert detour["mean_clearance_m"] > detour["min_clearance_m"] > 0
+    assert 0 < detour["planner_cpu_ms_mean"] <= detour["planner_cpu_ms_max"]

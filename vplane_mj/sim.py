@@ -25,6 +25,8 @@ from vplane_mj.sonar import SonarRing
 from vplane_mj.world import BUMP_SENSOR, OBSTACLES_BODY, ROBOT_PREFIX, SonarLayout, build_model
 
 SUMMARY_FORMAT = 1
+TIMING_KEYS = ("wall_time_s", "planner_cpu_ms_mean", "planner_cpu_ms_max")
+"""Summary keys measured on the wall clock: the only ones that differ between identical runs."""
 CLEARANCE_BATCH = 200
 """Positions collected before one vectorised clearance query (2 s at the 100 Hz motor rate)."""
 
@@ -117,12 +119,18 @@ class _CollisionCounter:
 
 
 class _Clearance:
-    """Smallest distance from base_link's centre to any obstacle or border (m), batched."""
+    """Smallest and mean distance from base_link's centre to any obstacle or border (m), batched."""
 
     def __init__(self, footprints: shapes.Footprints):
         self._footprints = footprints
         self._pending: list[np.ndarray] = []
         self.minimum = math.inf
+        self._total = 0.0
+        self._count = 0
+
+    @property
+    def mean(self) -> float:
+        return self._total / self._count if self._count else math.inf
 
     def add(self, positions: np.ndarray) -> None:
         self._pending.append(positions)
@@ -131,7 +139,10 @@ class _Clearance:
 
     def flush(self) -> None:
         if self._pending and len(self._footprints):
-            self.minimum = min(self.minimum, float(self._footprints.distance(np.vstack(self._pending)).min()))
+            distances = self._footprints.distance(np.vstack(self._pending))
+            self.minimum = min(self.minimum, float(distances.min()))
+            self._total += float(distances.sum())
+            self._count += len(distances)
         self._pending.clear()
 
 
@@ -232,6 +243,8 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
     times: list[float] = []
     positions: list[np.ndarray] = []
     modes: list[str] = []
+    yaws: list[float] = []
+    planner_cpu: list[float] = []
     objectives: list[tuple[float, float]] = []
     planes: list[tuple[tuple[float, float], tuple[float, float]]] = []
     path_length = 0.0
@@ -271,9 +284,12 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
             while next_sonar <= data.time + 1e-9:
                 next_sonar += sonar_period
         yaw = drive.yaw()
+        yaws.append(yaw)
+        cpu_start = time.perf_counter()
         decision = planner.step(
             Observation(data.time, position, yaw, goal, tolerance, layout.bearings, ranges, beam)
         )
+        planner_cpu.append(time.perf_counter() - cpu_start)
         local_minima += decision.local_minimum
         escapes += decision.escape_completed
         for text in decision.events:
@@ -321,6 +337,10 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         "path_length_m": path_length,
         "collisions": len(collisions.points),
         "min_clearance_m": None if math.isinf(clearance.minimum) else clearance.minimum - radius,
+        "mean_clearance_m": None if math.isinf(clearance.mean) else clearance.mean - radius,
+        **_motion_quality(np.array(yaws), path_length),
+        "planner_cpu_ms_mean": 1e3 * float(np.mean(planner_cpu)) if planner_cpu else None,
+        "planner_cpu_ms_max": 1e3 * float(np.max(planner_cpu)) if planner_cpu else None,
         "local_minima": local_minima,
         "escapes": escapes,
         "robot_radius_m": radius,
@@ -340,6 +360,24 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         objectives=objectives,
         planes=planes,
     )
+
+
+TURN_NOISE_RAD = 1e-3
+"""Heading changes per tick smaller than this do not count as turning (oscillation metric)."""
+
+
+def _motion_quality(yaws: np.ndarray, path_length: float) -> dict:
+    """Smoothness: total absolute heading change per metre travelled (rad/m); oscillation:
+    reversals of the turning direction per metre (1/m). None when the robot did not move."""
+    if len(yaws) < 2 or path_length < 1e-6:
+        return {"smoothness_rad_per_m": None, "oscillation_per_m": None}
+    turns = (np.diff(yaws) + math.pi) % (2 * math.pi) - math.pi
+    signs = np.sign(turns[np.abs(turns) > TURN_NOISE_RAD])
+    reversals = int(np.count_nonzero(np.diff(signs)))
+    return {
+        "smoothness_rad_per_m": float(np.sum(np.abs(turns))) / path_length,
+        "oscillation_per_m": reversals / path_length,
+    }
 
 
 def _collect_virtual(decision: Decision, objectives: list, planes: list) -> None:
