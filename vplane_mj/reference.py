@@ -59,19 +59,22 @@ def _polyline_length(points: np.ndarray) -> float:
     return float(np.sum(np.hypot(*np.diff(points, axis=0).T)))
 
 
-def _segments_clear(fp: Footprints, a: np.ndarray, bs: np.ndarray, spacing: float, thr: float) -> np.ndarray:
-    """For each end b in `bs` (M, 2): is every sample of the segment a..b farther than `thr`?"""
-    bs = np.atleast_2d(bs)
-    if len(bs) == 0:
+def _pairs_clear(fp: Footprints, a: np.ndarray, b: np.ndarray, spacing: float, thr) -> np.ndarray:
+    """For each segment a[i]..b[i] ((M, 2) each): is every sample farther than thr (scalar or (M,))?"""
+    a, b = np.atleast_2d(a), np.atleast_2d(b)
+    a = np.broadcast_to(a, b.shape) if len(a) == 1 else a
+    if len(b) == 0:
         return np.zeros(0, dtype=bool)
-    lengths = np.hypot(bs[:, 0] - a[0], bs[:, 1] - a[1])
+    if not len(fp):
+        return np.ones(len(b), dtype=bool)
+    lengths = np.hypot(b[:, 0] - a[:, 0], b[:, 1] - a[:, 1])
     counts = np.ceil(lengths / spacing).astype(int) + 1
-    seg = np.repeat(np.arange(len(bs)), counts)
+    seg = np.repeat(np.arange(len(b)), counts)
     starts = np.cumsum(counts) - counts
     k = np.arange(counts.sum()) - starts[seg]
     t = k / np.maximum(counts[seg] - 1, 1)
-    pts = a + t[:, None] * (bs[seg] - a)
-    ok = fp.distance(pts) > thr
+    pts = a[seg] + t[:, None] * (b[seg] - a[seg])
+    ok = fp.distance(pts) > np.broadcast_to(np.asarray(thr, dtype=float), (len(b),))[seg]
     return np.logical_and.reduceat(ok, starts)
 
 
