@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
 import tomli_w
 
 ARENA = 10.0
@@ -43,9 +44,9 @@ def _rotate(point: list[float], angle_deg: float) -> list[float]:
     ]
 
 
-def rotated(case: Case, angle_deg: float) -> Case:
+def rotated(case: Case, angle_deg: float, name: str | None = None) -> Case:
     """The same case with obstacles, start and goal rotated together about the arena centre."""
-    doc = {**case.document, "name": f"{case.name}_rot{round(angle_deg) % 360}"}
+    doc = {**case.document, "name": name or f"{case.name}_rot{round(angle_deg) % 360}"}
     obstacles = []
     for ob in case.document["world"].get("obstacles", []):
         turned = dict(ob)
@@ -164,4 +165,125 @@ def trap_suite() -> list[Case]:
         cases.append(asymmetric_case(f"asym_{yaw}", yaw))
         cases.append(two_traps_case(f"two_{yaw}", yaw))
     cases.append(goal_near_wall_case("goal_near_wall"))
+    return cases
+
+
+# -- seeded random families for sweeps (`vplane-mj generate FAMILY`) ---------------------------
+
+
+def random_trap(name: str, rng: np.random.Generator) -> Case:
+    """A U or H trap of random size and orientation; the start in front of the mouth (from an
+    approach angle up to 35 degrees off its axis) or, one time in five, inside the cup."""
+    kind = "h" if rng.random() < 0.4 else "u"
+    case = cup_case(
+        name,
+        yaw_deg=0.0,
+        width=round(float(rng.uniform(0.9, 2.4)), 3),
+        depth=round(float(rng.uniform(0.8, 1.6)), 3),
+        inside=bool(rng.random() < 0.2),
+        kind=kind,
+    )
+    if not _inside_start(case):
+        approach = float(rng.uniform(-35.0, 35.0))
+        case.document["robot"]["start"] = _polar(CENTER, 3.5, 180.0 + approach)
+    return rotated(case, float(rng.uniform(0.0, 360.0)), name=name)
+
+
+def _inside_start(case: Case) -> bool:
+    return math.dist(case.document["robot"]["start"], CENTER) < 1.0
+
+
+def random_clutter(name: str, rng: np.random.Generator) -> Case:
+    """Boxes and cylinders scattered over the arena, and a U trap on the straight line."""
+    angle = float(rng.uniform(0.0, 360.0))
+    start = _polar(CENTER, 4.2, angle + 180.0)
+    goal = _polar(CENTER, 4.2, angle)
+    trap = {
+        "kind": "u",
+        "center": list(CENTER),
+        "width": round(float(rng.uniform(1.2, 2.0)), 3),
+        "depth": round(float(rng.uniform(0.9, 1.4)), 3),
+        "yaw_deg": round(angle, 3),
+        "thickness": 0.1,
+    }
+    obstacles = [trap]
+    for _ in range(int(rng.integers(6, 14))):
+        centre = [round(float(v), 3) for v in rng.uniform(0.6, ARENA - 0.6, 2)]
+        if min(math.dist(centre, p) for p in (start, goal, CENTER)) < 1.4:
+            continue  # keep the start, the goal and the trap itself clear
+        if rng.random() < 0.5:
+            obstacles.append(
+                {"kind": "cylinder", "center": centre, "radius": round(float(rng.uniform(0.15, 0.4)), 3)}
+            )
+        else:
+            size = [round(float(v), 3) for v in rng.uniform(0.2, 0.9, 2)]
+            obstacles.append(
+                {
+                    "kind": "box",
+                    "center": centre,
+                    "size": size,
+                    "yaw_deg": round(float(rng.uniform(0, 180)), 3),
+                }
+            )
+    return Case(name, _document(name, obstacles, start, goal))
+
+
+def random_corridor(name: str, rng: np.random.Generator) -> Case:
+    """A zigzag of walls across the arena: the way to the goal winds through their gaps."""
+    gap = float(rng.uniform(0.8, 1.4))
+    count = int(rng.integers(2, 5))
+    xs = np.linspace(2.0, ARENA - 2.0, count)
+    walls = []
+    for k, x in enumerate(xs):
+        opening = float(rng.uniform(1.0, ARENA - 1.0 - gap))
+        if k % 2:  # alternate: the opening near the top or near the bottom half
+            opening = ARENA - opening - gap
+        walls.append(
+            {
+                "kind": "wall",
+                "from": [round(float(x), 3), 0.0],
+                "to": [round(float(x), 3), round(opening, 3)],
+                "thickness": 0.1,
+            }
+        )
+        walls.append(
+            {
+                "kind": "wall",
+                "from": [round(float(x), 3), round(opening + gap, 3)],
+                "to": [round(float(x), 3), ARENA],
+                "thickness": 0.1,
+            }
+        )
+    start = [1.0, round(float(rng.uniform(1.0, ARENA - 1.0)), 3)]
+    goal = [ARENA - 1.0, round(float(rng.uniform(1.0, ARENA - 1.0)), 3)]
+    return Case(name, _document(name, [w for w in walls if w["from"] != w["to"]], start, goal))
+
+
+FAMILIES = {"traps": random_trap, "clutter": random_clutter, "corridors": random_corridor}
+"""Generators of `vplane-mj generate`: each makes one case from a name and a generator."""
+
+
+def generate(family: str, count: int, seed: int, has_path) -> list[Case]:
+    """`count` valid cases of `family` from `seed`; `has_path(scenario)` rejects unsolvable ones.
+
+    Candidates are drawn from one generator seeded with `seed`, so the same arguments always
+    give the same files; a candidate that fails validation or has no path is drawn again.
+    """
+    from vplane_mj.errors import ScenarioError
+    from vplane_mj.scenario import parse_scenario
+
+    rng = np.random.default_rng(seed)
+    cases: list[Case] = []
+    attempts = 0
+    while len(cases) < count:
+        attempts += 1
+        if attempts > 50 * count:
+            raise RuntimeError(f"family {family}: too few valid cases after {attempts} attempts")
+        case = FAMILIES[family](f"{family}_{seed}_{len(cases):03d}", rng)
+        try:
+            scenario = parse_scenario(case.toml(), case.name)
+        except ScenarioError:
+            continue
+        if has_path(scenario):
+            cases.append(case)
     return cases

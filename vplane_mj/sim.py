@@ -18,6 +18,7 @@ from vplane_mj import __version__, shapes
 from vplane_mj.control import ControllerGains, WheelPI, heading_command, wheel_targets
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.reference import shortest_path_length
 from vplane_mj.render import Track
 from vplane_mj.robot import BASE_BODY, WHEEL_JOINTS, WHEEL_MOTORS, robot_geometry
 from vplane_mj.scenario import Scenario
@@ -344,6 +345,7 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         "local_minima": local_minima,
         "escapes": escapes,
         "robot_radius_m": radius,
+        **_path_quality(scenario, radius, reached, path_length),
         "final_distance_to_goal_m": math.hypot(goal[0] - position[0], goal[1] - position[1]),
         "message": message,
         "planner_params": planner.params,
@@ -360,6 +362,14 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         objectives=objectives,
         planes=planes,
     )
+
+
+def _path_quality(scenario: Scenario, radius: float, reached: bool, path_length: float) -> dict:
+    """The reference shortest path to the goal tolerance disc, and the path length over it."""
+    reference = shortest_path_length(scenario, radius)
+    optimal = None if reference is None else max(reference - scenario.robot.goal_tolerance, 0.0)
+    ratio = path_length / optimal if reached and optimal else None
+    return {"optimal_length_m": optimal, "path_ratio": ratio}
 
 
 TURN_NOISE_RAD = 1e-3
