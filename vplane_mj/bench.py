@@ -182,6 +182,10 @@ def summarize(rows: list[dict]) -> list[dict]:
     return table
 
 
+def _median(values: list[float]) -> float | None:
+    return statistics.median(values) if values else None
+
+
 def format_table(table: list[dict]) -> str:
     """The table as aligned text for the terminal."""
 

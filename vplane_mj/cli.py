@@ -11,6 +11,7 @@ from pathlib import Path
 import mujoco
 
 from vplane_mj.errors import VPlaneError
+from vplane_mj.families import FAMILIES
 from vplane_mj.interrupts import Interrupted, signals_raise_interrupted
 from vplane_mj.outputs import prepare_out_dir, write_atomically, write_json
 from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
@@ -67,6 +68,15 @@ def _parser() -> argparse.ArgumentParser:
     sweep.add_argument("--scheduler", metavar="ADDRESS", help="a Dask scheduler (not in this version)")
     sweep.add_argument("--out", type=Path, help=f"output directory (default {DEFAULT_OUT}/)")
     sweep.set_defaults(handler=_bench)
+
+    gen = commands.add_parser("generate", help="write seeded scenario files of a family")
+    gen.add_argument(
+        "family", choices=sorted(FAMILIES), metavar="FAMILY", help=f"one of: {', '.join(sorted(FAMILIES))}"
+    )
+    gen.add_argument("--count", type=int, default=10)
+    gen.add_argument("--seed", type=int, default=0)
+    gen.add_argument("--out", type=Path, required=True, metavar="DIR")
+    gen.set_defaults(handler=_generate)
 
     check = commands.add_parser("check", help="validate scenarios only")
     check.add_argument("scenarios", nargs="+", metavar="SCENARIO")
@@ -192,6 +202,27 @@ def _bench(args: argparse.Namespace) -> int:
                 file=sys.stderr,
             )
             return exc.exit_status
+
+
+def _generate(args: argparse.Namespace) -> int:
+    """Write `count` valid scenario files of a family, each with a reference path."""
+    from vplane_mj.families import generate
+    from vplane_mj.reference import shortest_path_length
+    from vplane_mj.robot import robot_radius_m
+
+    if args.count < 1:
+        raise VPlaneError(f"--count: must be at least 1, got {args.count}")
+    if args.seed < 0:
+        raise VPlaneError(f"--seed: must be at least 0, got {args.seed}")
+    out_dir = prepare_out_dir(args.out, create=False)
+    radius = robot_radius_m()
+    cases = generate(
+        args.family, args.count, args.seed, lambda s: shortest_path_length(s, radius) is not None
+    )
+    for case in cases:
+        path = write_atomically(out_dir / f"{case.name}.toml", lambda tmp, c=case: tmp.write_text(c.toml()))
+        print(f"wrote {path}")
+    return 0
 
 
 def _check(args: argparse.Namespace) -> int:

@@ -1,9 +1,11 @@
-"""Generated scenario families, as TOML documents: the trap suite of U/C and H obstacles.
+"""Generated scenario families, as TOML documents, in a 10 x 10 m arena.
 
-Each case places its trap(s) in a 10 x 10 m arena at some orientation, with the start in
-front of the mouth or inside the cup and the goal behind the trap, so that the straight
-line from start to goal runs into the cup. Rotating a case (every obstacle, the start and
-the goal together about the arena's centre) gives the same problem at another angle.
+The trap suite (`trap_suite`): fixed U/C and H traps at orientations off the axes, the
+start in front of the mouth or inside the cup, the goal behind the trap, so that the
+straight line from start to goal runs into the cup. Rotating a case (every obstacle, the
+start and the goal together about the arena's centre) gives the same problem at another
+angle. The seeded families of `vplane-mj generate` (`FAMILIES`): random traps, clutter
+with a trap on the straight line, and zigzag corridors.
 """
 
 from __future__ import annotations
