@@ -1,0 +1,123 @@
+"""VFH+ steering toward the goal (`vfh`), after Borenstein and Koren, and Ulrich and Borenstein.
+
+The sonar certainty grid (localmap.py) gives a polar histogram with obstacle cells
+enlarged by the robot radius plus a clearance (histogram.py); the free valleys are the
+directions the robot fits through; cells beyond the goal do not count. Candidates are the
+goal direction when it lies in a valley, the middle of narrow valleys and, in wide
+valleys, the directions half a wide valley in from each border. The cost
+5 |c - goal| + 2 |c - heading| + 2 |c - previous| picks one (VFH+'s weights). The force
+is a unit vector that way, shortened within 1 m of the goal. With no valley the robot
+stops; the local-minimum detector then makes it give up after `patience_s` (`stuck`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import numpy as np
+
+from vplane_mj.planning import histogram
+from vplane_mj.planning.apf import MINIMUM_PARAMS, detector_from
+from vplane_mj.planning.localmap import LocalMap
+from vplane_mj.planning.params import Param, PlannerInfo
+from vplane_mj.planning.types import Decision, Observation
+
+GOAL_WEIGHT, HEADING_WEIGHT, PREVIOUS_WEIGHT = 5.0, 2.0, 2.0
+"""VFH+ cost weights (Ulrich and Borenstein, 1998)."""
+
+INFO = PlannerInfo(
+    name="vfh",
+    summary="VFH+ polar-histogram steering toward the goal, from the sonar grid",
+    citation="J. Borenstein, Y. Koren, The vector field histogram, IEEE TRA 7(3), 1991; "
+    "I. Ulrich, J. Borenstein, VFH+, ICRA 1998",
+    params={
+        **MINIMUM_PARAMS,
+        "map_cell_m": Param(0.1, "m", "cell size of the local sonar map", gt=0),
+        "map_size_m": Param(8.0, "m", "side of the square local map that follows the robot", gt=0),
+        "map_threshold": Param(
+            4, "", "certainty at which a map cell counts as an obstacle", ge=1, integer=True
+        ),
+        "sector_deg": Param(5.0, "deg", "polar histogram sector width", gt=0, le=45),
+        "window_m": Param(2.0, "m", "radius of the histogram's active window", gt=0),
+        "histogram_threshold": Param(1.0, "", "sector density above which a sector is blocked", gt=0),
+        "clearance_m": Param(0.1, "m", "clearance added to the robot radius (enlargement)", ge=0),
+        "wide_valley_deg": Param(80.0, "deg", "valleys at least this wide are wide (s_max)", gt=0),
+    },
+)
+
+
+def _angle_between(a: float, b: float) -> float:
+    return abs((a - b + math.pi) % (2 * math.pi) - math.pi)
+
+
+class VfhPlanner:
+    """Steers along the cheapest free direction of the polar histogram."""
+
+    def __init__(self, params: Mapping[str, float], robot_radius_m: float):
+        self.params = dict(params)
+        self.radius = robot_radius_m
+        self.detector = detector_from(self.params)
+        self.map = LocalMap(self.params["map_cell_m"], self.params["map_size_m"])
+        self.n_sectors = max(8, round(360.0 / self.params["sector_deg"]))
+        self.previous: float | None = None
+
+    def step(self, obs: Observation) -> Decision:
+        p = self.params
+        self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
+        cells, certainty = self.map.cells(p["map_threshold"])
+        enlarge = self.radius + p["clearance_m"]
+        window = min(p["window_m"], obs.distance_to_goal() + enlarge)  # nothing beyond the goal blocks it
+        h = histogram.polar_histogram(obs.position, cells, certainty, self.n_sectors, window, enlarge)
+        to_goal = obs.goal - obs.position
+        goal_bearing = math.atan2(to_goal[1], to_goal[0])
+        direction = self._choose(histogram.find_valleys(h > p["histogram_threshold"]), goal_bearing, obs.yaw)
+        decision = Decision(force=np.zeros(2), mode="normal")
+        if direction is None:
+            decision.mode = "blocked"
+        else:
+            self.previous = direction
+            scale = min(1.0, obs.distance_to_goal())
+            decision.force = scale * np.array([math.cos(direction), math.sin(direction)])
+        decision.components = {"steering": decision.force}
+        near_goal = obs.distance_to_goal() <= obs.goal_tolerance
+        state = self.detector.update(obs.time_s, obs.position, near_goal)
+        if state.new:
+            decision.local_minimum = True
+            decision.events.append("local minimum detected")
+        if state.trapped:
+            decision.mode = "trapped"
+            if state.trapped_for_s >= p["patience_s"]:
+                decision.gave_up = True
+                decision.events.append(f"gave up: trapped for {state.trapped_for_s:.1f} s")
+        return decision
+
+    def _choose(self, valleys: list[histogram.Valley], goal: float, heading: float) -> float | None:
+        """The VFH+ candidate direction of least cost, or None when every sector is blocked."""
+        sector = 2 * math.pi / self.n_sectors
+        wide = max(1, round(math.radians(self.params["wide_valley_deg"]) / sector))
+        goal_sector = histogram.sector_of(goal, self.n_sectors)
+        candidates = []
+        for valley in valleys:
+            if valley.count >= self.n_sectors:
+                candidates.append(goal)
+                continue
+            if (goal_sector - valley.first) % self.n_sectors < valley.count:
+                candidates.append(goal)
+            if valley.count >= wide:
+                candidates.append((valley.first + wide / 2) * sector)
+                candidates.append((valley.first + valley.count - wide / 2) * sector)
+            else:
+                candidates.append((valley.first + valley.count / 2) * sector)
+        if not candidates:
+            return None
+        previous = heading if self.previous is None else self.previous
+
+        def cost(c: float) -> float:
+            return (
+                GOAL_WEIGHT * _angle_between(c, goal)
+                + HEADING_WEIGHT * _angle_between(c, heading)
+                + PREVIOUS_WEIGHT * _angle_between(c, previous)
+            )
+
+        return min(candidates, key=cost)

@@ -1,0 +1,73 @@
+"""APF with virtual obstacles at local minima (`vobs`), after Park et al. (the paper's ref. 9).
+
+On each local-minimum detection a virtual obstacle (a FIRAS repulsive point, eqs. 4-5) is
+placed at the robot's position and pushes it out of the minimum. A virtual obstacle is
+cleared after `vobs_lifetime_s`; the robot may then fall back into the same minimum, the
+weakness the virtual-plane method addresses. After `max_virtual` obstacles the planner
+gives up (outcome `stuck`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from vplane_mj.planning import fields
+from vplane_mj.planning.apf import FIELD_PARAMS, MINIMUM_PARAMS, detector_from, firas_components
+from vplane_mj.planning.params import Param, PlannerInfo
+from vplane_mj.planning.types import Decision, Observation
+
+INFO = PlannerInfo(
+    name="vobs",
+    summary="APF with a virtual obstacle placed at each local minimum",
+    citation="M. G. Park, J. H. Jeon, M. C. Lee, Obstacle avoidance for mobile robots using "
+    "artificial potential field approach with simulated annealing, ISIE 2001 (the paper's ref. 9)",
+    params={
+        **FIELD_PARAMS,
+        **{k: v for k, v in MINIMUM_PARAMS.items() if k != "patience_s"},
+        "vobs_gain": Param(0.3, "m", "eta of eq. 5 for a virtual obstacle", gt=0),
+        "vobs_influence_m": Param(1.5, "m", "f0 of eq. 5 for a virtual obstacle", gt=0),
+        "vobs_lifetime_s": Param(30.0, "s", "a virtual obstacle is cleared after this time", gt=0),
+        "max_virtual": Param(6, "", "virtual obstacles placed before giving up", ge=1, integer=True),
+    },
+)
+
+
+class VobsPlanner:
+    """F = F_A + F_R + the repulsion of the virtual obstacles that are still in force."""
+
+    def __init__(self, params: Mapping[str, float]):
+        self.params = dict(params)
+        self.detector = detector_from(self.params)
+        self.virtual: list[tuple[float, np.ndarray]] = []  # (time placed, position)
+        self.placed = 0
+
+    def step(self, obs: Observation) -> Decision:
+        p = self.params
+        components = firas_components(obs, p)
+        decision = Decision(force=np.zeros(2), mode="normal", components=components)
+        near_goal = obs.distance_to_goal() <= obs.goal_tolerance
+        if self.detector.update(obs.time_s, obs.position, near_goal).new:
+            decision.local_minimum = True
+            if self.placed >= p["max_virtual"]:
+                decision.gave_up = True
+                decision.events.append(f"gave up after {self.placed} virtual obstacles")
+            else:
+                self.placed += 1
+                self.virtual.append((obs.time_s, obs.position.copy()))
+                self.detector.reset()
+                x, y = obs.position
+                decision.events.append(f"local minimum detected: virtual obstacle at ({x:.2f}, {y:.2f})")
+        expired = [v for v in self.virtual if obs.time_s - v[0] > p["vobs_lifetime_s"]]
+        if expired:
+            decision.events.append(f"{len(expired)} virtual obstacle(s) cleared")
+            self.virtual = [v for v in self.virtual if v not in expired]
+        points = np.array([position for _, position in self.virtual]).reshape(-1, 2)
+        components["virtual"] = fields.repulsive_force(
+            obs.position, points, p["vobs_gain"], p["vobs_influence_m"]
+        )
+        decision.force = sum(components.values(), np.zeros(2))
+        decision.mode = "escaping" if len(self.virtual) else "normal"
+        decision.planes = []
+        return decision
