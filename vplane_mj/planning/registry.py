@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Protocol
 
-from vplane_mj.planning import apf, vfh, vobs, vplane
+from vplane_mj.planning import apf, bug2, vfh, vobs, vplane
 from vplane_mj.planning.params import PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
 
@@ -25,6 +25,7 @@ PLANNERS: dict[str, tuple[PlannerInfo, Factory]] = {
     vplane.INFO.name: (vplane.INFO, vplane.VPlanePlanner),
     vobs.INFO.name: (vobs.INFO, lambda params, _radius: vobs.VobsPlanner(params)),
     vfh.INFO.name: (vfh.INFO, vfh.VfhPlanner),
+    bug2.INFO.name: (bug2.INFO, lambda params, _radius: bug2.Bug2Planner(params)),
 }
 
 DEFAULT_PLANNER = vplane.INFO.name
