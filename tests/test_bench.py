@@ -24,6 +24,7 @@ def test_a_sweep_writes_rows_table_and_plot_and_resumes(tmp_path, capsys):
     assert by_planner["vplane"]["success_rate"] == 1.0
     assert by_planner["apf"]["success_rate"] == 0.5  # trapped in the C obstacle
     assert by_planner["apf"]["stuck"] == 2
+    assert 1.0 <= by_planner["vplane"]["median_path_ratio"] < 1.6
     assert "success_rate" in captured.out and "vplane" in captured.out
     assert len((tmp_path / "bench.csv").read_text().splitlines()) == 9
     assert (tmp_path / "bench.png").stat().st_size > 10_000

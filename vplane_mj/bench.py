@@ -36,6 +36,7 @@ TABLE_COLUMNS = (
     "errors",
     "median_time_to_goal_s",
     "median_path_length_m",
+    "median_path_ratio",
     "escapes",
 )
 
@@ -170,12 +171,9 @@ def summarize(rows: list[dict]) -> list[dict]:
                 "timeouts": sum(row["outcome"] == "timeout" for row in mine),
                 "stuck": sum(row["outcome"] == "stuck" for row in mine),
                 "errors": sum(row["outcome"] == "error" for row in mine),
-                "median_time_to_goal_s": statistics.median(r["time_to_goal_s"] for r in reached)
-                if reached
-                else None,
-                "median_path_length_m": statistics.median(r["path_length_m"] for r in reached)
-                if reached
-                else None,
+                "median_time_to_goal_s": _median([r["time_to_goal_s"] for r in reached]),
+                "median_path_length_m": _median([r["path_length_m"] for r in reached]),
+                "median_path_ratio": _median([r["path_ratio"] for r in reached if r.get("path_ratio")]),
                 "escapes": sum(row["escapes"] for row in mine),
             }
         )
