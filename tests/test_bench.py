@@ -69,3 +69,21 @@ def test_parse_seeds():
     assert parse_seeds("0-3") == [0, 1, 2, 3]
     assert parse_seeds("7") == [7]
     assert parse_seeds("5,0-1,5") == [0, 1, 5]
+
+
+def test_a_dask_cluster_gives_the_same_rows_as_the_local_pool(tmp_path, capsys):
+    distributed = pytest.importorskip("distributed")
+    local, remote = tmp_path / "local", tmp_path / "dask"
+    local.mkdir()
+    remote.mkdir()
+    args = ["bench", "open_field", "paper_c_escape", "--planners", "apf,vplane", "--seeds", "0"]
+    assert main([*args, "--jobs", "2", "--out", str(local)]) == 0
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster:
+        assert main([*args, "--scheduler", cluster.scheduler_address, "--out", str(remote)]) == 0
+    assert "on the Dask cluster at" in capsys.readouterr().err
+
+    def rows(directory):
+        document = json.loads((directory / "bench.json").read_text())
+        return [{k: v for k, v in r.items() if k not in TIMING_KEYS} for r in document["rows"]]
+
+    assert rows(remote) == rows(local)

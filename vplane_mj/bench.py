@@ -16,7 +16,7 @@ import json
 import statistics
 import sys
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
@@ -133,27 +133,61 @@ class Progress:
             print(line, file=sys.stderr, flush=True)
 
 
-def run_sweep(jobs: list[Job], out_dir: Path, workers: int) -> list[dict]:
-    """Run the jobs not yet in the journal; return every row of the sweep, in job order."""
+def run_sweep(jobs: list[Job], out_dir: Path, workers: int, scheduler: str | None = None) -> list[dict]:
+    """Run the jobs not yet in the journal; return every row of the sweep, in job order.
+
+    Locally the jobs go to a pool of `workers` processes; with `scheduler` (an address)
+    they go to that Dask distributed cluster instead. Each job is the same pure function
+    of its scenario text, so both engines give the same rows.
+    """
     journal_path = out_dir / JOURNAL
     finished = read_journal(journal_path)
     pending = [job for job in jobs if job.key not in finished]
+    rows = _dask_rows(pending, scheduler) if scheduler and pending else _local_rows(pending, workers)
+    engine = f"on the Dask cluster at {scheduler}" if scheduler else f"with {workers} worker(s)"
     print(
-        f"{len(jobs)} runs: {len(jobs) - len(pending)} already done, {len(pending)} to run "
-        f"with {workers} worker(s)",
+        f"{len(jobs)} runs: {len(jobs) - len(pending)} already done, {len(pending)} to run {engine}",
         file=sys.stderr,
     )
     if pending:
         progress = Progress(len(jobs), len(jobs) - len(pending))
-        with open(journal_path, "a", encoding="utf-8") as journal, ProcessPoolExecutor(workers) as pool:
-            futures = [pool.submit(run_job, job) for job in pending]
-            for future in as_completed(futures):
-                row = future.result()
+        with open(journal_path, "a", encoding="utf-8") as journal:
+            for row in rows:
                 journal.write(json.dumps(row, allow_nan=False) + "\n")
                 journal.flush()
                 finished[row["key"]] = row
                 progress.advance()
     return [finished[job.key] for job in jobs]
+
+
+def _local_rows(jobs: list[Job], workers: int) -> Iterator[dict]:
+    """Rows as the local process pool finishes them."""
+    with ProcessPoolExecutor(workers) as pool:
+        for future in as_completed([pool.submit(run_job, job) for job in jobs]):
+            yield future.result()
+
+
+def _dask_rows(jobs: list[Job], scheduler: str) -> Iterator[dict]:
+    """Rows as the workers of a Dask distributed cluster finish them (the [dask] extra).
+
+    Connects at once, so an unreachable scheduler is reported before anything is written.
+    """
+    try:
+        from distributed import Client
+        from distributed import as_completed as dask_completed
+    except ImportError as exc:
+        raise VPlaneError("--scheduler needs Dask: pip install 'vplane-mj[dask]'") from exc
+    try:
+        client = Client(scheduler, timeout=5)
+    except OSError as exc:
+        raise VPlaneError(f"--scheduler: cannot reach a Dask scheduler at {scheduler}: {exc}") from exc
+
+    def rows() -> Iterator[dict]:
+        with client:
+            for future in dask_completed(client.map(run_job, jobs, pure=False)):
+                yield future.result()
+
+    return rows()
 
 
 def summarize(rows: list[dict]) -> list[dict]:
@@ -253,10 +287,17 @@ def _plot(rows: list[dict]):
     return figure
 
 
-def bench(scenarios: list[str], planners: list[str], seeds: list[int], out_dir: Path, workers: int) -> int:
+def bench(
+    scenarios: list[str],
+    planners: list[str],
+    seeds: list[int],
+    out_dir: Path,
+    workers: int,
+    scheduler: str | None = None,
+) -> int:
     """The `vplane-mj bench` command after its arguments are parsed."""
     jobs = plan_jobs(scenarios, planners, seeds)
-    rows = run_sweep(jobs, out_dir, workers)
+    rows = run_sweep(jobs, out_dir, workers, scheduler)
     table = summarize(rows)
     print(format_table(table))
     for path in write_outputs(rows, table, out_dir):

@@ -65,7 +65,7 @@ def _parser() -> argparse.ArgumentParser:
     sweep.add_argument("--planners", help="comma-separated planner names (default: all)")
     sweep.add_argument("--seeds", default="0", help="seeds, e.g. 0-19 or 0,3,5-7 (default 0)")
     sweep.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="worker processes")
-    sweep.add_argument("--scheduler", metavar="ADDRESS", help="a Dask scheduler (not in this version)")
+    sweep.add_argument("--scheduler", metavar="ADDRESS", help="run on this Dask scheduler ([dask] extra)")
     sweep.add_argument("--out", type=Path, help=f"output directory (default {DEFAULT_OUT}/)")
     sweep.set_defaults(handler=_bench)
 
@@ -185,8 +185,6 @@ def _summary_line(scenario: Scenario, s: dict) -> str:
 def _bench(args: argparse.Namespace) -> int:
     from vplane_mj.bench import bench, parse_seeds
 
-    if args.scheduler is not None:
-        raise VPlaneError("--scheduler: running on a Dask cluster is not available in this version")
     if args.jobs < 1:
         raise VPlaneError(f"--jobs: must be at least 1, got {args.jobs}")
     planners = sorted(PLANNERS) if args.planners is None else [p.strip() for p in args.planners.split(",")]
@@ -194,7 +192,7 @@ def _bench(args: argparse.Namespace) -> int:
     out_dir = prepare_out_dir(args.out or DEFAULT_OUT, create=args.out is None)
     with signals_raise_interrupted():
         try:
-            return bench(args.scenarios, planners, seeds, out_dir, args.jobs)
+            return bench(args.scenarios, planners, seeds, out_dir, args.jobs, args.scheduler)
         except Interrupted as exc:
             print(
                 f"\ninterrupted by {exc}: finished runs are kept in {out_dir / 'bench.jsonl'}; "
