@@ -56,6 +56,7 @@ def test_a_sweep_writes_rows_table_and_plot_and_resumes(tmp_path, capsys):
         (["--planners", "apf,nope"], "planner.name"),
         (["--jobs", "0"], "--jobs"),
         (["--scheduler", "tcp://127.0.0.1:8786"], "--scheduler"),
+        (["--set", "sensors.dropout=2"], "sensors.dropout"),
     ],
 )
 def test_invalid_input_exits_2_and_writes_nothing(tmp_path, capsys, extra, fragment):

@@ -72,13 +72,15 @@ def parse_seeds(text: str) -> list[int]:
     return sorted(set(seeds))
 
 
-def plan_jobs(scenarios: Iterable[str], planners: Iterable[str], seeds: Iterable[int]) -> list[Job]:
-    """Every combination, each validated as `vplane-mj run` would (VPlaneError on bad input)."""
+def plan_jobs(
+    scenarios: Iterable[str], planners: Iterable[str], seeds: Iterable[int], overrides: Iterable[str] = ()
+) -> list[Job]:
+    """Every combination, with `--set` style overrides, each validated as `vplane-mj run` would."""
     jobs = []
     for ref in scenarios:
         for planner in planners:
             for seed in seeds:
-                scenario = load_scenario(ref, [f"planner.name={planner}", f"run.seed={seed}"])
+                scenario = load_scenario(ref, [*overrides, f"planner.name={planner}", f"run.seed={seed}"])
                 jobs.append(Job(scenario.name, planner, seed, scenario.to_toml()))
     return jobs
 
@@ -263,7 +265,7 @@ def _plot(rows: list[dict]):
 
     planners = list(dict.fromkeys(row["planner"] for row in rows))
     scenarios = list(dict.fromkeys(row["scenario"] for row in rows))
-    figure, (rates, times) = plt.subplots(1, 2, figsize=(13, 4.5))
+    figure, (rates, times, ratios) = plt.subplots(1, 3, figsize=(18, 4.5))
     width = 0.8 / len(planners)
     for k, planner in enumerate(planners):
         values = []
@@ -283,6 +285,9 @@ def _plot(rows: list[dict]):
     data = [[r["time_to_goal_s"] for r in rows if r["planner"] == p and r["reached"]] for p in planners]
     times.boxplot([d if d else [float("nan")] for d in data], tick_labels=planners)
     times.set(ylabel="time to goal (s)", title="time to goal of the runs that reached it")
+    data = [[r["path_ratio"] for r in rows if r["planner"] == p and r.get("path_ratio")] for p in planners]
+    ratios.boxplot([d if d else [float("nan")] for d in data], tick_labels=planners)
+    ratios.set(ylabel="path length / shortest path", title="path ratio of the runs that reached the goal")
     figure.tight_layout()
     return figure
 
@@ -294,9 +299,10 @@ def bench(
     out_dir: Path,
     workers: int,
     scheduler: str | None = None,
+    overrides: tuple[str, ...] = (),
 ) -> int:
     """The `vplane-mj bench` command after its arguments are parsed."""
-    jobs = plan_jobs(scenarios, planners, seeds)
+    jobs = plan_jobs(scenarios, planners, seeds, overrides)
     rows = run_sweep(jobs, out_dir, workers, scheduler)
     table = summarize(rows)
     print(format_table(table))

@@ -65,6 +65,13 @@ def _parser() -> argparse.ArgumentParser:
     sweep.add_argument("--planners", help="comma-separated planner names (default: all)")
     sweep.add_argument("--seeds", default="0", help="seeds, e.g. 0-19 or 0,3,5-7 (default 0)")
     sweep.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="worker processes")
+    sweep.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a key of every scenario, e.g. sensors.noise_std=0.01",
+    )
     sweep.add_argument("--scheduler", metavar="ADDRESS", help="run on this Dask scheduler ([dask] extra)")
     sweep.add_argument("--out", type=Path, help=f"output directory (default {DEFAULT_OUT}/)")
     sweep.set_defaults(handler=_bench)
@@ -192,7 +199,7 @@ def _bench(args: argparse.Namespace) -> int:
     out_dir = prepare_out_dir(args.out or DEFAULT_OUT, create=args.out is None)
     with signals_raise_interrupted():
         try:
-            return bench(args.scenarios, planners, seeds, out_dir, args.jobs, args.scheduler)
+            return bench(args.scenarios, planners, seeds, out_dir, args.jobs, args.scheduler, tuple(args.set))
         except Interrupted as exc:
             print(
                 f"\ninterrupted by {exc}: finished runs are kept in {out_dir / 'bench.jsonl'}; "
