@@ -19,6 +19,7 @@ import numpy as np
 
 from vplane_mj.planning.params import Param, PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.planning.vplane_geometry import unit
 
 AHEAD_HALF_ANGLE = math.radians(30.0)
 """Echoes within this angle of the goal direction count as ahead (hit and leave tests)."""
@@ -55,11 +56,6 @@ INFO = PlannerInfo(
 )
 
 
-def _unit(v: np.ndarray) -> np.ndarray:
-    n = float(np.hypot(*v))
-    return v / n if n > 1e-12 else np.zeros(2)
-
-
 def _rotate(v: np.ndarray, angle: float) -> np.ndarray:
     c, s = math.cos(angle), math.sin(angle)
     return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
@@ -88,7 +84,7 @@ class Bug2Planner:
     def mline_offset(self, position: np.ndarray) -> float:
         """Signed distance (m) of `position` from the m-line (positive on its left)."""
         start, goal = self.mline
-        direction = _unit(goal - start)
+        direction = unit(goal - start)
         rel = position - start
         return float(direction[0] * rel[1] - direction[1] * rel[0])
 
@@ -105,9 +101,9 @@ class Bug2Planner:
         to_goal = obs.goal - obs.position
         distance = float(np.hypot(*to_goal))
         scale = max(0.3, min(1.0, distance / self.params["slow_radius_m"]))
-        attract = _unit(to_goal) * scale
+        attract = unit(to_goal) * scale
         start, goal = self.mline
-        normal = _rotate(_unit(goal - start), math.pi / 2)
+        normal = _rotate(unit(goal - start), math.pi / 2)
         offset = self.mline_offset(obs.position)
         correction = -normal * float(np.clip(self.params["mline_gain"] * offset, -0.5, 0.5))
         return {"goal": attract, "mline": correction}
@@ -143,11 +139,11 @@ class Bug2Planner:
         close = ranges <= nearest + 0.1
         weights = 1.0 / (ranges[close] - nearest + 0.02)
         toward = np.array([np.sum(weights * np.cos(angles[close])), np.sum(weights * np.sin(angles[close]))])
-        away = -_unit(toward)  # the wall's normal at the robot, pointing away from it
+        away = -unit(toward)  # the wall's normal at the robot, pointing away from it
         tangent = _rotate(away, -self.side * math.pi / 2)
         error = nearest - p["wall_distance_m"]
         correction = float(np.clip(p["wall_gain"] * error, -1.0, 1.0))
-        steer = _unit(tangent - correction * away)
+        steer = unit(tangent - correction * away)
         return {"tangent": steer * p["follow_speed"]}
 
     # ------------------------------------------------------------------ the tick
