@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from vplane_mj.bench import parse_seeds
+from vplane_mj.bench import family_of, parse_seeds
 from vplane_mj.cli import main
 from vplane_mj.sim import TIMING_KEYS
 
@@ -88,3 +88,9 @@ def test_a_dask_cluster_gives_the_same_rows_as_the_local_pool(tmp_path, capsys):
         return [{k: v for k, v in r.items() if k not in TIMING_KEYS} for r in document["rows"]]
 
     assert rows(remote) == rows(local)
+
+
+def test_family_of_a_generated_scenario():
+    assert family_of("traps_1_003") == "traps"
+    assert family_of("clutter_12_000") == "clutter"
+    assert family_of("paper_c_avoid") == "paper_c_avoid"

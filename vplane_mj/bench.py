@@ -256,6 +256,14 @@ def write_outputs(rows: list[dict], table: list[dict], out_dir: Path) -> list[Pa
     return written
 
 
+def family_of(scenario: str) -> str:
+    """A generated scenario's family ("traps_1_003" -> "traps"); other names stand alone."""
+    parts = scenario.split("_")
+    while len(parts) > 1 and parts[-1].isdigit():
+        parts.pop()
+    return "_".join(parts)
+
+
 def _plot(rows: list[dict]):
     """Success rate per planner and scenario, and the times to goal."""
     import matplotlib
@@ -264,13 +272,13 @@ def _plot(rows: list[dict]):
     import matplotlib.pyplot as plt
 
     planners = list(dict.fromkeys(row["planner"] for row in rows))
-    scenarios = list(dict.fromkeys(row["scenario"] for row in rows))
+    scenarios = list(dict.fromkeys(family_of(row["scenario"]) for row in rows))
     figure, (rates, times, ratios) = plt.subplots(1, 3, figsize=(18, 4.5))
     width = 0.8 / len(planners)
     for k, planner in enumerate(planners):
         values = []
         for name in scenarios:
-            mine = [r for r in rows if r["planner"] == planner and r["scenario"] == name]
+            mine = [r for r in rows if r["planner"] == planner and family_of(r["scenario"]) == name]
             values.append(sum(r["success"] for r in mine) / len(mine) if mine else 0.0)
         rates.bar([i + k * width for i in range(len(scenarios))], values, width, label=planner)
     rates.set_xticks(
@@ -280,7 +288,7 @@ def _plot(rows: list[dict]):
         ha="right",
         fontsize=8,
     )
-    rates.set(ylim=(0, 1.05), ylabel="success rate", title="success per planner and scenario")
+    rates.set(ylim=(0, 1.05), ylabel="success rate", title="success per planner and family")
     rates.legend()
     data = [[r["time_to_goal_s"] for r in rows if r["planner"] == p and r["reached"]] for p in planners]
     times.boxplot([d if d else [float("nan")] for d in data], tick_labels=planners)
