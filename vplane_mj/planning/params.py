@@ -51,3 +51,14 @@ class PlannerInfo:
         values = {key: p.default for key, p in self.params.items()}
         values.update(overrides)
         return values
+
+
+SONAR_MAP_PARAMS: dict[str, Param] = {
+    "map_cell_m": Param(0.1, "m", "cell size of the local sonar map", gt=0),
+    "map_size_m": Param(8.0, "m", "side of the square local map that follows the robot", gt=0),
+    "map_threshold": Param(4, "", "certainty at which a map cell counts as an obstacle", ge=1, integer=True),
+    "sector_deg": Param(5.0, "deg", "polar histogram sector width", gt=0, le=45),
+    "window_m": Param(2.0, "m", "radius of the histogram's active window", gt=0),
+    "histogram_threshold": Param(1.0, "", "sector density above which a sector is blocked", gt=0),
+}
+"""The sonar certainty grid and polar histogram, shared by the planners that use them."""

@@ -20,7 +20,7 @@ import numpy as np
 from vplane_mj.planning import histogram
 from vplane_mj.planning.apf import MINIMUM_PARAMS, detector_from
 from vplane_mj.planning.localmap import LocalMap
-from vplane_mj.planning.params import Param, PlannerInfo
+from vplane_mj.planning.params import SONAR_MAP_PARAMS, Param, PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
 
 GOAL_WEIGHT, HEADING_WEIGHT, PREVIOUS_WEIGHT = 5.0, 2.0, 2.0
@@ -33,14 +33,7 @@ INFO = PlannerInfo(
     "I. Ulrich, J. Borenstein, VFH+, ICRA 1998",
     params={
         **MINIMUM_PARAMS,
-        "map_cell_m": Param(0.1, "m", "cell size of the local sonar map", gt=0),
-        "map_size_m": Param(8.0, "m", "side of the square local map that follows the robot", gt=0),
-        "map_threshold": Param(
-            4, "", "certainty at which a map cell counts as an obstacle", ge=1, integer=True
-        ),
-        "sector_deg": Param(5.0, "deg", "polar histogram sector width", gt=0, le=45),
-        "window_m": Param(2.0, "m", "radius of the histogram's active window", gt=0),
-        "histogram_threshold": Param(1.0, "", "sector density above which a sector is blocked", gt=0),
+        **SONAR_MAP_PARAMS,
         "clearance_m": Param(0.1, "m", "clearance added to the robot radius (enlargement)", ge=0),
         "wide_valley_deg": Param(80.0, "deg", "valleys at least this wide are wide (s_max)", gt=0),
     },

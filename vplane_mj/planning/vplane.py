@@ -30,7 +30,7 @@ import numpy as np
 from vplane_mj.planning import fields, histogram
 from vplane_mj.planning.apf import FIELD_PARAMS, MINIMUM_PARAMS, detector_from, firas_components
 from vplane_mj.planning.localmap import LocalMap, angular_extremes
-from vplane_mj.planning.params import Param, PlannerInfo
+from vplane_mj.planning.params import SONAR_MAP_PARAMS, Param, PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.planning.vplane_geometry import (
     VirtualPlane,
@@ -49,13 +49,8 @@ EDGE_OFFSETS_M = (0.05, 0.3, 0.6)
 PARAMS: dict[str, Param] = {
     **FIELD_PARAMS,
     **{k: v for k, v in MINIMUM_PARAMS.items() if k != "patience_s"},
-    "map_cell_m": Param(0.1, "m", "cell size of the local sonar map", gt=0),
-    "map_size_m": Param(8.0, "m", "side of the square local map that follows the robot", gt=0),
+    **SONAR_MAP_PARAMS,
     "echo_memory": Param(100, "", "sonar scans kept for the extreme points e1, e2", ge=1, integer=True),
-    "map_threshold": Param(4, "", "certainty at which a map cell counts as an obstacle", ge=1, integer=True),
-    "sector_deg": Param(5.0, "deg", "polar histogram sector width", gt=0, le=45),
-    "window_m": Param(2.0, "m", "radius of the histogram's active window", gt=0),
-    "histogram_threshold": Param(1.0, "", "sector density above which a sector is blocked", gt=0),
     "clearance_m": Param(
         0.08, "m", "clearance added to the robot radius (gap width, VFH+ enlargement)", ge=0
     ),
