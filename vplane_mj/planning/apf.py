@@ -23,13 +23,19 @@ FIELD_PARAMS: dict[str, Param] = {
     "influence": Param(0.8, "m", "f0 of eqs. 4-5, distance of influence of an echo", gt=0),
 }
 
-MINIMUM_PARAMS: dict[str, Param] = {
+DETECTOR_PARAMS: dict[str, Param] = {
     "stuck_window_s": Param(4.0, "s", "t: window of the local-minimum criteria", gt=0),
     "stuck_displacement_m": Param(0.2, "m", "d_th: least travel over the window", gt=0),
     "stuck_speed_mps": Param(0.02, "m/s", "v_th: speed below which the robot counts as halted", ge=0),
     "startup_s": Param(2.0, "s", "no detection during this time after the start", ge=0),
+}
+"""The local-minimum detector's parameters (planners with an escape use only these)."""
+
+MINIMUM_PARAMS: dict[str, Param] = {
+    **DETECTOR_PARAMS,
     "patience_s": Param(15.0, "s", "time spent trapped before giving up (outcome stuck)", gt=0),
 }
+"""The detector's parameters plus the patience of a planner without an escape."""
 
 INFO = PlannerInfo(
     name="apf",
@@ -71,15 +77,23 @@ class ApfPlanner:
     def step(self, obs: Observation) -> Decision:
         components = firas_components(obs, self.params)
         total = components["attractive"] + components["repulsive"]
-        near_goal = obs.distance_to_goal() <= obs.goal_tolerance
-        state = self.detector.update(obs.time_s, obs.position, near_goal)
         decision = Decision(force=total, mode="normal", components=components)
-        if state.new:
-            decision.local_minimum = True
-            decision.events.append("local minimum detected")
-        if state.trapped:
-            decision.mode = "trapped"
-            if state.trapped_for_s >= self.params["patience_s"]:
-                decision.gave_up = True
-                decision.events.append(f"gave up: trapped for {state.trapped_for_s:.1f} s")
+        report_trap(self.detector, obs, decision, self.params["patience_s"])
         return decision
+
+
+def report_trap(
+    detector: LocalMinimumDetector, obs: Observation, decision: Decision, patience_s: float
+) -> None:
+    """Feed the detector; mark a new local minimum, the trapped mode, and giving up after
+    `patience_s` trapped (for planners that have no escape)."""
+    near_goal = obs.distance_to_goal() <= obs.goal_tolerance
+    state = detector.update(obs.time_s, obs.position, near_goal)
+    if state.new:
+        decision.local_minimum = True
+        decision.events.append("local minimum detected")
+    if state.trapped:
+        decision.mode = "trapped"
+        if state.trapped_for_s >= patience_s:
+            decision.gave_up = True
+            decision.events.append(f"gave up: trapped for {state.trapped_for_s:.1f} s")

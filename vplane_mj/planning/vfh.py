@@ -18,7 +18,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from vplane_mj.planning import histogram
-from vplane_mj.planning.apf import MINIMUM_PARAMS, detector_from
+from vplane_mj.planning.apf import MINIMUM_PARAMS, detector_from, report_trap
 from vplane_mj.planning.localmap import LocalMap
 from vplane_mj.planning.params import SONAR_MAP_PARAMS, Param, PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
@@ -73,16 +73,7 @@ class VfhPlanner:
             scale = min(1.0, obs.distance_to_goal())
             decision.force = scale * np.array([math.cos(direction), math.sin(direction)])
         decision.components = {"steering": decision.force}
-        near_goal = obs.distance_to_goal() <= obs.goal_tolerance
-        state = self.detector.update(obs.time_s, obs.position, near_goal)
-        if state.new:
-            decision.local_minimum = True
-            decision.events.append("local minimum detected")
-        if state.trapped:
-            decision.mode = "trapped"
-            if state.trapped_for_s >= p["patience_s"]:
-                decision.gave_up = True
-                decision.events.append(f"gave up: trapped for {state.trapped_for_s:.1f} s")
+        report_trap(self.detector, obs, decision, p["patience_s"])
         return decision
 
     def _choose(self, valleys: list[histogram.Valley], goal: float, heading: float) -> float | None:

@@ -14,7 +14,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from vplane_mj.planning import fields
-from vplane_mj.planning.apf import FIELD_PARAMS, MINIMUM_PARAMS, detector_from, firas_components
+from vplane_mj.planning.apf import DETECTOR_PARAMS, FIELD_PARAMS, detector_from, firas_components
 from vplane_mj.planning.params import Param, PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
 
@@ -25,7 +25,7 @@ INFO = PlannerInfo(
     "artificial potential field approach with simulated annealing, ISIE 2001 (the paper's ref. 9)",
     params={
         **FIELD_PARAMS,
-        **{k: v for k, v in MINIMUM_PARAMS.items() if k != "patience_s"},
+        **DETECTOR_PARAMS,
         "vobs_gain": Param(0.3, "m", "eta of eq. 5 for a virtual obstacle", gt=0),
         "vobs_influence_m": Param(1.5, "m", "f0 of eq. 5 for a virtual obstacle", gt=0),
         "vobs_lifetime_s": Param(30.0, "s", "a virtual obstacle is cleared after this time", gt=0),

@@ -28,7 +28,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from vplane_mj.planning import fields, histogram
-from vplane_mj.planning.apf import FIELD_PARAMS, MINIMUM_PARAMS, detector_from, firas_components
+from vplane_mj.planning.apf import DETECTOR_PARAMS, FIELD_PARAMS, detector_from, firas_components
 from vplane_mj.planning.localmap import LocalMap, angular_extremes
 from vplane_mj.planning.params import SONAR_MAP_PARAMS, Param, PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
@@ -48,7 +48,7 @@ EDGE_OFFSETS_M = (0.05, 0.3, 0.6)
 
 PARAMS: dict[str, Param] = {
     **FIELD_PARAMS,
-    **{k: v for k, v in MINIMUM_PARAMS.items() if k != "patience_s"},
+    **DETECTOR_PARAMS,
     **SONAR_MAP_PARAMS,
     "echo_memory": Param(100, "", "sonar scans kept for the extreme points e1, e2", ge=1, integer=True),
     "clearance_m": Param(
