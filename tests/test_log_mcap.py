@@ -227,6 +227,21 @@ def test_force_arrows_scale_and_clip(run):
     assert {"attractive", "repulsive", "virtual", "total"} <= ids
 
 
+def test_an_odometry_run_logs_the_believed_pose_and_its_error(tmp_path):
+    overrides = ['sensors.pose="odometry"', "sensors.odometry_noise=0.02", "run.time_limit_s=6"]
+    scenario = load_scenario("single_box", overrides)
+    log = make_log(tmp_path / "odometry.mcap", scenario)
+    result = run_scenario(scenario, observers=(log,))
+    log.close(result.summary)
+    beliefs = [m.message for m in iter_messages(tmp_path / "odometry.mcap", ("/robot/odometry",))]
+    metrics = [m.message for m in iter_messages(tmp_path / "odometry.mcap", ("/metrics",))]
+    assert len(beliefs) == len(result.times)
+    truth, belief = result.positions[-1], beliefs[-1].pose.position
+    error = metrics[-2]["odometry_error_m"]  # the last planner tick (the final tick has no belief)
+    assert error == pytest.approx(math.dist(truth, (belief.x, belief.y)), abs=1e-9)
+    assert 0.0 < error < 0.5
+
+
 def test_metrics_json(run):
     records = [m.message for m in iter_messages(run["path"], ("/metrics",))]
     assert len(records) == len(run["result"].times) + 1
@@ -241,8 +256,10 @@ def test_metrics_json(run):
         "mode",
         "command_v_mps",
         "command_omega_radps",
+        "odometry_error_m",
     }
     assert all(set(record) == keys for record in records)
+    assert all(record["odometry_error_m"] is None for record in records)  # the planner used the true pose
     assert {record["mode"] for record in records} >= {"normal", "escaping"}
     last = records[-1]
     goal = np.array(run["scenario"].robot.goal)

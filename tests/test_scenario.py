@@ -85,6 +85,9 @@ start = [1.0, 4.0]
 start_yaw_deg = 30
 goal = [9.0, 4.0]
 goal_tolerance = 0.2
+wheel_friction = 0.5
+motor_gain = [0.9, 1]
+motor_bias_nm = [0, -0.02]
 
 [planner]
 name = "apf"
@@ -94,6 +97,10 @@ influence = 1
 [sensors]
 noise_std = 0.01
 dropout = 0.05
+crosstalk = 0.02
+dead = [23, 4]
+pose = "odometry"
+odometry_noise = 0.01
 count = 24
 rays_per_sonar = 5
 beam_deg = 25
@@ -138,9 +145,14 @@ def test_full_example_loads_with_every_value():
     assert s.robot.start == (1.0, 4.0) and s.robot.goal == (9.0, 4.0)
     assert s.robot.start_yaw == pytest.approx(math.radians(30))
     assert s.robot.goal_tolerance == 0.2
+    assert (s.robot.wheel_friction, s.robot.motor_gain, s.robot.motor_bias_nm) == (
+        0.5,
+        (0.9, 1.0),
+        (0, -0.02),
+    )
     assert s.planner == "apf"
     assert dict(s.planner_params) == {"attract_gain": 0.7, "influence": 1.0}
-    assert s.sensors == SensorSpec(0.01, 0.05, 24, 5, 25.0, 4.0, 10.0)
+    assert s.sensors == SensorSpec(0.01, 0.05, 0.02, (4, 23), "odometry", 0.01, 24, 5, 25.0, 4.0, 10.0)
     assert s.run == RunSpec(seed=7, time_limit_s=120.0, physics_dt_s=0.004, control_hz=25.0)
     assert isinstance(s.run.seed, int) and isinstance(s.run.time_limit_s, float)
 
@@ -150,6 +162,11 @@ def test_minimal_example_takes_the_defaults():
     assert s.description == ""
     assert s.world.border is True and s.world.obstacles == ()
     assert s.robot.goal_tolerance == 0.15
+    assert (s.robot.wheel_friction, s.robot.motor_gain, s.robot.motor_bias_nm) == (
+        1.0,
+        (1.0, 1.0),
+        (0.0, 0.0),
+    )
     assert dict(s.planner_params) == {}
     assert s.sensors == SensorSpec()
     assert s.run == RunSpec()

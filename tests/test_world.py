@@ -65,7 +65,7 @@ def test_sonar_ring_measures_a_wall_from_the_robot_centre(scenario_from):
     mujoco.mj_forward(model, data)
     first = model.sensor_adr[model.sensor(ROBOT_PREFIX + "sonar0_ray0").id]
     rays = data.sensordata[first : first + 48]
-    ring = SonarRing(16, 3, 3.0, 0.0, 0.0, np.random.default_rng(0))
+    ring = SonarRing(16, 3, 3.0, np.random.default_rng(0))
     ranges = ring.read(rays)
     # The wall's near face is at x = 2.95, 1.45 m ahead of the centre.
     assert ranges[0] == pytest.approx(1.45, abs=0.01)
@@ -76,7 +76,7 @@ def test_sonar_ring_measures_a_wall_from_the_robot_centre(scenario_from):
 
 
 def test_sonar_reports_no_echo_as_nan_never_as_a_distance():
-    ring = SonarRing(2, 3, 3.0, 0.0, 0.0, np.random.default_rng(0))
+    ring = SonarRing(2, 3, 3.0, np.random.default_rng(0))
     ranges = ring.read(np.array([-1.0, 3.0, 3.0, 2.0, -1.0, 1.5]))
     assert math.isnan(ranges[0])
     assert ranges[1] == pytest.approx(1.5 + 0.10)  # shortest ray wins, measured from the centre
@@ -84,10 +84,25 @@ def test_sonar_reports_no_echo_as_nan_never_as_a_distance():
 
 def test_sonar_noise_and_dropout_follow_the_seed():
     rays = np.full(48, 1.0)
-    a = SonarRing(16, 3, 3.0, 0.05, 0.3, np.random.default_rng(7)).read(rays)
-    b = SonarRing(16, 3, 3.0, 0.05, 0.3, np.random.default_rng(7)).read(rays)
+    a = SonarRing(16, 3, 3.0, np.random.default_rng(7), noise_std=0.05, dropout=0.3).read(rays)
+    b = SonarRing(16, 3, 3.0, np.random.default_rng(7), noise_std=0.05, dropout=0.3).read(rays)
     np.testing.assert_array_equal(a, b)
     assert np.isnan(a).any() and np.nanstd(a) > 0
+
+
+def test_sonar_crosstalk_gives_short_echoes_and_dead_sonars_stay_silent():
+    rays = np.tile([2.0, 2.0, 2.0, -1.0, -1.0, -1.0], 8)  # even sonars see a wall at 2 m, odd ones nothing
+    ring = SonarRing(16, 3, 3.0, np.random.default_rng(3), crosstalk=0.3, dead=(0, 5))
+    scans = np.array([ring.read(rays) for _ in range(400)])
+    assert np.isnan(scans[:, [0, 5]]).all()
+    live = np.delete(scans, [0, 5], axis=1)
+    true_range = np.where(np.arange(16) % 2 == 0, 2.1, np.nan)
+    spurious = ~np.isclose(live, np.delete(true_range, [0, 5]), equal_nan=True)
+    assert 0.25 < spurious.mean() < 0.35  # the crosstalk rate
+    even = np.delete(np.arange(16), [0, 5]) % 2 == 0
+    assert (live[:, even][spurious[:, even]] < 2.1).all()  # spurious echoes are shorter than the wall
+    odd_echoes = live[:, ~even][spurious[:, ~even]]
+    assert (odd_echoes >= 0.1).all() and (odd_echoes <= 3.1).all()  # within the transducer's range
 
 
 def test_sonar_layout_spans_the_beam():

@@ -17,6 +17,7 @@ messages' own `timestamp` fields, is the integer nanosecond of *simulated* time,
 | `/path` | `foxglove.SceneUpdate` | a new path segment about once per simulated second and at close |
 | `/events` | `foxglove.Log` | one per event, name `vplane_mj` |
 | `/metrics` | JSON (`vplane_mj.Metrics` JSON schema) | every tick |
+| `/robot/odometry` | `foxglove.PoseInFrame` | believed pose, every tick, if `sensors.pose = "odometry"` |
 
 Force arrows start at the robot's centre and point along the force (world frame);
 their length is `ARROW_M_PER_UNIT` (0.5 m) per unit of force, clipped to
@@ -109,6 +110,7 @@ METRICS_JSON_SCHEMA: dict[str, Any] = {
         "mode": {"type": "string", "description": "planner mode"},
         "command_v_mps": {"type": ["number", "null"], "description": "forward speed command"},
         "command_omega_radps": {"type": ["number", "null"], "description": "turn rate command"},
+        "odometry_error_m": {"type": ["number", "null"], "description": "believed to true position"},
     },
     "required": ["time_s", "mode"],
 }
@@ -263,6 +265,9 @@ class McapLog:
         self._path_ch = fc.SceneUpdateChannel("/path", context=ctx)
         self._events_ch = fc.LogChannel("/events", context=ctx)
         self._metrics_ch = foxglove.Channel("/metrics", schema=METRICS_JSON_SCHEMA, context=ctx)
+        self._odometry_ch = None
+        if scenario.sensors.pose == "odometry":
+            self._odometry_ch = fc.PoseInFrameChannel("/robot/odometry", context=ctx)
 
         self._writer.write_metadata(METADATA_NAME, self._run_metadata(metadata))
         self._log_world()
@@ -377,6 +382,7 @@ class McapLog:
         else:  # never log a non-finite pose: repeat the last good one
             x, y, yaw = self._last_pose
         self._log_pose(ns, stamp, x, y, yaw)
+        self._log_belief(ns, stamp, tick.believed_pose)
         self._log_scan(ns, stamp, tick.ranges)
         self._log_forces(ns, stamp, x, y, tick)
         self._log_virtual(ns, stamp, tick)
@@ -430,6 +436,14 @@ class McapLog:
             rotation=_yaw_quaternion(yaw),
         )
         self._tf_ch.log(fm.FrameTransforms(transforms=[transform]), log_time=ns)
+
+    def _log_belief(self, ns: int, stamp: fm.Timestamp, pose: tuple[float, float, float] | None) -> None:
+        if self._odometry_ch is None or pose is None or not all(map(math.isfinite, pose)):
+            return
+        message = fm.PoseInFrame(
+            timestamp=stamp, frame_id=WORLD_FRAME, pose=_pose(pose[0], pose[1], 0.0, pose[2])
+        )
+        self._odometry_ch.log(message, log_time=ns)
 
     def _log_scan(self, ns: int, stamp: fm.Timestamp, ranges: np.ndarray) -> None:
         values = np.asarray(ranges, dtype=float)
@@ -522,7 +536,11 @@ class McapLog:
             "mode": tick.decision.mode,
             "command_v_mps": _finite(tick.command[0]),
             "command_omega_radps": _finite(tick.command[1]),
+            "odometry_error_m": None,
         }
+        if tick.believed_pose is not None:
+            error = math.dist(tick.believed_pose[:2], (float(tick.position[0]), float(tick.position[1])))
+            record["odometry_error_m"] = _finite(error)
         self._metrics_ch.log(record, log_time=ns)
 
     # -- the path ----------------------------------------------------------------------------

@@ -29,7 +29,7 @@ from vplane_mj.errors import ScenarioError
 from vplane_mj.planning import registry
 from vplane_mj.planning.params import Param
 from vplane_mj.resources import data_dir
-from vplane_mj.robot import robot_radius_m
+from vplane_mj.robot import robot_geometry, robot_radius_m
 from vplane_mj.shapes import Box, Cup, Cylinder, HShape, Obstacle, Wall, scene_footprints
 
 FORMAT = 1
@@ -53,20 +53,38 @@ class WorldSpec:
 
 @dataclass(frozen=True)
 class RobotSpec:
-    """Start and goal (m); start_yaw in radians, resolved (default: facing the goal)."""
+    """Start and goal (m); start_yaw in radians, resolved (default: facing the goal).
+
+    Actuation faults: `wheel_friction` is the tyres' sliding friction coefficient (lower
+    lets the wheels slip); each motor (left, right) delivers `motor_gain` times the
+    commanded torque plus `motor_bias_nm` (N m).
+    """
 
     start: tuple[float, float]
     start_yaw: float
     goal: tuple[float, float]
     goal_tolerance: float = 0.15
+    wheel_friction: float = 1.0
+    motor_gain: tuple[float, float] = (1.0, 1.0)
+    motor_bias_nm: tuple[float, float] = (0.0, 0.0)
 
 
 @dataclass(frozen=True)
 class SensorSpec:
-    """The sonar ring: noise (m), dropout probability, layout, beam (deg), range (m), rate."""
+    """The sonar ring: noise (m), dropout probability, layout, beam (deg), range (m), rate.
+
+    Sensor faults: `crosstalk` is the probability that a reading is a spurious short
+    echo, `dead` the indices of sonars that never echo. `pose` is where the planner's
+    pose comes from: "truth" (the simulator, an ideal localiser) or "odometry" (dead
+    reckoning from the wheel encoders, whose travel has relative noise `odometry_noise`).
+    """
 
     noise_std: float = 0.0
     dropout: float = 0.0
+    crosstalk: float = 0.0
+    dead: tuple[int, ...] = ()
+    pose: str = "truth"
+    odometry_noise: float = 0.0
     count: int = 16
     rays_per_sonar: int = 3
     beam_deg: float = 20.0
@@ -128,9 +146,11 @@ _BOUNDS = (
 class Field:
     """One allowed key: its type, whether it is required, its bounds, where its value goes.
 
-    `kind` is "number" (int or float, finite), "int", "bool", "str" or "point" (an array
-    of exactly 2 numbers; the bounds apply to each). `attr` is the dataclass attribute it
-    fills (default: the key itself); `convert` maps the checked value (e.g. to radians).
+    `kind` is "number" (int or float, finite), "int", "bool", "str" (one of `choices` when
+    given), "point" or "pair" (an array of exactly 2 numbers, [x, y] or [left, right]; the
+    bounds apply to each) or "ints" (an array of distinct integers within the bounds).
+    `attr` is the dataclass attribute it fills (default: the key itself); `convert` maps
+    the checked value (e.g. to radians).
     """
 
     kind: str
@@ -141,6 +161,7 @@ class Field:
     le: float | None = None
     attr: str | None = None
     convert: Callable[[Any], Any] | None = None
+    choices: tuple[str, ...] = ()
 
     def check(self, value: object) -> str | None:
         """Why `value` is unacceptable for this key, or None when it is fine."""
@@ -204,20 +225,47 @@ def _check_bool(value: object, field: Field) -> str | None:
 
 
 def _check_str(value: object, field: Field) -> str | None:
-    """A string."""
-    return None if isinstance(value, str) else f"must be a string, got {_type_name(value)}"
+    """A string, one of the field's choices when it has any."""
+    if not isinstance(value, str):
+        return f"must be a string, got {_type_name(value)}"
+    if field.choices and value not in field.choices:
+        return f"must be one of {', '.join(map(repr, field.choices))}, got {value!r}"
+    return None
 
 
-def _check_point(value: object, field: Field) -> str | None:
-    """An array of exactly 2 finite numbers, each within bounds."""
+def _check_two_numbers(value: object, field: Field, shape: str) -> str | None:
+    """An array of exactly 2 finite numbers, each within bounds; `shape` shows their meaning."""
     if not isinstance(value, list):
-        return f"must be an array of 2 numbers [x, y], got {_type_name(value)}"
+        return f"must be an array of 2 numbers {shape}, got {_type_name(value)}"
     if len(value) != 2:
-        return f"must be an array of exactly 2 numbers, got {len(value)} items"
+        return f"must be an array of exactly 2 numbers {shape}, got {len(value)} items"
     for index, item in enumerate(value):
         reason = _check_number(item, field)
         if reason:
             return f"item {index}: {reason}"
+    return None
+
+
+def _check_point(value: object, field: Field) -> str | None:
+    """A point [x, y]."""
+    return _check_two_numbers(value, field, "[x, y]")
+
+
+def _check_pair(value: object, field: Field) -> str | None:
+    """A value per wheel, [left, right]."""
+    return _check_two_numbers(value, field, "[left, right]")
+
+
+def _check_ints(value: object, field: Field) -> str | None:
+    """An array of distinct integers, each within bounds."""
+    if not isinstance(value, list):
+        return f"must be an array of integers, got {_type_name(value)}"
+    for index, item in enumerate(value):
+        reason = _check_int(item, field)
+        if reason:
+            return f"item {index}: {reason}"
+        if item in value[:index]:
+            return f"item {index}: {item} is listed twice"
     return None
 
 
@@ -227,6 +275,8 @@ _CHECKS: dict[str, Callable[[object, Field], str | None]] = {
     "bool": _check_bool,
     "str": _check_str,
     "point": _check_point,
+    "pair": _check_pair,
+    "ints": _check_ints,
 }
 
 _CONVERSIONS: dict[str, Callable[[Any], Any]] = {
@@ -235,6 +285,8 @@ _CONVERSIONS: dict[str, Callable[[Any], Any]] = {
     "bool": bool,
     "str": str,
     "point": lambda xy: (float(xy[0]), float(xy[1])),
+    "pair": lambda pair: (float(pair[0]), float(pair[1])),
+    "ints": lambda items: tuple(sorted(int(item) for item in items)),
 }
 
 _SECTIONS = ("world", "robot", "planner", "sensors", "run")
@@ -255,11 +307,18 @@ _ROBOT_FIELDS = {
     "start_yaw_deg": Field("number", attr="start_yaw", convert=math.radians),
     "goal": Field("point", required=True),
     "goal_tolerance": Field("number", gt=0),
+    "wheel_friction": Field("number", ge=0.01, le=5),
+    "motor_gain": Field("pair", gt=0, le=2),
+    "motor_bias_nm": Field("pair"),
 }
 
 _SENSOR_FIELDS = {
     "noise_std": Field("number", ge=0),
     "dropout": Field("number", ge=0, lt=1),
+    "crosstalk": Field("number", ge=0, lt=1),
+    "dead": Field("ints", ge=0),
+    "pose": Field("str", choices=("truth", "odometry")),
+    "odometry_noise": Field("number", ge=0, le=1),
     "count": Field("int", ge=4, le=128),
     "rays_per_sonar": Field("int", ge=1, le=15),
     "beam_deg": Field("number", gt=0, le=60),
@@ -467,9 +526,14 @@ def _facing(start: tuple[float, float], goal: tuple[float, float]) -> float:
 
 
 def _read_robot(doc: Mapping[str, Any]) -> RobotSpec:
-    """The `[robot]` table, start_yaw resolved."""
+    """The `[robot]` table, start_yaw resolved; a motor bias within the torque limit."""
     values = _read_fields(_sub_table(doc, "robot", required=True), "robot", _ROBOT_FIELDS)
     values.setdefault("start_yaw", _facing(values["start"], values["goal"]))
+    limit = robot_geometry()["torque_limit_nm"]
+    for index, bias in enumerate(values.get("motor_bias_nm", ())):
+        if abs(bias) > limit:
+            reason = f"item {index}: must be within the motor's torque limit +-{limit:g} N m, got {bias!r}"
+            raise _Invalid("robot.motor_bias_nm", reason)
     return RobotSpec(**values)
 
 
@@ -505,8 +569,13 @@ def _read_planner(doc: Mapping[str, Any]) -> tuple[str, Mapping[str, float]]:
 
 
 def _read_sensors(doc: Mapping[str, Any]) -> SensorSpec:
-    """The optional `[sensors]` table."""
-    return SensorSpec(**_read_fields(_sub_table(doc, "sensors"), "sensors", _SENSOR_FIELDS))
+    """The optional `[sensors]` table; dead sonars must exist in the ring."""
+    sensors = SensorSpec(**_read_fields(_sub_table(doc, "sensors"), "sensors", _SENSOR_FIELDS))
+    for index, sonar in enumerate(doc["sensors"].get("dead", []) if sensors.dead else []):
+        if sonar >= sensors.count:
+            ring = f"a ring of count = {sensors.count} (0 to {sensors.count - 1})"
+            raise _Invalid("sensors.dead", f"item {index}: no sonar {sonar} in {ring}")
+    return sensors
 
 
 def _read_run(doc: Mapping[str, Any]) -> RunSpec:

@@ -6,6 +6,7 @@ geometry is used only to score the run (clearance) and to draw it, never to plan
 
 from __future__ import annotations
 
+import hashlib
 import math
 import time
 from dataclasses import dataclass, field
@@ -16,6 +17,7 @@ import numpy as np
 
 from vplane_mj import __version__, shapes
 from vplane_mj.control import ControllerGains, WheelPI, heading_command, wheel_targets
+from vplane_mj.odometry import WheelOdometry
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.reference import shortest_path_length
@@ -30,6 +32,20 @@ TIMING_KEYS = ("wall_time_s", "planner_cpu_ms_mean", "planner_cpu_ms_max")
 """Summary keys measured on the wall clock: the only ones that differ between identical runs."""
 CLEARANCE_BATCH = 200
 """Positions collected before one vectorised clearance query (2 s at the 100 Hz motor rate)."""
+ODOMETRY_STREAM = 1
+"""Second word of the odometry noise's seed, (seed, 1): a stream apart from the sonar's."""
+BELIEF_PATIENCE_S = 3.0
+"""Simulated time the odometry may hold the robot at the goal while it truly is not, before
+the run ends as `stuck` (the planner then drives to where it believes the goal is)."""
+FATAL_WARNINGS = {
+    mujoco.mjtWarning.mjWARN_BADQACC: "bad acceleration (the simulation became unstable)",
+    mujoco.mjtWarning.mjWARN_BADQVEL: "bad velocity (the simulation became unstable)",
+    mujoco.mjtWarning.mjWARN_BADQPOS: "bad position (the simulation became unstable)",
+    mujoco.mjtWarning.mjWARN_BADCTRL: "bad control (a non-finite wheel torque)",
+    mujoco.mjtWarning.mjWARN_CONTACTFULL: "contact buffer full (too many contacts)",
+    mujoco.mjtWarning.mjWARN_CNSTRFULL: "constraint buffer full (too many constraints)",
+}
+"""MuJoCo warnings that end a run as outcome `error`: after them MuJoCo resets or drops state."""
 
 
 @dataclass(frozen=True)
@@ -43,6 +59,8 @@ class Tick:
     ranges: np.ndarray
     decision: Decision
     command: tuple[float, float]
+    believed_pose: tuple[float, float, float] | None = None
+    """The pose the planner used, when it comes from odometry rather than the simulator."""
 
 
 class Observer(Protocol):
@@ -166,7 +184,9 @@ class _Drive:
         self.xpos, self.xmat = data.xpos[base], data.xmat[base]
         free_joint = int(np.flatnonzero(model.jnt_type == mujoco.mjtJoint.mjJNT_FREE)[0])
         self.root_dof = model.jnt_dofadr[free_joint]
-        self.wheel_dofs = [model.jnt_dofadr[model.joint(ROBOT_PREFIX + j).id] for j in WHEEL_JOINTS]
+        wheel_joints = [model.joint(ROBOT_PREFIX + j).id for j in WHEEL_JOINTS]
+        self.wheel_dofs = [model.jnt_dofadr[j] for j in wheel_joints]
+        self.wheel_qpos = [model.jnt_qposadr[j] for j in wheel_joints]
         self.motors = [model.actuator(ROBOT_PREFIX + a).id for a in WHEEL_MOTORS]
         limit = self.geometry["torque_limit_nm"]
         self.wheels = [WheelPI(self.gains.wheel_kp, self.gains.wheel_ki, limit) for _ in self.motors]
@@ -180,9 +200,13 @@ class _Drive:
         qvel = self.data.qvel
         return math.hypot(qvel[self.root_dof], qvel[self.root_dof + 1])
 
-    def command(self, force: np.ndarray) -> tuple[float, float]:
-        """(v, omega) that heading control derives from a planner's force."""
-        return heading_command(float(force[0]), float(force[1]), self.yaw(), self.gains)
+    def wheel_angles(self) -> tuple[float, float]:
+        """The wheels' encoder angles (rad), left and right."""
+        return float(self.data.qpos[self.wheel_qpos[0]]), float(self.data.qpos[self.wheel_qpos[1]])
+
+    def command(self, force: np.ndarray, yaw: float) -> tuple[float, float]:
+        """(v, omega) that heading control derives from a planner's force at heading `yaw` (rad)."""
+        return heading_command(float(force[0]), float(force[1]), yaw, self.gains)
 
     def run_tick(self, command: tuple[float, float], after_step) -> np.ndarray:
         """Drive one control tick; return base_link's xy after every motor period (chunks, 2)."""
@@ -220,10 +244,13 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         sensors.count,
         sensors.rays_per_sonar,
         sensors.range_max,
-        sensors.noise_std,
-        sensors.dropout,
         np.random.default_rng(scenario.run.seed),
+        noise_std=sensors.noise_std,
+        dropout=sensors.dropout,
+        crosstalk=sensors.crosstalk,
+        dead=sensors.dead,
     )
+    localiser = _Localiser(drive, scenario)
     first_ray = model.sensor_adr[model.sensor(ROBOT_PREFIX + "sonar0_ray0").id]
     rays = data.sensordata[first_ray : first_ray + sensors.count * sensors.rays_per_sonar]
     radius = drive.geometry["radius_m"]
@@ -269,8 +296,11 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
     position = drive.xpos[:2].copy()
     clearance.add(position[None, :])
     while True:
-        if not np.all(np.isfinite(data.qpos)):
-            outcome, message = "error", "the simulation diverged (non-finite state)"
+        message = _fatal_warning(data)
+        if message is None and not np.all(np.isfinite(data.qpos)):
+            message = f"the simulation diverged (non-finite state) at t = {data.time:.3f} s"
+        if message is not None:
+            outcome = "error"
             note(message)
             break
         if math.hypot(goal[0] - position[0], goal[1] - position[1]) <= tolerance:
@@ -286,22 +316,37 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
                 next_sonar += sonar_period
         yaw = drive.yaw()
         yaws.append(yaw)
+        believed_xy, believed_yaw = localiser.pose(position, yaw)
+        if localiser.believes_arrived(data.time, believed_xy, goal, tolerance):
+            outcome = "stuck"
+            message = (
+                f"odometry has put the robot at the goal for {BELIEF_PATIENCE_S:g} s, but it is "
+                f"{math.dist(position, goal):.3f} m away: the planner has nowhere left to go"
+            )
+            note(message)
+            break
         cpu_start = time.perf_counter()
         decision = planner.step(
-            Observation(data.time, position, yaw, goal, tolerance, layout.bearings, ranges, beam)
+            Observation(data.time, believed_xy, believed_yaw, goal, tolerance, layout.bearings, ranges, beam)
         )
         planner_cpu.append(time.perf_counter() - cpu_start)
+        if not np.all(np.isfinite(decision.force)):
+            outcome = "error"
+            message = f"planner {scenario.planner!r} gave a non-finite force at t = {data.time:.3f} s"
+            note(message)
+            break
         local_minima += decision.local_minimum
         escapes += decision.escape_completed
         for text in decision.events:
             note(text)
         _collect_virtual(decision, objectives, planes)
-        command = drive.command(decision.force)
+        command = drive.command(decision.force, believed_yaw)
         times.append(data.time)
         positions.append(position)
         modes.append(decision.mode)
         if observers:
-            tick = Tick(data.time, position, yaw, drive.planar_speed(), ranges, decision, command)
+            belief = localiser.belief(believed_xy, believed_yaw)
+            tick = Tick(data.time, position, yaw, drive.planar_speed(), ranges, decision, command, belief)
             for observer in observers:
                 observer.on_tick(tick)
         if decision.gave_up:
@@ -347,6 +392,8 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         "robot_radius_m": radius,
         **_path_quality(scenario, radius, reached, path_length),
         "final_distance_to_goal_m": math.hypot(goal[0] - position[0], goal[1] - position[1]),
+        "odometry_error_m": localiser.error(position),
+        "trajectory_sha256": _trajectory_digest(positions, position, drive.yaw()),
         "message": message,
         "planner_params": planner.params,
         "version": __version__,
@@ -362,6 +409,70 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         objectives=objectives,
         planes=planes,
     )
+
+
+class _Localiser:
+    """The pose the planner sees: the simulator's (`sensors.pose = "truth"`), or the belief of
+    wheel odometry (`"odometry"`), updated at each control tick from the wheel encoders."""
+
+    def __init__(self, drive: _Drive, scenario: Scenario):
+        self._drive = drive
+        self._arrived_at: float | None = None
+        self.odometry = None
+        if scenario.sensors.pose == "odometry":
+            self.odometry = WheelOdometry(
+                (*scenario.robot.start, scenario.robot.start_yaw),
+                drive.wheel_angles(),
+                drive.geometry["wheel_radius_m"],
+                drive.geometry["track_m"],
+                scenario.sensors.odometry_noise,
+                np.random.default_rng((scenario.run.seed, ODOMETRY_STREAM)),
+            )
+
+    def pose(self, position: np.ndarray, yaw: float) -> tuple[np.ndarray, float]:
+        """The planner's position (m) and yaw (rad), given the true ones."""
+        if self.odometry is None:
+            return position, yaw
+        x, y, believed_yaw = self.odometry.update(self._drive.wheel_angles())
+        return np.array([x, y]), believed_yaw
+
+    def believes_arrived(self, time_s: float, xy: np.ndarray, goal: np.ndarray, tolerance: float) -> bool:
+        """True once the believed position has stayed within the goal tolerance for
+        BELIEF_PATIENCE_S (s); never with the true pose (the run has ended on arrival)."""
+        if self.odometry is None or math.dist(xy, goal) > tolerance:
+            self._arrived_at = None
+            return False
+        if self._arrived_at is None:
+            self._arrived_at = time_s
+        return time_s - self._arrived_at >= BELIEF_PATIENCE_S - 1e-9
+
+    def belief(self, xy: np.ndarray, yaw: float) -> tuple[float, float, float] | None:
+        """The believed pose for observers, None when the planner uses the true pose."""
+        return None if self.odometry is None else (float(xy[0]), float(xy[1]), yaw)
+
+    def error(self, position: np.ndarray) -> float | None:
+        """Distance (m) between the believed and the true position, None without odometry."""
+        if self.odometry is None:
+            return None
+        return math.hypot(self.odometry.x - position[0], self.odometry.y - position[1])
+
+
+def _fatal_warning(data: mujoco.MjData) -> str | None:
+    """A message for the first fatal MuJoCo warning raised so far, else None."""
+    for warning, meaning in FATAL_WARNINGS.items():
+        if data.warning[warning].number:
+            return f"MuJoCo warning at t = {data.time:.3f} s: {meaning}"
+    return None
+
+
+def _trajectory_digest(positions: list[np.ndarray], final: np.ndarray, final_yaw: float) -> str:
+    """SHA-256 of the positions at every control tick and the final pose, bit for bit:
+    equal digests mean identical trajectories (the determinism check of bench sweeps)."""
+    digest = hashlib.sha256()
+    for position in positions:
+        digest.update(np.asarray(position, dtype=np.float64).tobytes())
+    digest.update(np.array([final[0], final[1], final_yaw], dtype=np.float64).tobytes())
+    return digest.hexdigest()
 
 
 def _path_quality(scenario: Scenario, radius: float, reached: bool, path_length: float) -> dict:

@@ -16,8 +16,15 @@ from dm_control import mjcf
 
 from vplane_mj import shapes
 from vplane_mj.resources import model_path
-from vplane_mj.robot import BASE_BODY, SONAR_MOUNT_HEIGHT_M, SONAR_MOUNT_RADIUS_M
-from vplane_mj.scenario import Scenario, SensorSpec
+from vplane_mj.robot import (
+    BASE_BODY,
+    SONAR_MOUNT_HEIGHT_M,
+    SONAR_MOUNT_RADIUS_M,
+    WHEEL_JOINTS,
+    WHEEL_MOTORS,
+    robot_geometry,
+)
+from vplane_mj.scenario import RobotSpec, Scenario, SensorSpec
 
 OBSTACLE_HEIGHT_M = 0.5
 ROBOT_PREFIX = "robot/"
@@ -72,6 +79,7 @@ def build_mjcf(scenario: Scenario) -> mjcf.RootElement:
     robot = mjcf.from_path(str(model_path("robot.xml")))
     robot.model = ROBOT_PREFIX.rstrip("/")
     _add_sonar_ring(robot, scenario.sensors)
+    _apply_actuation_faults(robot, scenario.robot)
     frame = arena.attach(robot)
     frame.add("freejoint")
     x, y = scenario.robot.start
@@ -174,3 +182,32 @@ def _add_sonar_ring(robot: mjcf.RootElement, spec: SensorSpec) -> None:
                 cutoff=spec.range_max,
                 interval=(1.0 / spec.rate_hz, 0.0),
             )
+
+
+def _apply_actuation_faults(robot: mjcf.RootElement, spec: RobotSpec) -> None:
+    """Wheel slip and motor faults as model properties, so an exported world keeps them.
+
+    The wheels' sliding friction becomes `wheel_friction` (the wheel geoms take priority
+    over the floor in the contact, so theirs is the friction used). A motor with gain g
+    and bias b becomes an affine actuator of gear g: torque = g * clamp(ctrl + b / g),
+    i.e. g times the commanded torque plus b, saturating at g times the torque limit.
+    """
+    wheel = robot.find("default", "wheel").geom
+    wheel.friction = (spec.wheel_friction, *wheel.friction[1:])
+    limit = robot_geometry()["torque_limit_nm"]
+    for motor_name, joint, gain, bias in zip(
+        WHEEL_MOTORS, WHEEL_JOINTS, spec.motor_gain, spec.motor_bias_nm, strict=True
+    ):
+        if gain == 1.0 and bias == 0.0:
+            continue
+        robot.find("actuator", motor_name).remove()
+        robot.actuator.add(
+            "general",
+            name=motor_name,
+            joint=joint,
+            gear=(gain,),
+            ctrlrange=(-limit, limit),
+            forcerange=(-limit, limit),
+            biastype="affine",
+            biasprm=(bias / gain, 0.0, 0.0),
+        )
