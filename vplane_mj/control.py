@@ -35,9 +35,12 @@ def wrap_angle(angle: float) -> float:
 
 
 def heading_command(fx: float, fy: float, yaw: float, gains: ControllerGains) -> tuple[float, float]:
-    """(v, omega) that turns the robot toward the force and drives along it when aligned."""
+    """(v, omega) that turns the robot toward the force and drives along it when aligned.
+
+    A force too weak to have a direction, or not finite, stops the robot.
+    """
     magnitude = math.hypot(fx, fy)
-    if magnitude < 1e-9:
+    if magnitude < 1e-9 or not math.isfinite(magnitude):
         return 0.0, 0.0
     error = wrap_angle(math.atan2(fy, fx) - yaw)
     speed = min(gains.max_speed, gains.speed_gain * magnitude * max(0.0, math.cos(error)))

@@ -62,12 +62,19 @@ def make_plane(
 ) -> VirtualPlane:
     """The plane e1-e2 whose normal points away from the trap's obstacle points (their mean).
 
+    Its normal is never zero: for coincident e1 and e2 it points from the trap's points
+    toward the robot.
+
     Sonar sees a trap's mouth only at its sampled points, so the extreme points lie a
     little inside the true ends: the plane is lengthened by `extend` (m) at both ends and
     moved out along its normal to the trap's outermost point, so that it closes the mouth.
     """
     tangent = unit(e2 - e1)
     normal = np.array([-tangent[1], tangent[0]])
+    if not tangent.any():  # e1 = e2: face the robot, away from the trap's points
+        normal = unit(robot - np.mean(trap_points, axis=0))
+        normal = normal if normal.any() else np.array([1.0, 0.0])
+        tangent = np.array([normal[1], -normal[0]])
     if (np.mean(trap_points, axis=0) - e1) @ normal > 0:
         normal = -normal
     outermost = max(0.0, float(np.max((np.asarray(trap_points) - e1) @ normal)))
