@@ -1,0 +1,82 @@
+"""Same scenario, planner and seed, every fault on: the same summary and trajectory, bit for bit,
+in another process and on the Dask engine."""
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from vplane_mj.cli import main
+from vplane_mj.scenario import load_scenario
+from vplane_mj.sim import TIMING_KEYS, run_scenario
+
+EVERY_FAULT = [
+    "sensors.noise_std=0.02",
+    "sensors.dropout=0.1",
+    "sensors.crosstalk=0.05",
+    "sensors.dead=[2, 9]",
+    "robot.wheel_friction=0.5",
+    "robot.motor_gain=[0.9, 0.7]",
+    "robot.motor_bias_nm=[0.01, -0.01]",
+    'sensors.pose="odometry"',
+    "sensors.odometry_noise=0.01",
+]
+SETS = [arg for override in EVERY_FAULT for arg in ("--set", override)]
+
+
+def _without_timing(summary: dict) -> dict:
+    return {key: value for key, value in summary.items() if key not in TIMING_KEYS}
+
+
+def _run_in_new_process(out_dir, hash_seed: str) -> dict:
+    command = [sys.executable, "-m", "vplane_mj", "run", "paper_h_escape", "--seed", "3", *SETS]
+    command += ["--no-log", "--no-render", "--out", str(out_dir)]
+    env = {**os.environ, "PYTHONHASHSEED": hash_seed}
+    finished = subprocess.run(command, capture_output=True, text=True, env=env, timeout=300)
+    assert finished.returncode in (0, 1), finished.stderr
+    return json.loads((out_dir / "paper_h_escape-vplane-3.json").read_text())
+
+
+def test_two_processes_and_this_one_give_identical_runs(tmp_path):
+    first, second = tmp_path / "a", tmp_path / "b"
+    first.mkdir()
+    second.mkdir()
+    a, b = _run_in_new_process(first, "1"), _run_in_new_process(second, "2")
+    here = run_scenario(load_scenario("paper_h_escape", [*EVERY_FAULT, "run.seed=3"])).summary
+    here = json.loads(json.dumps(here))  # the JSON form the files hold
+    assert _without_timing(a) == _without_timing(b) == _without_timing(here)
+    assert a["odometry_error_m"] > 0  # the faults were on
+
+
+def test_another_seed_gives_another_trajectory():
+    def digest(seed):
+        scenario = load_scenario("single_box", [*EVERY_FAULT, f"run.seed={seed}", "run.time_limit_s=5"])
+        return run_scenario(scenario).summary["trajectory_sha256"]
+
+    assert digest(0) == digest(0) != digest(1)
+
+
+def test_dask_and_the_local_pool_give_identical_rows_with_every_fault_on(tmp_path, capsys):
+    distributed = pytest.importorskip("distributed")
+    local, remote = tmp_path / "local", tmp_path / "dask"
+    local.mkdir()
+    remote.mkdir()
+    args = ["bench", "paper_c_escape", "single_box", "--planners", "vplane,bug2", "--seeds", "0-1", *SETS]
+    assert main([*args, "--jobs", "2", "--out", str(local)]) == 0
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster:
+        assert main([*args, "--scheduler", cluster.scheduler_address, "--out", str(remote)]) == 0
+    capsys.readouterr()
+
+    def rows(directory):
+        document = json.loads((directory / "bench.json").read_text())
+        return sorted(
+            (_without_timing(row) for row in document["rows"]),
+            key=lambda row: (row["scenario"], row["planner"], row["seed"]),
+        )
+
+    local_rows, remote_rows = rows(local), rows(remote)
+    assert len(local_rows) == 8
+    assert local_rows == remote_rows
+    assert len({row["trajectory_sha256"] for row in local_rows}) == 8
