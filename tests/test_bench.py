@@ -1,10 +1,18 @@
-"""`vplane-mj bench`: the sweep, its outputs, resuming, and invalid input."""
+"""`vplane-mj bench`: the sweep, its outputs, resuming, interruptions, and invalid input."""
 
+import contextlib
+import csv
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
 
 import pytest
 
-from vplane_mj.bench import family_of, parse_seeds
+from vplane_mj.bench import JOURNAL, family_of, parse_seeds, read_journal
 from vplane_mj.cli import main
 from vplane_mj.sim import TIMING_KEYS
 
@@ -40,6 +48,7 @@ def test_a_sweep_writes_rows_table_and_plot_and_resumes(tmp_path, capsys):
     (tmp_path / "bench.jsonl").write_text("\n".join(lines[:5]) + "\n" + lines[5][:40])
     assert main([*ARGS, "--out", str(tmp_path)]) == 0
     assert "5 already done, 3 to run" in capsys.readouterr().err
+    assert len(read_journal(tmp_path / "bench.jsonl")) == 8  # the torn line did not swallow a new row
     resumed = json.loads((tmp_path / "bench.json").read_text())["rows"]
 
     def strip(table):
@@ -94,3 +103,162 @@ def test_family_of_a_generated_scenario():
     assert family_of("traps_1_003") == "traps"
     assert family_of("clutter_12_000") == "clutter"
     assert family_of("paper_c_avoid") == "paper_c_avoid"
+
+
+# A sweep in its own process, interrupted as a user or a service manager would. A finer physics
+# step makes each run (8 simulated seconds) last about a second, so that a signal lands mid-sweep
+# and a sweep that waited for its remaining runs (three rounds of two) rather than stop would show.
+SWEEP = ["open_field", "single_box", "--planners", "apf", "--seeds", "0-3", "--jobs", "2"]
+SWEEP_KEYS = {(s, "apf", seed) for s in ("open_field", "single_box") for seed in range(4)}
+SLOW_RUNS = ["--set", "run.physics_dt_s=0.0005", "--set", "run.time_limit_s=8"]
+
+
+def bench_command(out_dir):
+    return [sys.executable, "-m", "vplane_mj", "bench", *SWEEP, *SLOW_RUNS, "--out", str(out_dir)]
+
+
+def start_bench(out_dir):
+    """The sweep as the leader of its own process group, like a command started from a shell."""
+    return subprocess.Popen(
+        bench_command(out_dir),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+
+
+def wait_for_a_finished_run(out_dir, process, seconds=60.0):
+    """Wait until the journal holds a complete line: the sweep is under way."""
+    journal = out_dir / JOURNAL
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline and process.poll() is None:
+        if journal.exists() and b"\n" in journal.read_bytes():
+            return
+        time.sleep(0.02)
+    raise AssertionError(f"the sweep finished no run (status {process.poll()})")
+
+
+def proc_stat(pid):
+    """(parent pid, state letter) of a live process from /proc, or None once it is gone."""
+    try:
+        text = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    state, ppid = text[text.rindex(")") + 2 :].split()[:2]
+    return int(ppid), state
+
+
+def descendants(pid):
+    """The pids of every process below `pid`."""
+    parents = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit() and (stat := proc_stat(entry.name)):
+            parents[int(entry.name)] = stat[0]
+    found, frontier = set(), {pid}
+    while frontier:
+        frontier = {child for child, parent in parents.items() if parent in frontier} - found
+        found |= frontier
+    return found
+
+
+def wait_until_gone(pids, seconds):
+    """The pids still running (zombies count as gone) after waiting up to `seconds`."""
+    deadline = time.monotonic() + seconds
+    while True:
+        alive = {pid for pid in pids if (stat := proc_stat(pid)) and stat[1] != "Z"}
+        if not alive or time.monotonic() > deadline:
+            return alive
+        time.sleep(0.05)
+
+
+def end_session(process):
+    """Kill whatever is left of the sweep's process group (a failed test leaves nothing behind)."""
+    with contextlib.suppress(ProcessLookupError):
+        os.killpg(process.pid, signal.SIGKILL)
+    if process.returncode is None:
+        process.communicate(timeout=30)
+
+
+def assert_only_complete_files(out_dir):
+    """The journal's lines are whole rows; bench.csv, .json and .png are complete or absent."""
+    names = {path.name for path in out_dir.iterdir()}
+    assert names <= {JOURNAL, "bench.csv", "bench.json", "bench.png"}, names
+    text = (out_dir / JOURNAL).read_text(encoding="utf-8")
+    assert text.endswith("\n")
+    rows = [json.loads(line) for line in text.splitlines()]
+    keys = [(row["scenario"], row["planner"], row["seed"]) for row in rows]
+    assert len(keys) == len(set(keys)) and set(keys) <= SWEEP_KEYS
+    if "bench.json" in names:
+        assert len(json.loads((out_dir / "bench.json").read_text())["rows"]) == len(SWEEP_KEYS)
+    if "bench.csv" in names:
+        with open(out_dir / "bench.csv", newline="") as stream:
+            table = list(csv.reader(stream))
+        assert "scenario" in table[0] and all(len(row) == len(table[0]) for row in table[1:])
+    if "bench.png" in names:
+        data = (out_dir / "bench.png").read_bytes()
+        assert data.startswith(b"\x89PNG\r\n\x1a\n") and data.endswith(b"IEND\xaeB`\x82")
+    return rows
+
+
+def assert_the_rerun_completes_the_sweep(out_dir, done):
+    """The same command again runs only what the journal lacks and writes one row per run."""
+    finished = subprocess.run(bench_command(out_dir), capture_output=True, text=True, timeout=120)
+    assert finished.returncode == 0, finished.stderr
+    assert f"{len(SWEEP_KEYS)} runs: {done} already done, {len(SWEEP_KEYS) - done} to run" in finished.stderr
+    assert len(assert_only_complete_files(out_dir)) == len(SWEEP_KEYS)
+    assert {"bench.csv", "bench.json", "bench.png"} <= {path.name for path in out_dir.iterdir()}
+    with open(out_dir / "bench.csv", newline="") as stream:
+        rows = list(csv.DictReader(stream))
+    assert len(rows) == len(SWEEP_KEYS)
+    assert {(row["scenario"], row["planner"], int(row["seed"])) for row in rows} == SWEEP_KEYS
+
+
+@pytest.mark.parametrize(
+    "signum, whole_group",
+    [(signal.SIGINT, False), (signal.SIGINT, True), (signal.SIGTERM, False), (signal.SIGTERM, True)],
+    ids=["SIGINT-process", "SIGINT-group", "SIGTERM-process", "SIGTERM-group"],
+)
+def test_an_interrupted_sweep_keeps_its_finished_runs_stops_its_workers_and_resumes(
+    tmp_path, signum, whole_group
+):
+    process = start_bench(tmp_path)
+    try:
+        wait_for_a_finished_run(tmp_path, process)
+        workers = descendants(process.pid)
+        assert workers, "the sweep has no worker processes"
+        # Ctrl-C in a terminal signals the whole foreground process group, workers included.
+        signalled = time.monotonic()
+        (os.killpg if whole_group else os.kill)(process.pid, signum)
+        _, err = process.communicate(timeout=30)
+        assert time.monotonic() - signalled < 2.0, "the sweep waited for its remaining runs"
+        assert process.returncode == 128 + signum, err
+        assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+        messages = [line for line in err.splitlines() if "interrupted" in line]
+        assert messages == [
+            f"interrupted by {signal.Signals(signum).name}: finished runs are kept in {tmp_path / JOURNAL}; "
+            "run the same command again to complete the sweep"
+        ]
+        assert not wait_until_gone(workers, seconds=2.0), "worker processes outlived the sweep"
+    finally:
+        end_session(process)
+    done = len(assert_only_complete_files(tmp_path))
+    assert 1 <= done < len(SWEEP_KEYS)
+    assert_the_rerun_completes_the_sweep(tmp_path, done)
+
+
+def test_a_killed_sweep_leaves_a_journal_the_rerun_resumes_from(tmp_path):
+    process = start_bench(tmp_path)
+    try:
+        wait_for_a_finished_run(tmp_path, process)
+        workers = descendants(process.pid)
+        process.kill()
+        process.communicate(timeout=30)
+        # Orphaned workers notice that the sweep is gone and exit rather than run on.
+        assert not wait_until_gone(workers, seconds=5.0), "worker processes outlived the killed sweep"
+    finally:
+        end_session(process)
+    done = len(read_journal(tmp_path / JOURNAL))
+    assert 1 <= done < len(SWEEP_KEYS)
+    assert {path.name for path in tmp_path.iterdir()} == {JOURNAL}
+    assert_the_rerun_completes_the_sweep(tmp_path, done)

@@ -4,17 +4,22 @@ Every finished run is appended at once to `bench.jsonl` in the output directory 
 summary per line), so an interrupted sweep loses nothing finished: the same command run
 again skips the runs whose rows exist (same scenario text, planner and seed) and does the
 rest. At the end `bench.csv`, `bench.json` (rows and table) and `bench.png` are written
-(each atomically) and the table is printed.
+(each atomically) and the table is printed. An interruption (SIGINT, SIGTERM) stops the
+workers at once: the runs they had under way are done again by the next invocation.
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import hashlib
 import io
 import json
+import os
+import signal
 import statistics
 import sys
+import threading
 import time
 from collections.abc import Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -151,22 +156,67 @@ def run_sweep(jobs: list[Job], out_dir: Path, workers: int, scheduler: str | Non
         f"{len(jobs)} runs: {len(jobs) - len(pending)} already done, {len(pending)} to run {engine}",
         file=sys.stderr,
     )
-    if pending:
-        progress = Progress(len(jobs), len(jobs) - len(pending))
-        with open(journal_path, "a", encoding="utf-8") as journal:
-            for row in rows:
-                journal.write(json.dumps(row, allow_nan=False) + "\n")
-                journal.flush()
-                finished[row["key"]] = row
-                progress.advance()
+    # Closed explicitly, so that the workers stop however the loop ends (an interruption, a failed run).
+    with contextlib.closing(rows):
+        if pending:
+            progress = Progress(len(jobs), len(jobs) - len(pending))
+            with open(journal_path, "a", encoding="utf-8") as journal:
+                if not _ends_with_a_newline(journal_path):
+                    journal.write("\n")  # a killed sweep's torn line stays a line apart from the new rows
+                for row in rows:
+                    journal.write(json.dumps(row, allow_nan=False) + "\n")
+                    journal.flush()
+                    finished[row["key"]] = row
+                    progress.advance()
     return [finished[job.key] for job in jobs]
 
 
+def _ends_with_a_newline(path: Path) -> bool:
+    """Whether the file is empty or its last line is complete."""
+    with open(path, "rb") as stream:
+        if stream.seek(0, os.SEEK_END) == 0:
+            return True
+        stream.seek(-1, os.SEEK_END)
+        return stream.read(1) == b"\n"
+
+
 def _local_rows(jobs: list[Job], workers: int) -> Iterator[dict]:
-    """Rows as the local process pool finishes them."""
-    with ProcessPoolExecutor(workers) as pool:
+    """Rows as the local process pool finishes them; on any early exit the workers are stopped."""
+    pool = ProcessPoolExecutor(workers, initializer=_start_worker, initargs=(os.getpid(),))
+    try:
         for future in as_completed([pool.submit(run_job, job) for job in jobs]):
             yield future.result()
+    except BaseException:  # an interruption, the generator closed early, a failed run
+        _stop_workers(pool)
+        raise
+    pool.shutdown()
+
+
+def _start_worker(sweep_pid: int) -> None:
+    """Set up a worker process of the local pool.
+
+    Ctrl-C in a terminal reaches the whole process group: the workers ignore SIGINT and
+    leave it to the sweep, which stops them. A worker whose sweep was killed outright
+    exits instead of running on.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    threading.Thread(target=_exit_when_orphaned, args=(sweep_pid,), daemon=True).start()
+
+
+def _exit_when_orphaned(sweep_pid: int) -> None:
+    """In a worker: exit as soon as its parent is no longer the sweep that started it."""
+    while os.getppid() == sweep_pid:
+        time.sleep(0.5)
+    os._exit(1)
+
+
+def _stop_workers(pool: ProcessPoolExecutor) -> None:
+    """Cancel the jobs not started and end the running ones now rather than wait for them."""
+    # The executor has no public way to end running workers before Python 3.14.
+    for process in list((pool._processes or {}).values()):
+        process.terminate()
+    pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _dask_rows(jobs: list[Job], scheduler: str) -> Iterator[dict]:

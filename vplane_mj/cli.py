@@ -201,9 +201,10 @@ def _bench(args: argparse.Namespace) -> int:
         try:
             return bench(args.scenarios, planners, seeds, out_dir, args.jobs, args.scheduler, tuple(args.set))
         except Interrupted as exc:
+            end_of_progress_bar = "\n" if sys.stderr.isatty() else ""
             print(
-                f"\ninterrupted by {exc}: finished runs are kept in {out_dir / 'bench.jsonl'}; "
-                "run the same command again to complete the sweep",
+                f"{end_of_progress_bar}interrupted by {exc}: finished runs are kept in "
+                f"{out_dir / 'bench.jsonl'}; run the same command again to complete the sweep",
                 file=sys.stderr,
             )
             return exc.exit_status
