@@ -236,3 +236,21 @@ def test_killed_run_leaves_a_recoverable_partial_log(tmp_path):
     log = read_log(partial)
     assert not log.complete and len(log.times_ns) > 20
     assert np.all(np.diff(log.times_ns) > 0)
+
+
+@pytest.mark.parametrize("command", [["run", "open_field", "--no-log", "--no-render"], ["list"]])
+def test_a_reader_that_goes_away_does_not_turn_into_a_traceback(tmp_path, command):
+    """`vplane-mj ... | head -1`: the command finishes, writes its files, keeps its exit status."""
+    out = ["--out", str(tmp_path)] if command[0] == "run" else []
+    process = subprocess.Popen(
+        [sys.executable, "-m", "vplane_mj", *command, *out],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    process.stdout.close()  # the reader is gone before anything is printed
+    stderr = process.stderr.read()
+    assert process.wait(timeout=120) == 0
+    assert "Traceback" not in stderr and "BrokenPipe" not in stderr, stderr
+    if command[0] == "run":
+        assert json.loads((tmp_path / "open_field-vplane-0.json").read_text())["reached"]
