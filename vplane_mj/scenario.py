@@ -37,6 +37,16 @@ FORMAT = 1
 
 NAME_PATTERN = re.compile(r"[a-z0-9_]+")
 """What a scenario `name` must match in full (it names output files)."""
+MAX_NAME_LENGTH = 100
+"""The longest `name`: output files are `<name>-<planner>-<seed>.<ext>` (at most 255 bytes)."""
+MAX_ARENA_M = 150.0
+"""The largest side of the arena (m): the top camera that renders runs cannot see wider than 180 m."""
+MAX_NOISE_STD_M = 10.0
+"""The largest sonar noise (m): more is meaningless, and huge readings overflow the sonar map."""
+MIN_OBSTACLE_M, MAX_OBSTACLE_M = 0.001, 1000.0
+"""Obstacle sizes and thicknesses (m) lie in [MIN_OBSTACLE_M, MAX_OBSTACLE_M], coordinates within
++-MAX_OBSTACLE_M: beyond these a size or a thickness can vanish in floating point (MuJoCo rejects
+the geom) and distances overflow."""
 
 
 # --------------------------------------------------------------------------- dataclasses
@@ -298,7 +308,7 @@ _TOP_FIELDS = {
 }
 
 _WORLD_FIELDS = {
-    "size": Field("point", required=True, gt=0),
+    "size": Field("point", required=True, gt=0, le=MAX_ARENA_M),
     "border": Field("bool"),
 }
 
@@ -313,7 +323,7 @@ _ROBOT_FIELDS = {
 }
 
 _SENSOR_FIELDS = {
-    "noise_std": Field("number", ge=0),
+    "noise_std": Field("number", ge=0, le=MAX_NOISE_STD_M),
     "dropout": Field("number", ge=0, lt=1),
     "crosstalk": Field("number", ge=0, lt=1),
     "dead": Field("ints", ge=0),
@@ -330,14 +340,14 @@ _RUN_FIELDS = {
     "seed": Field("int", ge=0, lt=2**32),
     "time_limit_s": Field("number", gt=0),
     "physics_dt_s": Field("number", ge=0.0005, le=0.01),
-    "control_hz": Field("number", gt=0, le=200),
+    "control_hz": Field("number", ge=1, le=200),  # one control tick is simulated whole
 }
 
 _STRING = Field("str")
-_CENTER = Field("point", required=True)
-_LENGTH = Field("number", required=True, gt=0)
+_CENTER = Field("point", required=True, ge=-MAX_OBSTACLE_M, le=MAX_OBSTACLE_M)
+_LENGTH = Field("number", required=True, gt=0, ge=MIN_OBSTACLE_M, le=MAX_OBSTACLE_M)
 _YAW = Field("number", attr="yaw", convert=math.radians)
-_THICKNESS = Field("number", gt=0)
+_THICKNESS = Field("number", gt=0, ge=MIN_OBSTACLE_M, le=MAX_OBSTACLE_M)
 
 
 def _check_wall(wall: Wall, path: str) -> None:
@@ -375,10 +385,14 @@ class _Kind:
     check: Callable[[Any, str], None] | None = None
 
 
-_BOX_FIELDS = {"center": _CENTER, "size": Field("point", required=True, gt=0), "yaw_deg": _YAW}
+_BOX_FIELDS = {
+    "center": _CENTER,
+    "size": Field("point", required=True, gt=0, ge=MIN_OBSTACLE_M, le=MAX_OBSTACLE_M),
+    "yaw_deg": _YAW,
+}
 _WALL_FIELDS = {
-    "from": Field("point", required=True, attr="start"),
-    "to": Field("point", required=True, attr="end"),
+    "from": Field("point", required=True, ge=-MAX_OBSTACLE_M, le=MAX_OBSTACLE_M, attr="start"),
+    "to": Field("point", required=True, ge=-MAX_OBSTACLE_M, le=MAX_OBSTACLE_M, attr="end"),
     "thickness": _THICKNESS,
 }
 _CYLINDER_FIELDS = {"center": _CENTER, "radius": _LENGTH}
@@ -485,6 +499,9 @@ def _read_top(doc: Mapping[str, Any]) -> dict[str, Any]:
     top = _read_fields(doc, "", _TOP_FIELDS, extra=_SECTIONS)
     if not NAME_PATTERN.fullmatch(top["name"]):
         raise _Invalid("name", f"must match [a-z0-9_]+ (it names output files), got {top['name']!r}")
+    if len(top["name"]) > MAX_NAME_LENGTH:
+        length = len(top["name"])
+        raise _Invalid("name", f"must be at most {MAX_NAME_LENGTH} characters (it names files), got {length}")
     return top
 
 

@@ -81,7 +81,10 @@ class LocalMinimumDetector:
         return math.hypot(x1 - x0, y1 - y0)
 
     def _slow_throughout(self) -> bool:
-        """v_r <= v_th at every step of the window (speeds from successive samples, m/s)."""
+        """v_r <= v_th at every step of the window (speeds from successive samples, m/s).
+
+        A window of one sample (window_s of about zero) has no step: it is not slow.
+        """
         samples = iter(self._samples)
         next(samples)  # the oldest sample's speed belongs to the step before the window
-        return max(s[3] for s in samples) <= self.speed_mps
+        return max((s[3] for s in samples), default=math.inf) <= self.speed_mps

@@ -7,6 +7,10 @@ import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+MAX_MAGNITUDE = 1e6
+"""No planner parameter may exceed this in absolute value: a larger one is surely a mistake,
+and such values overflow the planners' force arithmetic to inf (the run would end in error)."""
+
 
 @dataclass(frozen=True)
 class Param:
@@ -28,6 +32,8 @@ class Param:
             return f"must be an integer, got {value!r}"
         if (isinstance(value, int) and abs(value) > sys.float_info.max) or not math.isfinite(value):
             return f"must be finite, got {value!r}"
+        if abs(value) > MAX_MAGNITUDE:
+            return f"must be at most {MAX_MAGNITUDE:g} in magnitude, got {value!r}"
         if self.gt is not None and not value > self.gt:
             return f"must be greater than {self.gt:g}, got {value!r}"
         if self.ge is not None and not value >= self.ge:
@@ -54,11 +60,14 @@ class PlannerInfo:
 
 
 SONAR_MAP_PARAMS: dict[str, Param] = {
-    "map_cell_m": Param(0.1, "m", "cell size of the local sonar map", gt=0),
-    "map_size_m": Param(8.0, "m", "side of the square local map that follows the robot", gt=0),
+    "map_cell_m": Param(0.1, "m", "cell size of the local sonar map", ge=0.05, le=1.0),
+    "map_size_m": Param(8.0, "m", "side of the square local map that follows the robot", gt=0, le=20.0),
     "map_threshold": Param(4, "", "certainty at which a map cell counts as an obstacle", ge=1, integer=True),
-    "sector_deg": Param(5.0, "deg", "polar histogram sector width", gt=0, le=45),
+    "sector_deg": Param(5.0, "deg", "polar histogram sector width", ge=0.5, le=45),
     "window_m": Param(2.0, "m", "radius of the histogram's active window", gt=0),
     "histogram_threshold": Param(1.0, "", "sector density above which a sector is blocked", gt=0),
 }
-"""The sonar certainty grid and polar histogram, shared by the planners that use them."""
+"""The sonar certainty grid and polar histogram, shared by the planners that use them.
+
+The bounds keep the grid (at most 400 x 400 cells) and the histogram (at most 720 sectors)
+small enough to update at the control rate."""

@@ -9,8 +9,10 @@ Algorithm 3 of the paper, as a state machine with three modes:
   and the virtual plane e1-e2 is added to the list L.
 
 One departure from the paper: within `goal_fade_m` of the goal the echo repulsion fades
-linearly to zero (after Ge and Cui's fix of "goal not reachable with obstacles nearby",
-which the paper names but does not treat), so a goal close to a wall can be reached.
+to zero with the square of the distance to the goal (after Ge and Cui's fix of "goal not
+reachable with obstacles nearby", which the paper names but does not treat), so a goal
+close to a wall can be reached: near the goal the attraction falls only linearly, so it
+wins there over any bounded repulsion (a linear fade would balance it short of the goal).
 
 The rules the paper leaves open: a plane is retired once the robot is nearer the goal
 than any point of the plane, or when more than `max_planes` exist (the oldest goes); a
@@ -52,13 +54,13 @@ PARAMS: dict[str, Param] = {
     **SONAR_MAP_PARAMS,
     "echo_memory": Param(100, "", "sonar scans kept for the extreme points e1, e2", ge=1, integer=True),
     "clearance_m": Param(
-        0.08, "m", "clearance added to the robot radius (gap width, VFH+ enlargement)", ge=0
+        0.08, "m", "clearance added to the robot radius (gap width, VFH+ enlargement)", ge=0, le=1.0
     ),
     "min_gap_deg": Param(10.0, "deg", "narrowest valley that counts as a passage", gt=0),
     "concave_depth_m": Param(0.3, "m", "depth behind the chord e1-e2 that makes an obstacle concave", gt=0),
     "lookahead_m": Param(2.0, "m", "how far ahead toward the goal obstacles are examined", gt=0),
     "goal_fade_m": Param(
-        0.6, "m", "echo repulsion fades linearly to zero within this distance of the goal", ge=0
+        0.6, "m", "echo repulsion fades (quadratically) to zero within this distance of the goal", ge=0
     ),
     "vno_gain": Param(0.5, "1/m", "gamma of eq. 7, attraction of the virtual new objective", gt=0),
     "vno_tolerance_m": Param(0.15, "m", "distance at which the virtual objective counts as reached", gt=0),
@@ -67,7 +69,7 @@ PARAMS: dict[str, Param] = {
     "max_escapes": Param(4, "", "escapes tried before giving up", ge=1, integer=True),
     "plane_gain": Param(0.05, "m", "eta of eqs. 8-10, virtual plane repulsion gain", gt=0),
     "plane_influence_m": Param(0.6, "m", "r of eq. 8, the virtual plane's radius of influence", gt=0),
-    "plane_step_m": Param(0.05, "m", "spacing of the points p_i on the plane (eqs. 9-10)", gt=0),
+    "plane_step_m": Param(0.05, "m", "spacing of the points p_i on the plane (eqs. 9-10)", ge=0.005),
     "plane_margin_m": Param(0.3, "m", "the corridor extends this far past the plane's ends", ge=0),
     "slide_gain": Param(1.0, "", "tangential force along the plane, relative to its normal force", ge=0),
     "max_planes": Param(4, "", "virtual planes kept at most (list L)", ge=1, integer=True),
@@ -126,7 +128,7 @@ class VPlanePlanner:
 
         components = firas_components(obs, p)
         if p["goal_fade_m"] > 0:  # goals near obstacles stay reachable (GNRON)
-            components["repulsive"] *= min(1.0, obs.distance_to_goal() / p["goal_fade_m"])
+            components["repulsive"] *= min(1.0, obs.distance_to_goal() / p["goal_fade_m"]) ** 2
         if self.temp_goal is not None:
             decision.mode = "escaping"
             components["attractive"] = -2.0 * p["vno_gain"] * (obs.position - self.temp_goal)  # eq. 7
