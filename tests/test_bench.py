@@ -14,6 +14,7 @@ import pytest
 
 from vplane_mj.bench import JOURNAL, family_of, parse_seeds, read_journal
 from vplane_mj.cli import main
+from vplane_mj.errors import VPlaneError
 from vplane_mj.sim import TIMING_KEYS
 
 ARGS = ["bench", "open_field", "paper_c_escape", "--planners", "apf,vplane", "--seeds", "0-1", "--jobs", "2"]
@@ -79,6 +80,9 @@ def test_parse_seeds():
     assert parse_seeds("0-3") == [0, 1, 2, 3]
     assert parse_seeds("7") == [7]
     assert parse_seeds("5,0-1,5") == [0, 1, 5]
+    for bad in ("0-4294967296", "0-4294967295", "-1", "3-1", "a"):
+        with pytest.raises(VPlaneError, match="--seeds"):
+            parse_seeds(bad)
 
 
 def test_a_dask_cluster_gives_the_same_rows_as_the_local_pool(tmp_path, capsys):

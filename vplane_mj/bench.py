@@ -62,19 +62,25 @@ class Job:
         return f"{self.scenario}|{self.planner}|{self.seed}|{digest}"
 
 
+MAX_SEEDS = 100_000
+"""The most seeds one sweep takes (a typo such as 0-4294967295 would plan billions of runs)."""
+
+
 def parse_seeds(text: str) -> list[int]:
-    """Seeds from "0-19", "7" or "0,2,5-7"; a VPlaneError names the bad part."""
-    seeds: list[int] = []
+    """Seeds from "0-19", "7" or "0,2,5-7", each below 2**32; a VPlaneError names the bad part."""
+    seeds: set[int] = set()
     for part in text.split(","):
         bounds = part.strip().split("-")
         try:
             low, high = (int(bounds[0]), int(bounds[-1])) if len(bounds) <= 2 else (None, None)
         except ValueError:
             low = high = None
-        if low is None or low < 0 or high < low:
-            raise VPlaneError(f"--seeds: {part.strip()!r} is not a seed or a range like 0-19")
-        seeds.extend(range(low, high + 1))
-    return sorted(set(seeds))
+        if low is None or low < 0 or high < low or high >= 2**32:
+            raise VPlaneError(f"--seeds: {part.strip()!r} is not a seed or a range like 0-19 (seeds < 2**32)")
+        if len(seeds) + (high - low + 1) > MAX_SEEDS:
+            raise VPlaneError(f"--seeds: more than {MAX_SEEDS} seeds in {text.strip()!r}")
+        seeds.update(range(low, high + 1))
+    return sorted(seeds)
 
 
 def plan_jobs(
