@@ -1,0 +1,346 @@
+"""Soak test: generated scenarios with random sensor and actuation faults, all planners, no crash.
+
+`--count` scenarios (default 1000) are generated in turn from the families traps, clutter and
+corridors (`vplane_mj.families.generate`, seed `--seed`, only cases with a reference path),
+the planners are assigned round-robin, and each run gets its own random faults, each fault
+turned on independently with probability 1/2 (the odometry pose 1/4), drawn from the same
+seed so the soak is reproducible:
+
+| fault | key | range |
+|---|---|---|
+| sonar range noise | sensors.noise_std | 0-0.05 m |
+| dropout | sensors.dropout | 0-0.3 |
+| crosstalk (spurious short echoes) | sensors.crosstalk | 0-0.1 |
+| dead sonars | sensors.dead | 1-3 of the 16 |
+| wheel slip | robot.wheel_friction | 0.2-1.0 |
+| motor gain, per wheel | robot.motor_gain | 0.5-1.0 |
+| motor bias, per wheel | robot.motor_bias_nm | -0.05-0.05 N m |
+| dead-reckoned pose | sensors.pose = "odometry", sensors.odometry_noise | 0-0.02 per tick |
+
+Each run has the simulated time limit `--time-limit` (s) and runs in a pool of `--jobs`
+worker processes. An exception raised by a run is a crash: its traceback goes to
+`OUT/failed/<scenario>-<planner>-<seed>.traceback.txt`, and the soak goes on. A worker process
+that dies (segfault, out of memory) breaks the pool: the runs then in flight are retried one
+at a time, and one that kills its worker again is recorded as ended without a summary. The
+scenario of every crash, missing summary or `error` outcome is written beside it as
+`<...>.toml` (run it again with `vplane-mj run FILE`). The planned runs (scenario texts and
+faults; planning 1000 takes a few minutes) are saved in `OUT/plan.json` and the finished ones
+journaled in `OUT/soak.jsonl`, so the same command run again only does what is missing
+(delete both to start afresh, e.g. after a change to the scenario generators).
+
+Prints and writes `OUT/soak.json` (runs, crashes, runs without a summary, outcomes per
+planner, success rate per planner and family, the `error` outcomes with their messages,
+wall times) and `OUT/soak.png` (outcomes per planner). Exit status 1 if any run crashed or
+ended without a summary, else 0.
+
+    python benchmarks/soak.py [--count 1000] [--seed 0] [--jobs 2] [--time-limit 60] [--out logs/soak]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+import traceback
+from collections import deque
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import asdict
+from pathlib import Path
+
+import numpy as np
+
+from vplane_mj.bench import Job, Progress, family_of, read_journal, run_job
+from vplane_mj.errors import VPlaneError
+from vplane_mj.families import FAMILIES, generate
+from vplane_mj.outputs import prepare_out_dir, write_atomically, write_json
+from vplane_mj.planning.registry import PLANNERS
+from vplane_mj.reference import shortest_path_length
+from vplane_mj.robot import robot_radius_m
+from vplane_mj.scenario import SensorSpec, parse_scenario
+
+JOURNAL = "soak.jsonl"
+PLAN = "plan.json"
+OUTCOMES = ("reached", "timeout", "stuck", "error")
+
+
+def draw_faults(rng: np.random.Generator) -> list[str]:
+    """`--set` overrides for one run's faults (see the table above)."""
+
+    def on(probability: float = 0.5) -> bool:
+        return rng.random() < probability
+
+    def draw(low: float, high: float, size: int | None = None):
+        return np.round(rng.uniform(low, high, size), 4).tolist()
+
+    faults = []
+    if on():
+        faults.append(f"sensors.noise_std={draw(0.0, 0.05)}")
+    if on():
+        faults.append(f"sensors.dropout={draw(0.0, 0.3)}")
+    if on():
+        faults.append(f"sensors.crosstalk={draw(0.0, 0.1)}")
+    if on():
+        dead = rng.choice(SensorSpec.count, size=int(rng.integers(1, 4)), replace=False)
+        faults.append(f"sensors.dead={sorted(dead.tolist())}")
+    if on():
+        faults.append(f"robot.wheel_friction={draw(0.2, 1.0)}")
+    if on():
+        faults.append(f"robot.motor_gain={draw(0.5, 1.0, 2)}")
+    if on():
+        faults.append(f"robot.motor_bias_nm={draw(-0.05, 0.05, 2)}")
+    if on(0.25):
+        faults += ['sensors.pose="odometry"', f"sensors.odometry_noise={draw(0.0, 0.02)}"]
+    return faults
+
+
+def plan_soak(count: int, seed: int, time_limit: float) -> list[tuple[Job, list[str]]]:
+    """The runs, each with its fault overrides: families in turn, planners round-robin."""
+    families = list(FAMILIES)
+    radius = robot_radius_m()
+
+    def has_path(scenario) -> bool:
+        return shortest_path_length(scenario, radius) is not None
+
+    cases = {
+        family: generate(family, len(range(k, count, len(families))), seed, has_path)
+        for k, family in enumerate(families)
+    }
+    fault_rng = np.random.default_rng([seed, 1])  # a stream apart from the generators'
+    planners = sorted(PLANNERS)
+    runs = []
+    for index in range(count):
+        case = cases[families[index % len(families)]][index // len(families)]
+        planner = planners[index % len(planners)]
+        faults = draw_faults(fault_rng)
+        overrides = [
+            *faults,
+            f"planner.name={planner}",
+            f"run.seed={index}",
+            f"run.time_limit_s={time_limit}",
+        ]
+        scenario = parse_scenario(case.toml(), case.name, overrides)
+        runs.append((Job(case.name, planner, index, scenario.to_toml()), faults))
+    return runs
+
+
+def load_or_plan(path: Path, count: int, seed: int, time_limit: float) -> list[tuple[Job, list[str]]]:
+    """The runs as planned before in `path` with the same arguments, else planned and saved there."""
+    settings = {"count": count, "seed": seed, "time_limit_s": time_limit}
+    if path.exists():
+        plan = json.loads(path.read_text(encoding="utf-8"))
+        if plan["settings"] == settings:
+            return [(Job(**run["job"]), run["faults"]) for run in plan["runs"]]
+    runs = plan_soak(count, seed, time_limit)
+    write_json(path, {"settings": settings, "runs": [{"job": asdict(j), "faults": f} for j, f in runs]})
+    return runs
+
+
+def guarded_run(job: Job) -> dict:
+    """One run's summary row, or a crash row with the traceback of the exception it raised."""
+    try:
+        return run_job(job)
+    except Exception:
+        return {"key": job.key, "crash": traceback.format_exc()}
+
+
+def run_pool(jobs: list[Job], workers: int, record) -> None:
+    """Run the jobs in a pool of `workers` processes and `record(job, row)` each as it finishes.
+
+    A worker process that dies breaks the pool: the jobs then in flight are retried one at a
+    time in a pool of their own, and one that kills that one too gets a row with `no_summary`.
+    """
+    queue = deque(jobs)
+    while queue:
+        for job in _run_batch(queue, workers, record):
+            if _run_batch(deque([job]), 1, record):
+                record(job, {"key": job.key, "no_summary": "its worker process died, twice"})
+
+
+def _run_batch(queue: deque[Job], workers: int, record) -> list[Job]:
+    """Run jobs off `queue`, at most `workers` at a time, until it is empty or the pool breaks;
+    the jobs in flight when it broke."""
+    lost: list[Job] = []
+    intact = True
+    with ProcessPoolExecutor(workers) as pool:
+        running = {}
+        while (intact and queue) or running:
+            while intact and queue and len(running) < workers:
+                try:
+                    running[pool.submit(guarded_run, queue[0])] = queue[0]
+                except BrokenProcessPool:
+                    intact = False
+                else:
+                    queue.popleft()
+            done, _ = wait(running, return_when=FIRST_COMPLETED)
+            for future in done:
+                job = running.pop(future)
+                try:
+                    row = future.result()
+                except BrokenProcessPool:
+                    intact = False
+                    lost.append(job)
+                else:
+                    record(job, row)
+    return lost
+
+
+def base_name(job: Job) -> str:
+    return f"{job.scenario}-{job.planner}-{job.seed}"
+
+
+def report(runs: list[tuple[Job, list[str]]], rows: dict[str, dict], wall_s: float) -> dict:
+    """The soak's figures from the journal rows of its runs."""
+    planners = sorted({job.planner for job, _ in runs})
+    families = list(dict.fromkeys(family_of(job.scenario) for job, _ in runs))
+    finished = [(job, rows.get(job.key, {})) for job, _ in runs]
+    summaries = [(job, row) for job, row in finished if row.get("outcome") in OUTCOMES]
+    crashes = [(job, row) for job, row in finished if "crash" in row]
+    missing = [
+        (job, row) for job, row in finished if "crash" not in row and row.get("outcome") not in OUTCOMES
+    ]
+    outcomes = {planner: dict.fromkeys(OUTCOMES, 0) for planner in planners}
+    success: dict[str, dict] = {planner: {} for planner in planners}
+    for planner in planners:
+        for family in families:
+            mine = [r for j, r in summaries if j.planner == planner and family_of(j.scenario) == family]
+            success[planner][family] = sum(r["success"] for r in mine) / len(mine) if mine else None
+            for row in mine:
+                outcomes[planner][row["outcome"]] += 1
+    run_wall = [row["wall_time_s"] for _, row in summaries]
+    return {
+        "format": 1,
+        "runs": len(runs),
+        "crashes": [
+            {"run": base_name(j), "planner": j.planner, "exception": r["crash"].splitlines()[-1]}
+            for j, r in crashes
+        ],
+        "without_summary": [
+            {"run": base_name(j), "planner": j.planner, "reason": r.get("no_summary", "not run")}
+            for j, r in missing
+        ],
+        "outcomes_per_planner": outcomes,
+        "success_rate_per_planner_and_family": success,
+        "errors": [
+            {"run": base_name(j), "message": r["message"]} for j, r in summaries if r["outcome"] == "error"
+        ],
+        "faults_per_run_mean": sum(len(faults) for _, faults in runs) / len(runs),
+        "wall_time_s": wall_s,
+        "run_wall_time_s_total": sum(run_wall),
+        "run_wall_time_s_mean": sum(run_wall) / len(run_wall) if run_wall else None,
+        "run_wall_time_s_max": max(run_wall, default=None),
+    }
+
+
+def print_report(figures: dict) -> None:
+    crashes, missing = figures["crashes"], figures["without_summary"]
+    print(f"runs: {figures['runs']}, crashes: {len(crashes)}, without a summary: {len(missing)}\n")
+    success = figures["success_rate_per_planner_and_family"]
+    families = list(next(iter(success.values())))
+    table = [["planner", *OUTCOMES, *(f"success {family}" for family in families)]]
+    for planner, counts in figures["outcomes_per_planner"].items():
+        rates = ["-" if rate is None else f"{100 * rate:.0f}%" for rate in success[planner].values()]
+        table.append([planner, *(str(counts[outcome]) for outcome in OUTCOMES), *rates])
+    widths = [max(len(line[k]) for line in table) for k in range(len(table[0]))]
+    for line in table:
+        print("  ".join(cell.rjust(width) for cell, width in zip(line, widths, strict=True)))
+    for title, entries, field in (
+        ("crashes", crashes, "exception"),
+        ("without a summary", missing, "reason"),
+        ("error outcomes", figures["errors"], "message"),
+    ):
+        if entries:
+            print(f"\n{title}:")
+            for entry in entries:
+                print(f"  {entry['run']}: {entry[field]}")
+    total, mean, longest = (figures[f"run_wall_time_s_{k}"] for k in ("total", "mean", "max"))
+    print(f"\nwall time {figures['wall_time_s']:.0f} s; simulation loops {total:.0f} s in all", end="")
+    print(f", {mean:.2f} s mean, {longest:.1f} s max per run" if mean is not None else "")
+
+
+def plot(figures: dict, path: Path) -> Path:
+    """Outcomes per planner as stacked bars, crashes and runs without a summary on top."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    outcomes = figures["outcomes_per_planner"]
+    planners = list(outcomes)
+    stacks = {outcome: [outcomes[p][outcome] for p in planners] for outcome in OUTCOMES}
+    for label, entries in (("crash", figures["crashes"]), ("no summary", figures["without_summary"])):
+        stacks[label] = [sum(entry["planner"] == p for entry in entries) for p in planners]
+    colours = ("C2", "C1", "C0", "C3", "k", "C7")
+    figure, ax = plt.subplots(figsize=(7, 4))
+    bottom = np.zeros(len(planners))
+    for (label, counts), colour in zip(stacks.items(), colours, strict=True):
+        ax.bar(planners, counts, bottom=bottom, color=colour, label=label)
+        bottom += counts
+    ax.set(ylabel="runs", title=f"soak: {figures['runs']} runs with random faults")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    figure.tight_layout()
+    return write_atomically(path, lambda tmp: figure.savefig(tmp, format="png", dpi=100))
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--count", type=int, default=1000, help="number of runs")
+    parser.add_argument("--seed", type=int, default=0, help="master seed of scenarios and faults")
+    parser.add_argument("--time-limit", type=float, default=60.0, help="simulated seconds per run")
+    parser.add_argument("--jobs", type=int, default=2, help="worker processes")
+    parser.add_argument("--out", type=Path, default=Path("logs/soak"))
+    args = parser.parse_args(argv)
+    if args.count < 1 or args.seed < 0 or args.jobs < 1:
+        parser.error("--count and --jobs must be at least 1, --seed at least 0")
+
+    started = time.monotonic()
+    try:
+        failed_dir = prepare_out_dir(args.out / "failed", create=True)
+    except VPlaneError as exc:
+        parser.error(str(exc))
+    runs = load_or_plan(args.out / PLAN, args.count, args.seed, args.time_limit)
+    faults = {job.key: overrides for job, overrides in runs}
+    journal_path = args.out / JOURNAL
+    rows = read_journal(journal_path)
+    pending = [job for job, _ in runs if job.key not in rows]
+    print(
+        f"{len(runs)} runs: {len(runs) - len(pending)} already done, {len(pending)} to run", file=sys.stderr
+    )
+
+    with open(journal_path, "a", encoding="utf-8") as journal:
+        if journal_path.read_bytes()[-1:] not in (b"", b"\n"):
+            journal.write("\n")  # keep a killed soak's torn last line apart from the new rows
+        progress = Progress(len(runs), len(runs) - len(pending))
+
+        def record(job: Job, row: dict) -> None:
+            try:
+                line = json.dumps({**row, "faults": faults[job.key]}, allow_nan=False)
+            except (TypeError, ValueError) as exc:  # a summary that is not valid JSON
+                line = json.dumps({"key": job.key, "no_summary": f"invalid summary: {exc}"})
+            row = rows[job.key] = json.loads(line)
+            if "outcome" not in row or row["outcome"] == "error":
+                base = failed_dir / base_name(job)
+                write_atomically(Path(f"{base}.toml"), lambda tmp: tmp.write_text(job.toml))
+                if "crash" in row:
+                    trace = Path(f"{base}.traceback.txt")
+                    write_atomically(trace, lambda tmp: tmp.write_text(row["crash"]))
+            journal.write(line + "\n")
+            journal.flush()
+            progress.advance()
+
+        try:
+            run_pool(pending, args.jobs, record)
+        except KeyboardInterrupt:
+            print("\ninterrupted: the same command goes on from here", file=sys.stderr)
+            return 130
+
+    figures = report(runs, rows, time.monotonic() - started)
+    print_report(figures)
+    print(f"\nwrote {write_json(args.out / 'soak.json', figures)}")
+    print(f"wrote {plot(figures, args.out / 'soak.png')}")
+    return 1 if figures["crashes"] or figures["without_summary"] else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
