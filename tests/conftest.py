@@ -1,8 +1,15 @@
-"""Shared fixtures: scenarios from text, and quick access to the shipped ones."""
+"""Shared fixtures: scenarios from text, and quick access to the shipped ones.
+
+Property-based tests are derandomised: every run of the suite tries the same examples.
+"""
 
 import pytest
+from hypothesis import settings
 
 from vplane_mj.scenario import load_scenario, parse_scenario
+
+settings.register_profile("deterministic", derandomize=True, database=None)
+settings.load_profile("deterministic")
 
 
 @pytest.fixture
