@@ -8,7 +8,7 @@ with the simulated time limit `--time-limit` (s): by default 8 x 34 x 5 = 1360 r
 are written to `OUT/cases/`; the runs go through `vplane_mj.bench.run_sweep`, so
 `OUT/bench.jsonl` journals them and the same command run again only does what is missing. The
 level is part of each run's scenario name (`u_front_0_noise_0p03_dropout_0p1`: noise 0.03 m,
-dropout 0.1), so journal rows of different levels stay apart. A run succeeds when it reaches
+dropout 0.1), so every journal row says which level it belongs to. A run succeeds when it reaches
 the goal without a collision.
 
 Writes `OUT/degradation.csv` (per planner and level: runs, successes, reached, runs with a

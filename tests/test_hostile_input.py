@@ -440,6 +440,15 @@ def report(capsys, test: str, tally: Counter) -> None:
 # --------------------------------------------------------------------------- 1. fuzzing
 
 
+def count_rejection(code: int, err: str, source: str, touched: list[str], tally: Counter) -> None:
+    """A rejection: exit 2 and a message naming a key path the mutations explain; counted."""
+    assert code == 2, (code, err)
+    key = reported_key(err, source)
+    assert key is not None and related(key, touched), (err, touched)
+    tally["rejected"] += 1
+    event("rejected")
+
+
 def test_check_accepts_or_rejects_fuzzed_scenarios_cleanly(capsys):
     """`check` on mutated scenario files: ok (exit 0), or exit 2 naming a key path the mutation explains."""
     tally: Counter = Counter()
@@ -456,11 +465,7 @@ def test_check_accepts_or_rejects_fuzzed_scenarios_cleanly(capsys):
             tally["accepted"] += 1
             event("accepted")
             return
-        assert code == 2, (code, err)
-        key = reported_key(err, str(path))
-        assert key is not None and related(key, touched), (err, touched)
-        tally["rejected"] += 1
-        event("rejected")
+        count_rejection(code, err, str(path), touched, tally)
 
     check_one()
     report(capsys, "check fuzz", tally)
@@ -485,12 +490,8 @@ def test_run_accepts_or_rejects_fuzzed_scenarios_cleanly(capsys):
                 assert_run_outputs(out_dir, code)
                 tally["ran"] += 1
                 return
-            assert code == 2, (code, err)
             assert list(out_dir.iterdir()) == []
-            key = reported_key(err, str(path))
-            assert key is not None and related(key, touched), (err, touched)
-            tally["rejected"] += 1
-            event("rejected")
+            count_rejection(code, err, str(path), touched, tally)
 
     run_one()
     report(capsys, "run fuzz", tally)

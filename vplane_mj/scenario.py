@@ -588,7 +588,7 @@ def _read_planner(doc: Mapping[str, Any]) -> tuple[str, Mapping[str, float]]:
 def _read_sensors(doc: Mapping[str, Any]) -> SensorSpec:
     """The optional `[sensors]` table; dead sonars must exist in the ring."""
     sensors = SensorSpec(**_read_fields(_sub_table(doc, "sensors"), "sensors", _SENSOR_FIELDS))
-    for index, sonar in enumerate(doc["sensors"].get("dead", []) if sensors.dead else []):
+    for index, sonar in enumerate(_sub_table(doc, "sensors").get("dead", [])):
         if sonar >= sensors.count:
             ring = f"a ring of count = {sensors.count} (0 to {sensors.count - 1})"
             raise _Invalid("sensors.dead", f"item {index}: no sonar {sonar} in {ring}")
