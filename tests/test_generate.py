@@ -1,14 +1,16 @@
 """`vplane-mj generate`: seeded, valid, solvable scenario files."""
 
+import numpy as np
 import pytest
 
 from vplane_mj.cli import main
+from vplane_mj.families import BARN_CELL_M, FAMILIES, barn_cells, cell_rectangles
 from vplane_mj.reference import shortest_path_length
 from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import load_scenario
 
 
-@pytest.mark.parametrize("family", ["traps", "clutter", "corridors"])
+@pytest.mark.parametrize("family", ["traps", "clutter", "corridors", "barn"])
 def test_a_family_is_deterministic_valid_and_solvable(tmp_path, capsys, family):
     first, second = tmp_path / "a", tmp_path / "b"
     first.mkdir()
@@ -20,7 +22,8 @@ def test_a_family_is_deterministic_valid_and_solvable(tmp_path, capsys, family):
     for path in files:
         assert path.read_text() == (second / path.name).read_text()
         scenario = load_scenario(str(path))
-        assert shortest_path_length(scenario, robot_radius_m()) is not None
+        clearance = FAMILIES[family].clearance_m
+        assert shortest_path_length(scenario, robot_radius_m(), clearance) is not None
     other = tmp_path / "c"
     other.mkdir()
     main(["generate", family, "--count", "4", "--seed", "8", "--out", str(other)])
@@ -33,3 +36,26 @@ def test_bad_arguments_exit_2_and_write_nothing(tmp_path, capsys, argv):
     assert main(["generate", *argv, "--out", str(tmp_path)]) == 2
     assert list(tmp_path.iterdir()) == []
     assert "Traceback" not in capsys.readouterr().err
+
+
+def test_barn_rectangles_cover_exactly_the_filled_cells():
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        grid = barn_cells(rng)
+        covered = np.zeros(grid.shape, dtype=int)
+        for row0, col0, rows, cols in cell_rectangles(grid):
+            covered[row0 : row0 + rows, col0 : col0 + cols] += 1
+        np.testing.assert_array_equal(covered, grid.astype(int))  # every cell once, no overlap
+
+
+def test_barn_worlds_span_the_difficulty_of_the_original(tmp_path, capsys):
+    """Open fields and dense ones with only narrow passages: the fill and smoothing vary."""
+    assert main(["generate", "barn", "--count", "12", "--seed", "0", "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    scenarios = [load_scenario(str(p)) for p in sorted(tmp_path.glob("*.toml"))]
+    filled = []
+    for scenario in scenarios:
+        assert scenario.world.size == pytest.approx((4.2, 10.5))
+        assert scenario.robot.goal[1] - scenario.robot.start[1] == pytest.approx(8.7)
+        filled.append(sum(ob.size[0] * ob.size[1] for ob in scenario.world.obstacles) / BARN_CELL_M**2)
+    assert min(filled) < 0.1 * 28 * 30 < 0.25 * 28 * 30 < max(filled)

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj.sim import TIMING_KEYS, run_scenario
+from vplane_mj.sim import TIMING_KEYS, barn_score, run_scenario
 
 OPEN = """
 format = 1
@@ -22,6 +22,7 @@ name = "apf"
 
 SUMMARY_KEYS = {
     "format",
+    "score",
     "scenario",
     "planner",
     "seed",
@@ -135,3 +136,23 @@ def test_motion_quality_metrics(shipped):
     assert detour["smoothness_rad_per_m"] > 5 * straight["smoothness_rad_per_m"]
     assert detour["mean_clearance_m"] > detour["min_clearance_m"] > 0
     assert 0 < detour["planner_cpu_ms_mean"] <= detour["planner_cpu_ms_max"]
+
+
+def test_barn_score_clips_the_time_between_two_and_eight_optimal_times():
+    # 5 m at 0.5 m/s: OT = 10 s.
+    assert barn_score(True, 5.0, 25.0, 0.5) == pytest.approx(10 / 25)
+    assert barn_score(True, 5.0, 12.0, 0.5) == pytest.approx(0.5)  # faster than 2 OT counts as 2 OT
+    assert barn_score(True, 5.0, 300.0, 0.5) == pytest.approx(1 / 8)  # slower than 8 OT counts as 8 OT
+    assert barn_score(False, 5.0, 25.0, 0.5) == 0.0
+    assert barn_score(True, None, 25.0, 0.5) is None
+
+
+def test_the_summary_scores_a_run_against_its_reference_path(shipped):
+    reached = run_scenario(shipped("paper_c_escape")).summary
+    optimal_time = reached["optimal_length_m"] / 0.5
+    assert reached["success"]
+    expected = optimal_time / min(max(reached["time_to_goal_s"], 2 * optimal_time), 8 * optimal_time)
+    assert reached["score"] == pytest.approx(expected)
+    assert 0.125 <= reached["score"] <= 0.5
+    trapped = run_scenario(shipped("paper_c_escape", "planner.name=apf")).summary
+    assert trapped["score"] == 0.0

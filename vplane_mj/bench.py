@@ -35,6 +35,7 @@ TABLE_COLUMNS = (
     "planner",
     "runs",
     "success_rate",
+    "mean_score",
     "collision_rate",
     "timeouts",
     "stuck",
@@ -259,6 +260,7 @@ def summarize(rows: list[dict]) -> list[dict]:
                 "planner": planner,
                 "runs": len(mine),
                 "success_rate": sum(row["success"] for row in mine) / len(mine),
+                "mean_score": _mean([row["score"] for row in mine if row.get("score") is not None]),
                 "collision_rate": sum(row["collisions"] > 0 for row in mine) / len(mine),
                 "timeouts": sum(row["outcome"] == "timeout" for row in mine),
                 "stuck": sum(row["outcome"] == "stuck" for row in mine),
@@ -274,6 +276,10 @@ def summarize(rows: list[dict]) -> list[dict]:
 
 def _median(values: list[float]) -> float | None:
     return statistics.median(values) if values else None
+
+
+def _mean(values: list[float]) -> float | None:
+    return statistics.fmean(values) if values else None
 
 
 def format_table(table: list[dict]) -> str:

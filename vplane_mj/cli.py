@@ -257,7 +257,10 @@ def _generate(args: argparse.Namespace) -> int:
     out_dir = prepare_out_dir(args.out, create=False)
     radius = robot_radius_m()
     cases = generate(
-        args.family, args.count, args.seed, lambda s: shortest_path_length(s, radius) is not None
+        args.family,
+        args.count,
+        args.seed,
+        lambda scenario, clearance: shortest_path_length(scenario, radius, clearance) is not None,
     )
     for case in cases:
         path = write_atomically(out_dir / f"{case.name}.toml", lambda tmp, c=case: tmp.write_text(c.toml()))

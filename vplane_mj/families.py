@@ -11,6 +11,7 @@ with a trap on the straight line, and zigzag corridors.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -261,12 +262,116 @@ def random_corridor(name: str, rng: np.random.Generator) -> Case:
     return Case(name, _document(name, [w for w in walls if w["from"] != w["to"]], start, goal))
 
 
-FAMILIES = {"traps": random_trap, "clutter": random_clutter, "corridors": random_corridor}
-"""Generators of `vplane-mj generate`: each makes one case from a name and a generator."""
+# -- BARN-like cluttered worlds ------------------------------------------------------------------
+
+BARN_CELL_M = 0.15
+"""Side of one obstacle cell (m), as in BARN."""
+BARN_COLUMNS, BARN_ROWS = 28, 30
+"""The obstacle field: 28 cells across the arena's whole width (4.2 m), 30 along it (4.5 m)."""
+BARN_LENGTH_M = 10.5
+"""Arena length (m) along y: the robot drives from y = BARN_START_Y_M to past the field."""
+BARN_START_Y_M, BARN_FIELD_Y_M, BARN_GOAL_PAST_M = 1.0, 4.5, 0.7
+"""Start 3.5 m in front of the field, which begins at y = 4.5 m; the goal 0.7 m past its far end."""
+BARN_FILL = (0.10, 0.40)
+BARN_SMOOTHING_PASSES = (0, 4)
+BARN_CLEARANCE_M = 0.05
+"""A world is kept only when the robot's disc plus this clearance has a path to the goal."""
+
+
+def barn_cells(rng: np.random.Generator) -> np.ndarray:
+    """An occupancy grid (BARN_ROWS, BARN_COLUMNS) drawn by a cellular automaton (Perille et al.).
+
+    Cells are filled at random with a probability drawn from BARN_FILL, then smoothed by 0-4
+    passes (drawn from BARN_SMOOTHING_PASSES) of BARN's rule: a cell fills when more than 4 of
+    its 8 neighbours are filled and empties when fewer than 2 are. Beyond the side columns
+    stand the arena's walls (they count as filled); before and after the field is open floor.
+    Few passes leave scattered cells; more passes grow them into blobs with narrow, winding
+    passages.
+    """
+    fill = rng.uniform(*BARN_FILL)
+    grid = rng.random((BARN_ROWS, BARN_COLUMNS)) < fill
+    for _ in range(int(rng.integers(BARN_SMOOTHING_PASSES[0], BARN_SMOOTHING_PASSES[1] + 1))):
+        padded = np.pad(grid, ((1, 1), (0, 0)), constant_values=False)
+        padded = np.pad(padded, ((0, 0), (1, 1)), constant_values=True).astype(int)
+        neighbours = sum(
+            padded[1 + dy : 1 + dy + BARN_ROWS, 1 + dx : 1 + dx + BARN_COLUMNS]
+            for dy in (-1, 0, 1)
+            for dx in (-1, 0, 1)
+            if dy or dx
+        )
+        grid = np.where(neighbours > 4, True, np.where(neighbours < 2, False, grid))
+    return grid
+
+
+def cell_rectangles(grid: np.ndarray) -> list[tuple[int, int, int, int]]:
+    """Filled cells merged into few rectangles (row0, col0, rows, cols) covering exactly them.
+
+    Runs of filled cells along each row are merged with the identical runs of the rows
+    above them, so a blob becomes a handful of boxes instead of one box per cell.
+    """
+    rectangles: list[tuple[int, int, int, int]] = []
+    open_runs: dict[tuple[int, int], int] = {}  # (col0, cols) -> the row where the run began
+    for row in range(grid.shape[0] + 1):
+        runs: set[tuple[int, int]] = set()
+        if row < grid.shape[0]:
+            edges = np.flatnonzero(np.diff(np.concatenate(([0], grid[row].astype(int), [0]))))
+            runs = {(int(a), int(b - a)) for a, b in zip(edges[::2], edges[1::2], strict=True)}
+        for col0, cols in sorted(set(open_runs) - runs):
+            first = open_runs.pop((col0, cols))
+            rectangles.append((first, col0, row - first, cols))
+        for run in sorted(runs - set(open_runs)):
+            open_runs[run] = row
+    return rectangles
+
+
+def random_barn(name: str, rng: np.random.Generator) -> Case:
+    """A BARN-like world: a 4.2 x 10.5 m arena crossed by a cellular-automaton obstacle field."""
+    width = BARN_COLUMNS * BARN_CELL_M
+    obstacles = []
+    for row0, col0, rows, cols in cell_rectangles(barn_cells(rng)):
+        obstacles.append(
+            {
+                "kind": "box",
+                "center": [
+                    round((col0 + cols / 2) * BARN_CELL_M, 6),
+                    round(BARN_FIELD_Y_M + (row0 + rows / 2) * BARN_CELL_M, 6),
+                ],
+                "size": [round(cols * BARN_CELL_M, 6), round(rows * BARN_CELL_M, 6)],
+            }
+        )
+    goal_y = BARN_FIELD_Y_M + BARN_ROWS * BARN_CELL_M + BARN_GOAL_PAST_M
+    document = {
+        "format": 1,
+        "name": name,
+        "description": "generated BARN-like world",
+        "world": {"size": [round(width, 6), BARN_LENGTH_M], "obstacles": obstacles},
+        "robot": {"start": [round(width / 2, 6), BARN_START_Y_M], "goal": [round(width / 2, 6), goal_y]},
+        "run": {"time_limit_s": 150.0},
+    }
+    return Case(name, document)
+
+
+@dataclass(frozen=True)
+class Family:
+    """A seeded family of `vplane-mj generate`: one case from a name and a generator, and the
+    clearance (m) beyond the robot radius that a kept case's reference path must have."""
+
+    make: Callable[[str, np.random.Generator], Case]
+    clearance_m: float = 0.0
+
+
+FAMILIES = {
+    "traps": Family(random_trap),
+    "clutter": Family(random_clutter),
+    "corridors": Family(random_corridor),
+    "barn": Family(random_barn, BARN_CLEARANCE_M),
+}
+"""The families of `vplane-mj generate`."""
 
 
 def generate(family: str, count: int, seed: int, has_path) -> list[Case]:
-    """`count` valid cases of `family` from `seed`; `has_path(scenario)` rejects unsolvable ones.
+    """`count` valid cases of `family` from `seed`; `has_path(scenario, clearance_m)` rejects
+    the unsolvable ones.
 
     Candidates are drawn from one generator seeded with `seed`, so the same arguments always
     give the same files; a candidate that fails validation or has no path is drawn again.
@@ -281,11 +386,11 @@ def generate(family: str, count: int, seed: int, has_path) -> list[Case]:
         attempts += 1
         if attempts > 50 * count:
             raise RuntimeError(f"family {family}: too few valid cases after {attempts} attempts")
-        case = FAMILIES[family](f"{family}_{seed}_{len(cases):03d}", rng)
+        case = FAMILIES[family].make(f"{family}_{seed}_{len(cases):03d}", rng)
         try:
             scenario = parse_scenario(case.toml(), case.name)
         except ScenarioError:
             continue
-        if has_path(scenario):
+        if has_path(scenario, FAMILIES[family].clearance_m):
             cases.append(case)
     return cases

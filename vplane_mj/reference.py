@@ -385,13 +385,14 @@ def shortest_path(
 
 
 @functools.lru_cache(maxsize=64)
-def _cached_length(toml_text: str, robot_radius_m: float) -> float | None:
+def _cached_length(toml_text: str, robot_radius_m: float, clearance_m: float) -> float | None:
     from vplane_mj.scenario import parse_scenario  # lazy: scenario.py imports mujoco-side modules
 
-    ref = shortest_path(parse_scenario(toml_text, "<reference>"), robot_radius_m)
+    ref = shortest_path(parse_scenario(toml_text, "<reference>"), robot_radius_m, clearance_m=clearance_m)
     return None if ref is None else ref.length_m
 
 
-def shortest_path_length(scenario, robot_radius_m: float) -> float | None:
-    """The reference path length (m), or None; cached by the scenario's TOML text and the radius."""
-    return _cached_length(scenario.to_toml(), float(robot_radius_m))
+def shortest_path_length(scenario, robot_radius_m: float, clearance_m: float = 0.0) -> float | None:
+    """The reference path length (m) for the robot's disc plus `clearance_m`, or None; cached by
+    the scenario's TOML text, the radius and the clearance."""
+    return _cached_length(scenario.to_toml(), float(robot_radius_m), float(clearance_m))

@@ -390,7 +390,7 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         "local_minima": local_minima,
         "escapes": escapes,
         "robot_radius_m": radius,
-        **_path_quality(scenario, radius, reached, path_length),
+        **_path_quality(scenario, radius, reached and not collisions.points, path_length, time_to_goal),
         "final_distance_to_goal_m": math.hypot(goal[0] - position[0], goal[1] - position[1]),
         "odometry_error_m": localiser.error(position),
         "trajectory_sha256": _trajectory_digest(positions, position, drive.yaw()),
@@ -475,12 +475,35 @@ def _trajectory_digest(positions: list[np.ndarray], final: np.ndarray, final_yaw
     return digest.hexdigest()
 
 
-def _path_quality(scenario: Scenario, radius: float, reached: bool, path_length: float) -> dict:
-    """The reference shortest path to the goal tolerance disc, and the path length over it."""
+def _path_quality(
+    scenario: Scenario, radius: float, success: bool, path_length: float, time_to_goal: float | None
+) -> dict:
+    """The reference shortest path to the goal tolerance disc, the path length over it, and the
+    BARN score (`barn_score`)."""
     reference = shortest_path_length(scenario, radius)
     optimal = None if reference is None else max(reference - scenario.robot.goal_tolerance, 0.0)
-    ratio = path_length / optimal if reached and optimal else None
-    return {"optimal_length_m": optimal, "path_ratio": ratio}
+    ratio = path_length / optimal if time_to_goal is not None and optimal else None
+    return {
+        "optimal_length_m": optimal,
+        "path_ratio": ratio,
+        "score": barn_score(success, optimal, time_to_goal, ControllerGains().max_speed),
+    }
+
+
+def barn_score(
+    success: bool, optimal_length_m: float | None, time_to_goal_s: float | None, top_speed_mps: float
+) -> float | None:
+    """The BARN benchmark's score (Perille et al. 2020; Xiao et al. 2022): success x OT / clip(T,
+    2 OT, 8 OT), with OT the reference path length over the top speed (s) and T the time to goal
+    (s). In [1/8, 1/2] for a success, 0 otherwise; None when no reference path exists."""
+    if optimal_length_m is None:
+        return None
+    if not success or time_to_goal_s is None:
+        return 0.0
+    optimal_time = optimal_length_m / top_speed_mps
+    if optimal_time <= 0:
+        return 0.5  # the run began within the goal tolerance
+    return optimal_time / min(max(time_to_goal_s, 2 * optimal_time), 8 * optimal_time)
 
 
 TURN_NOISE_RAD = 1e-3
