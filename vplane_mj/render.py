@@ -23,6 +23,7 @@ MODE_RGBA = {
     "avoiding": (0.95, 0.5, 0.0, 1.0),  # orange
     "escaping": (0.1, 0.35, 0.9, 1.0),  # blue
     "trapped": (0.55, 0.0, 0.55, 1.0),  # purple
+    "following": (0.0, 0.6, 0.3, 1.0),  # green
 }
 OTHER_MODE_RGBA = (0.3, 0.3, 0.3, 1.0)
 START_RGBA = (0.1, 0.6, 0.1, 1.0)

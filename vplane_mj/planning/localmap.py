@@ -23,11 +23,30 @@ from scipy import ndimage
 class LocalMap:
     """Certainty grid of obstacle cells around the robot (see the module docstring)."""
 
-    def __init__(self, cell_m: float, size_m: float, hit: int = 3, miss: int = 1, max_certainty: int = 15):
+    def __init__(
+        self,
+        cell_m: float,
+        size_m: float,
+        hit: int = 3,
+        miss: int = 1,
+        max_certainty: int = 15,
+        hit_range_m: float = math.inf,
+        silent_free_m: float = 0.0,
+    ):
         self.cell_m = cell_m
         self.n = max(8, math.ceil(size_m / cell_m))
         self.hit, self.miss, self.max_certainty = hit, miss, max_certainty
+        self.hit_range_m = hit_range_m
+        """Echoes beyond this range (m) only clear their cone: their arc is too wide to place them."""
+        self.silent_free_m = silent_free_m
+        """A reading without an echo marks its cone `seen` free this far (m); it changes no
+        certainty, since it may be a lost reading."""
         self.grid = np.zeros((self.n, self.n), dtype=np.int16)
+        self.seen = np.zeros((self.n, self.n), dtype=bool)
+        """Cells some reading has shown free (inside a cone, short of its echo) or the robot's disc
+        has covered; the others were never seen free (obstacles, or unknown)."""
+        self.swept = np.zeros((self.n, self.n), dtype=bool)
+        """Cells the robot's disc has covered (`sweep`): in a static world, never an obstacle."""
         self.origin: np.ndarray | None = None  # world cell index of grid[0, 0]
 
     def update(
@@ -35,10 +54,13 @@ class LocalMap:
     ) -> None:
         """Fold one scan of the sonar ring (ranges in m from the robot's centre) into the grid."""
         self._follow(position)
-        if not np.isfinite(ranges).any():
+        echoes = np.isfinite(ranges)
+        silent = self.silent_free_m if not echoes.all() else 0.0
+        if not echoes.any() and silent <= 0:
             return
         # Only the cells within the longest reading can change: work on that window.
-        reach = math.ceil(float(np.nanmax(ranges)) / self.cell_m) + 1
+        longest = max(float(np.max(ranges[echoes])) if echoes.any() else 0.0, silent)
+        reach = math.ceil(longest / self.cell_m) + 1
         centre = np.floor(np.asarray(position) / self.cell_m).astype(int) - self.origin
         lo = np.maximum(centre - reach, 0)
         hi = np.minimum(centre + reach + 1, self.n)
@@ -52,12 +74,34 @@ class LocalMap:
         sonar = np.round(bearing / spacing).astype(int) % len(bearings)
         offset = (bearing - sonar * spacing + math.pi) % (2 * math.pi) - math.pi
         reading = ranges[sonar]
-        in_cone = (np.abs(offset) <= beam / 2) & np.isfinite(reading)
+        in_beam = np.abs(offset) <= beam / 2
+        in_cone = in_beam & np.isfinite(reading)
+        if silent > 0:
+            self.seen[lo[0] : hi[0], lo[1] : hi[1]] |= in_beam & np.isnan(reading) & (distance < silent)
         reading = np.where(in_cone, reading, -1.0)
         window = self.grid[lo[0] : hi[0], lo[1] : hi[1]]  # a view: updated in place
-        window -= self.miss * (in_cone & (distance < reading - self.cell_m))
-        window += self.hit * (np.abs(distance - reading) <= 0.75 * self.cell_m)
+        shown_free = in_cone & (distance < reading - self.cell_m)
+        self.seen[lo[0] : hi[0], lo[1] : hi[1]] |= shown_free
+        window -= self.miss * shown_free
+        window += self.hit * (
+            (np.abs(distance - reading) <= 0.75 * self.cell_m) & (reading <= self.hit_range_m)
+        )
         np.clip(window, 0, self.max_certainty, out=window)
+
+    def sweep(self, position: np.ndarray, radius_m: float) -> None:
+        """Mark swept (and seen free) the cells whose centre lies within `radius_m` of a point (m):
+        the robot's own disc stands there, so no obstacle does."""
+        self._follow(position)
+        reach = math.ceil(radius_m / self.cell_m) + 1
+        centre = np.floor(np.asarray(position) / self.cell_m).astype(int) - self.origin
+        lo, hi = np.maximum(centre - reach, 0), np.minimum(centre + reach + 1, self.n)
+        if np.any(hi <= lo):
+            return
+        rel_x = (self.origin[0] + np.arange(lo[0], hi[0]) + 0.5) * self.cell_m - position[0]
+        rel_y = (self.origin[1] + np.arange(lo[1], hi[1]) + 0.5) * self.cell_m - position[1]
+        inside = np.hypot(rel_x[:, None], rel_y[None, :]) <= radius_m
+        self.swept[lo[0] : hi[0], lo[1] : hi[1]] |= inside
+        self.seen[lo[0] : hi[0], lo[1] : hi[1]] |= inside
 
     def cells(self, min_certainty: int = 1) -> tuple[np.ndarray, np.ndarray]:
         """Centres (N, 2) in metres and certainties (N,) of cells at or above a certainty."""
@@ -102,11 +146,12 @@ class LocalMap:
         shift = centre_cell - self.origin
         if np.max(np.abs(shift)) < self.n // 4:
             return
-        moved = np.zeros_like(self.grid)
         src = [slice(max(0, s), self.n + min(0, s)) for s in shift]
         dst = [slice(max(0, -s), self.n + min(0, -s)) for s in shift]
-        moved[dst[0], dst[1]] = self.grid[src[0], src[1]]
-        self.grid = moved
+        for name in ("grid", "seen", "swept"):
+            moved = np.zeros_like(getattr(self, name))
+            moved[dst[0], dst[1]] = getattr(self, name)[src[0], src[1]]
+            setattr(self, name, moved)
         self.origin = centre_cell
 
 

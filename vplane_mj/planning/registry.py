@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Protocol
 
-from vplane_mj.planning import apf, bug2, vfh, vobs, vplane
+from vplane_mj.planning import apf, bug2, vfh, vobs, vplane, vplane_plus
 from vplane_mj.planning.params import PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
 
@@ -23,6 +23,7 @@ Factory = Callable[[Mapping[str, float], float], Planner]
 PLANNERS: dict[str, tuple[PlannerInfo, Factory]] = {
     apf.INFO.name: (apf.INFO, lambda params, _radius: apf.ApfPlanner(params)),
     vplane.INFO.name: (vplane.INFO, vplane.VPlanePlanner),
+    vplane_plus.INFO.name: (vplane_plus.INFO, vplane_plus.VPlanePlusPlanner),
     vobs.INFO.name: (vobs.INFO, lambda params, _radius: vobs.VobsPlanner(params)),
     vfh.INFO.name: (vfh.INFO, vfh.VfhPlanner),
     bug2.INFO.name: (bug2.INFO, lambda params, _radius: bug2.Bug2Planner(params)),

@@ -59,6 +59,7 @@ def make_plane(
     robot: np.ndarray,
     goal: np.ndarray,
     extend: float = 0.0,
+    to_outermost: bool = True,
 ) -> VirtualPlane:
     """The plane e1-e2 whose normal points away from the trap's obstacle points (their mean).
 
@@ -66,8 +67,9 @@ def make_plane(
     toward the robot.
 
     Sonar sees a trap's mouth only at its sampled points, so the extreme points lie a
-    little inside the true ends: the plane is lengthened by `extend` (m) at both ends and
-    moved out along its normal to the trap's outermost point, so that it closes the mouth.
+    little inside the true ends: the plane is lengthened by `extend` (m) at both ends and,
+    with `to_outermost`, moved out along its normal to the trap's outermost point, so that
+    it closes the mouth.
     """
     tangent = unit(e2 - e1)
     normal = np.array([-tangent[1], tangent[0]])
@@ -77,7 +79,7 @@ def make_plane(
         tangent = np.array([normal[1], -normal[0]])
     if (np.mean(trap_points, axis=0) - e1) @ normal > 0:
         normal = -normal
-    outermost = max(0.0, float(np.max((np.asarray(trap_points) - e1) @ normal)))
+    outermost = max(0.0, float(np.max((np.asarray(trap_points) - e1) @ normal))) if to_outermost else 0.0
     shift = outermost * normal
     e1, e2 = e1 - extend * tangent + shift, e2 + extend * tangent + shift
     via_e1 = np.hypot(*(e1 - robot)) + np.hypot(*(goal - e1))

@@ -1,0 +1,165 @@
+"""The clutter extension `vplane_plus` on synthetic sonar scans (pure numpy), and its map search."""
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+from vplane_mj import shapes
+from vplane_mj.planning import gridsearch
+from vplane_mj.planning.registry import make_planner
+from vplane_mj.planning.types import Observation
+from vplane_mj.planning.vplane_geometry import make_plane
+from vplane_mj.scenario import parse_scenario
+from vplane_mj.synthetic import BEAM, BEARINGS, scan
+
+RADIUS = 0.11
+
+CUP = """
+format = 1
+name = "cup"
+[world]
+size = [10.0, 10.0]
+[[world.obstacles]]
+kind = "u"
+center = [5.0, 5.0]
+width = 1.6
+depth = 1.2
+thickness = 0.1
+{extra}
+[robot]
+start = [5.2, 5.0]
+goal = [9.0, 5.0]
+"""
+
+
+def world(extra: str = ""):
+    scenario = parse_scenario(CUP.format(extra=extra), "cup.toml")
+    return scenario, shapes.scene_footprints(scenario.world.obstacles, scenario.world.size)
+
+
+def hold(planner, footprints, position, goal, seconds, yaw=0.0, start_s=0.0):
+    """Keep the robot still at 20 Hz; return every decision."""
+    decisions = []
+    for k in range(round(seconds * 20)):
+        obs = Observation(
+            start_s + k * 0.05,
+            np.asarray(position, float),
+            yaw,
+            np.asarray(goal, float),
+            0.15,
+            BEARINGS,
+            scan(footprints, position, yaw),
+            BEAM,
+        )
+        decisions.append(planner.step(obs))
+    return decisions
+
+
+def drive(planner, footprints, waypoints, goal):
+    """Move the robot along straight legs at 0.5 m/s (20 Hz), facing its way; return the time."""
+    time_s = 0.0
+    for a, b in itertools.pairwise(waypoints):
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        yaw = math.atan2(b[1] - a[1], b[0] - a[0])
+        steps = max(1, round(float(np.hypot(*(b - a))) / 0.025))
+        for k in range(steps):
+            position = a + (b - a) * k / steps
+            ranges = scan(footprints, position, yaw)
+            obs = Observation(time_s, position, yaw, np.asarray(goal, float), 0.15, BEARINGS, ranges, BEAM)
+            planner.step(obs)
+            time_s += 0.05
+    return time_s
+
+
+BOX_BESIDE_MOUTH = """
+[[world.obstacles]]
+kind = "box"
+center = [4.5, 6.325]
+size = [0.2, 0.35]
+"""
+
+
+def test_a_plane_never_spans_a_gap_the_robot_fits_through():
+    """A box 0.35 m beyond the end of the cup's upper arm, in line with the mouth: the robot
+    (0.22 m) fits between them, so the plane that closes the cup must end before the box."""
+    scenario, footprints = world(BOX_BESIDE_MOUTH)
+    box = shapes.Footprints(scenario.world.obstacles[1].footprint())
+    planner = make_planner("vplane_plus", {}, RADIUS)
+    start_s = drive(planner, footprints, [(2.0, 5.0), (5.2, 5.0)], scenario.robot.goal)
+    decisions = hold(planner, footprints, (5.2, 5.0), scenario.robot.goal, 8.0, start_s=start_s)
+    assert any(e.startswith("escape started") for d in decisions for e in d.events)
+    plane = planner.pending_plane
+    assert plane is not None
+    span = np.linspace(plane.e1, plane.e2, 50)
+    assert np.all(np.abs(span[:, 0] - 4.45) < 0.2)  # across the mouth (x = 4.4 to 4.5)
+    assert span[:, 1].min() < 4.5 and span[:, 1].max() > 5.5  # from arm to arm
+    assert float(box.distance(span).min()) > 2 * RADIUS  # and not on to the box
+
+
+def test_no_giving_up_while_the_map_shows_a_way():
+    """Held still in the cup, escape after escape fails: the planner follows the map's way
+    instead of giving up, and its way leaves through the mouth."""
+    scenario, footprints = world()
+    planner = make_planner("vplane_plus", {}, RADIUS)
+    start_s = drive(planner, footprints, [(2.0, 5.0), (5.2, 5.0)], scenario.robot.goal)
+    decisions = hold(planner, footprints, (5.2, 5.0), scenario.robot.goal, 60.0, start_s=start_s)
+    assert not any(d.gave_up for d in decisions)
+    assert planner.following and decisions[-1].mode == "following"
+    assert min(point[0] for point in planner.follow_way) < 4.4 - RADIUS  # out through the mouth
+
+
+def test_it_gives_up_when_the_map_holds_no_way():
+    closed = """
+[[world.obstacles]]
+kind = "box"
+center = [4.35, 5.0]
+size = [0.1, 1.8]
+"""
+    scenario, footprints = world(closed)
+    planner = make_planner("vplane_plus", {"no_way_patience_s": 4.0}, RADIUS)
+    decisions = hold(planner, footprints, (5.0, 5.0), scenario.robot.goal, 40.0)
+    assert any(d.gave_up for d in decisions)
+    assert any("gave up: the map has held no way" in e for d in decisions for e in d.events)
+
+
+def test_a_plane_that_closes_the_only_way_is_retired():
+    """The goal lies before the cup's mouth and the robot inside: a plane across the mouth
+    closes the only way, so following the map retires it."""
+    _, footprints = world()
+    goal = np.array([1.0, 5.0])
+    planner = make_planner("vplane_plus", {"fallback_after": 0}, RADIUS)
+    start_s = drive(planner, footprints, [(2.0, 5.0), (5.2, 5.0)], goal)
+    mouth = make_plane(
+        np.array([4.45, 4.1]), np.array([4.45, 5.9]), np.array([[5.5, 5.0]]), np.array([3.0, 5.0]), goal
+    )
+    planner.planes.append(mouth)
+    decisions = hold(planner, footprints, (5.2, 5.0), goal, 8.0, start_s=start_s)
+    events = [e for d in decisions for e in d.events]
+    assert "virtual plane retired: it closed the only known way to the goal" in events
+    assert mouth not in planner.planes
+
+
+def test_costs_block_the_disc_and_charge_for_closeness():
+    occupied = np.zeros((40, 40), dtype=bool)
+    occupied[20, :] = True
+    doubtful = np.zeros_like(occupied)
+    cost = gridsearch.step_costs(occupied, doubtful, 0.05, 0.11, 0.3, 4.0, 20.0)
+    assert np.isinf(cost[18:23, 5]).all() and np.isfinite(cost[17, 5])  # 0.10 m blocked, 0.15 m not
+    assert cost[17, 5] > cost[14, 5] > cost[5, 5] == 1.0
+    soft = gridsearch.step_costs(doubtful, occupied, 0.05, 0.11, 0.3, 4.0, 20.0)
+    assert np.isfinite(soft).all() and soft[20, 5] > 20  # doubtful: passable at a price
+
+
+def test_the_way_goes_round_a_wall_through_its_gap():
+    cost = np.ones((60, 60))
+    cost[30, :] = np.inf
+    cost[30, 45:50] = 1.0  # a gap at j = 45..49
+    target = np.array([np.ravel_multi_index((50, 10), cost.shape)])
+    costs = gridsearch.cost_to_go(cost, target, np.zeros(1), 0.05)
+    way = gridsearch.descend(costs, (10, 10), 10_000)
+    assert way[-1] == (50, 10)
+    crossing = [j for i, j in way if i == 30]
+    assert crossing and all(45 <= j <= 49 for j in crossing)
+    assert costs[10, 10] == pytest.approx(0.05 * (2 * math.hypot(20, 35)), rel=0.1)

@@ -1,0 +1,192 @@
+"""Shortest ways over the sonar map: where the robot's disc fits, and the cost to go to a target.
+
+Pure numpy and scipy. Each cell gets a step cost from its distance to the nearest obstacle
+cell (`step_costs`): infinite (blocked) closer than the robot's radius plus a clearance, 1 far
+from obstacles, and rising in between, so ways keep their distance where there is room and
+still pass a narrow gap when it is the only one (a costmap's inflation layer). An 8-connected
+grid graph over the finite cells (diagonal moves only between two free orthogonal neighbours,
+so no corner is cut; each move costs its length times the mean of its two cells' costs) gives,
+by Dijkstra, each cell's cost to go to a set of target cells (`cost_to_go`). Cells the sonar
+has never seen count as free: the search is optimistic about the unknown, so a way that is
+not known to be blocked is worth trying, and the map corrects it when the sonar sees more.
+Steepest descent of the cost gives the way itself (`descend`).
+
+Grids are indexed [i, j] with i along world x and j along world y, like the sonar map.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
+
+INFLATED_STEP_COST = 10.0
+"""Step cost of blocked cells made passable (under the robot's own disc, at the goal)."""
+_NEIGHBOURS = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1))
+
+
+def step_costs(
+    sure: np.ndarray,
+    doubtful: np.ndarray,
+    cell_m: float,
+    lethal_m: float,
+    inflation_m: float,
+    inflation_weight: float,
+    doubt_cost: float,
+) -> np.ndarray:
+    """Step cost of each cell from the distances (m) between its centre and the nearest obstacle
+    cell's centre: inf closer than `lethal_m` to a `sure` obstacle cell; `doubt_cost` more closer
+    than that to a `doubtful` one (a way through it is tried only when no other is known, and
+    the sonar settles the doubt on the way); 1 + w ((lethal + inflation - d) / inflation)^2
+    within `inflation_m` beyond the lethal distance of either kind; 1 farther."""
+    cost = np.ones(sure.shape)
+    occupied = sure | doubtful
+    if not occupied.any():
+        return cost
+    d = ndimage.distance_transform_edt(~occupied) * cell_m
+    closeness = np.clip((lethal_m + inflation_m - d) / inflation_m, 0.0, 1.0)
+    cost += inflation_weight * closeness**2 + np.where(d < lethal_m, doubt_cost, 0.0)
+    if sure.any():
+        cost[ndimage.distance_transform_edt(~sure) * cell_m < lethal_m] = np.inf
+    return cost
+
+
+def clear_step_cost(beyond_lethal_m: float, inflation_m: float, inflation_weight: float) -> float:
+    """The largest step cost of a cell at least `beyond_lethal_m` (m) farther than the lethal
+    distance from every obstacle cell, sure or doubtful (see `step_costs`)."""
+    closeness = max(0.0, (inflation_m - beyond_lethal_m) / inflation_m)
+    return 1.0 + inflation_weight * closeness**2
+
+
+@dataclass
+class Window:
+    """A rectangle of grid cells in the world: the step cost `cost[i, j]` of the robot's centre
+    in each (inf: blocked), cells of `cell_m` whose cell (0, 0) has its lower-left corner at
+    `corner` (m)."""
+
+    cost: np.ndarray
+    corner: np.ndarray
+    cell_m: float
+    seen: np.ndarray
+    """Cells known to be free (seen so by the sensors), as opposed to merely unknown."""
+
+    @property
+    def free(self) -> np.ndarray:
+        return np.isfinite(self.cost)
+
+    def cell_of(self, point: np.ndarray) -> tuple[int, int] | None:
+        """The cell that holds a world point (m), None outside the window."""
+        i, j = np.floor((np.asarray(point, float) - self.corner) / self.cell_m).astype(int)
+        if 0 <= i < self.cost.shape[0] and 0 <= j < self.cost.shape[1]:
+            return int(i), int(j)
+        return None
+
+    def free_cell_near(self, point: np.ndarray, radius_m: float) -> tuple[int, int] | None:
+        """The free cell nearest a point (m) within `radius_m`, None when there is none."""
+        distance = np.hypot(*np.moveaxis(self.centres() - point, -1, 0))
+        distance[~self.free | (distance > radius_m)] = np.inf
+        best = np.unravel_index(int(np.argmin(distance)), distance.shape)
+        return (int(best[0]), int(best[1])) if np.isfinite(distance[best]) else None
+
+    def centre(self, cell: tuple[int, int]) -> np.ndarray:
+        """The world point (m) at a cell's centre."""
+        return self.corner + (np.asarray(cell, float) + 0.5) * self.cell_m
+
+    def centres(self) -> np.ndarray:
+        """Every cell's centre (m), shaped like `free` plus a last axis of 2."""
+        i, j = np.meshgrid(np.arange(self.cost.shape[0]), np.arange(self.cost.shape[1]), indexing="ij")
+        return self.corner + (np.stack([i, j], axis=-1) + 0.5) * self.cell_m
+
+    def clear_disc(self, point: np.ndarray, radius_m: float) -> None:
+        """Make passable the blocked cells whose centre lies within `radius_m` of a point (m)."""
+        near = np.hypot(*np.moveaxis(self.centres() - point, -1, 0)) <= radius_m
+        cell = self.cell_of(point)
+        if cell is not None:
+            near[cell] = True
+        self.cost[near & ~np.isfinite(self.cost)] = INFLATED_STEP_COST
+
+    def block_segment(self, a: np.ndarray, b: np.ndarray) -> None:
+        """Mark blocked the cells a segment (m) passes through, thickened so no diagonal step
+        slips between them."""
+        steps = max(2, math.ceil(2 * float(np.hypot(*(b - a))) / self.cell_m) + 1)
+        points = np.linspace(a, b, steps)
+        cells = np.floor((points - self.corner) / self.cell_m).astype(int)
+        for di, dj in ((0, 0), (1, 0), (0, 1), (1, 1)):
+            i, j = cells[:, 0] + di, cells[:, 1] + dj
+            inside = (i >= 0) & (i < self.cost.shape[0]) & (j >= 0) & (j < self.cost.shape[1])
+            self.cost[i[inside], j[inside]] = np.inf
+
+    def line_of_sight(self, a: np.ndarray, b: np.ndarray) -> bool:
+        """Whether the straight segment between two world points (m) stays on free cells (or
+        leaves the window), sampled every half cell."""
+        steps = max(2, math.ceil(2 * float(np.hypot(*(b - a))) / self.cell_m) + 1)
+        cells = np.floor((np.linspace(a, b, steps) - self.corner) / self.cell_m).astype(int)
+        i, j = cells[:, 0], cells[:, 1]
+        inside = (i >= 0) & (i < self.cost.shape[0]) & (j >= 0) & (j < self.cost.shape[1])
+        return bool(np.all(np.isfinite(self.cost[i[inside], j[inside]])))
+
+
+def cost_to_go(cost: np.ndarray, targets: np.ndarray, target_costs: np.ndarray, cell_m: float) -> np.ndarray:
+    """Least cost (m, weighted by the step costs) from every cell to the targets; inf where no
+    target is reachable.
+
+    `targets` are flat indices of cells, each starting at its `target_costs` (m): a target
+    outside the grid is represented by the border cells with their straight distance to it.
+    Targets on blocked cells are dropped.
+    """
+    nx, ny = cost.shape
+    n = nx * ny
+    free = np.isfinite(cost)
+    index = np.arange(n).reshape(nx, ny)
+    rows, cols, weights = [], [], []
+
+    def link(a: tuple[slice, slice], b: tuple[slice, slice], mask: np.ndarray, length: float) -> None:
+        rows.append(index[a][mask])
+        cols.append(index[b][mask])
+        weights.append(length * 0.5 * (cost[a][mask] + cost[b][mask]))
+
+    all_, head, tail = slice(None), slice(None, -1), slice(1, None)
+    link((all_, head), (all_, tail), free[:, :-1] & free[:, 1:], cell_m)
+    link((head, all_), (tail, all_), free[:-1, :] & free[1:, :], cell_m)
+    square = free[:-1, :-1] & free[:-1, 1:] & free[1:, :-1] & free[1:, 1:]
+    link((head, head), (tail, tail), square, cell_m * math.sqrt(2))
+    link((head, tail), (tail, head), square, cell_m * math.sqrt(2))
+    keep = free.ravel()[targets]
+    targets, target_costs = targets[keep], target_costs[keep]
+    if not len(targets):
+        return np.full((nx, ny), np.inf)
+    # One extra node, the source, joins every target at its starting cost (a tiny positive
+    # weight stands for zero: the sparse graph drops explicit zeros).
+    rows.append(np.full(len(targets), n))
+    cols.append(targets)
+    weights.append(np.maximum(target_costs, 1e-9))
+    graph = coo_matrix(
+        (np.concatenate(weights), (np.concatenate(rows), np.concatenate(cols))), shape=(n + 1, n + 1)
+    ).tocsr()
+    costs = dijkstra(graph, directed=False, indices=n)
+    return costs[:n].reshape(nx, ny)
+
+
+def descend(costs: np.ndarray, start: tuple[int, int], max_cells: int) -> list[tuple[int, int]]:
+    """The cells from `start` down the cost to the target (steepest descent over 8 neighbours),
+    at most `max_cells` steps; just `start` when it has no finite cost."""
+    nx, ny = costs.shape
+    path = [start]
+    i, j = start
+    if not np.isfinite(costs[i, j]):
+        return path
+    for _ in range(max_cells):
+        best, best_cost = None, costs[i, j]
+        for di, dj in _NEIGHBOURS:
+            a, b = i + di, j + dj
+            if 0 <= a < nx and 0 <= b < ny and costs[a, b] < best_cost:
+                best, best_cost = (a, b), costs[a, b]
+        if best is None:
+            break
+        i, j = best
+        path.append(best)
+    return path

@@ -1,0 +1,473 @@
+"""The paper's method made robust in clutter (`vplane_plus`).
+
+The structure of Algorithm 3 stays: F = F_A + F_R + F_P in `normal` mode (eqs. 3, 5, 8-10),
+histogram avoidance of concave obstacles (Algorithm 1, `avoiding`), and on a local minimum a
+virtual new objective on the bisector of the trap's extreme points (Algorithm 2, `escaping`)
+followed by a virtual plane e1-e2 that keeps the robot out of the trap. What the paper leaves
+open is decided with what the sonar map remembers (`gridsearch`: the map's obstacle cells
+inflated by the robot's disc, the unknown counted as free):
+
+- the trap is one obstacle: the connected obstacle cells nearest toward the goal, where cells
+  separated by a gap the robot fits through belong to different obstacles; e1 and e2 are its
+  angular ends, and a plane whose segment passes another obstacle (so it would span a gap
+  between two) is not created;
+- the virtual new objective must lie on a cell the map says is free and reachable from the
+  robot, outside the trap; the paper's point on the bisector is kept when it is, else the
+  nearest such cell is taken; the robot goes there along the map's shortest way (`escaping`);
+- a plane that cuts the only known way to the goal is retired;
+- after `fallback_after` escapes, the robot follows the map's shortest way to the goal
+  (`following`), replanned as the map grows: with a map that remembers, this finds the goal
+  whenever the sonar can show a way (a complete fallback); the planner gives up only when the
+  map holds no way to the goal at all for `no_way_patience_s`.
+
+Every decision is an event (`/events`), and objectives and planes appear in `/virtual`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+
+import numpy as np
+from scipy import ndimage
+
+from vplane_mj.planning import fields, gridsearch
+from vplane_mj.planning.apf import firas_components
+from vplane_mj.planning.localmap import LocalMap, angular_extremes
+from vplane_mj.planning.params import Param, PlannerInfo
+from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.planning.vplane import PARAMS as VPLANE_PARAMS
+from vplane_mj.planning.vplane import VPlanePlanner
+from vplane_mj.planning.vplane_geometry import VirtualPlane, make_plane, unit, virtual_objective
+
+LANE_MARGIN_M = 0.02
+"""An echo closer than the robot radius plus this to the way's line ahead blocks the robot's lane."""
+SILENT_FREE_M = 1.0
+"""A sonar that hears no echo shows its first metre free, for the choice of objectives only."""
+OBJECTIVE_ROOM_M = 0.05
+"""A virtual objective lies at least this much beyond the robot's disc from every mapped obstacle."""
+TRAP_REACH_M = 2.5
+"""Obstacle cells farther than this from the robot are not part of the trap it is in."""
+
+
+def _with_default(param: Param, default: float) -> Param:
+    return dataclasses.replace(param, default=default)
+
+
+PARAMS: dict[str, Param] = {
+    **VPLANE_PARAMS,
+    "map_cell_m": _with_default(VPLANE_PARAMS["map_cell_m"], 0.05),
+    "map_size_m": _with_default(VPLANE_PARAMS["map_size_m"], 16.0),
+    "map_hit": Param(1, "", "certainty an echo adds to each cell of its arc", ge=1, le=15, integer=True),
+    "map_miss": Param(
+        2, "", "certainty a reading removes from the cells it shows free", ge=0, le=15, integer=True
+    ),
+    "path_clearance_m": Param(
+        0.0, "m", "the map's ways never pass closer than the robot radius plus this", ge=0, le=1.0
+    ),
+    "inflation_m": Param(0.3, "m", "beyond that, the map's ways pay for passing closer than this", gt=0),
+    "inflation_weight": Param(4.0, "", "extra step cost right at the clearance (costmap inflation)", ge=0),
+    "map_hit_range_m": Param(1.5, "m", "echoes farther than this only clear the map (arcs too wide)", gt=0),
+    "map_sure": Param(
+        10, "", "certainty at which an obstacle cell is sure (lower: doubtful)", ge=1, integer=True
+    ),
+    "doubt_cost": Param(20.0, "", "extra step cost of passing a doubtful obstacle cell", ge=0),
+    "waypoint_m": Param(1.0, "m", "how far along the map's way the robot is attracted", gt=0),
+    "replan_period_s": Param(0.5, "s", "the map's way is searched again this often", gt=0),
+    "search_margin_m": Param(2.5, "m", "the search covers the robot and the goal plus this margin", gt=0),
+    "follow_influence_m": Param(0.35, "m", "f0 of the echo repulsion while following the map's way", gt=0),
+    "fallback_after": Param(
+        2, "", "escapes before the map's way is followed to the goal", ge=0, integer=True
+    ),
+    "no_way_patience_s": Param(8.0, "s", "give up after the map has held no way to the goal this long", gt=0),
+}
+
+INFO = PlannerInfo(
+    name="vplane_plus",
+    summary="the paper's method with map-checked extreme points, objectives and planes, and a "
+    "map-way fallback (clutter)",
+    citation="A Novel Approach to Local Minima Problem in Robot Path Planning Using Artificial "
+    "Potential Field (virtual plane method), extended for clutter",
+    params=PARAMS,
+)
+
+
+class VPlanePlusPlanner(VPlanePlanner):
+    """The paper's state machine plus the map's ways (see the module docstring)."""
+
+    def __init__(self, params: Mapping[str, float], robot_radius_m: float):
+        super().__init__(params, robot_radius_m)
+        p = self.params
+        self.map = LocalMap(
+            p["map_cell_m"],
+            p["map_size_m"],
+            hit=round(p["map_hit"]),
+            miss=round(p["map_miss"]),
+            hit_range_m=p["map_hit_range_m"],
+            silent_free_m=SILENT_FREE_M,
+        )
+        self.escape_way: list[np.ndarray] = []  # waypoints (m) to the virtual objective
+        self.following = False
+        self.follow_way: list[np.ndarray] = []
+        self.next_replan_s = 0.0
+        self.no_way_since: float | None = None
+        self.sight: gridsearch.Window | None = None  # the window of the latest way, for sight lines
+
+    # -- the loop -------------------------------------------------------------------------
+    def step(self, obs: Observation) -> Decision:
+        p = self.params
+        self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
+        self.map.sweep(obs.position, self.radius)
+        decision = Decision(force=np.zeros(2), mode="normal")
+        self._retire_planes(obs, decision)
+
+        near_goal = obs.distance_to_goal() <= obs.goal_tolerance
+        state = self.detector.update(obs.time_s, obs.position, near_goal)
+        if state.new:
+            decision.local_minimum = True
+            decision.events.append("local minimum detected")
+            if self.following:
+                self.next_replan_s = obs.time_s  # look for a way again at once
+                self.detector.reset()
+            else:
+                self._start_escape(obs, decision)
+        elif self.temp_goal is not None and obs.time_s - self.escape_started_s > p["escape_timeout_s"]:
+            decision.events.append("escape timed out")
+            self._start_escape(obs, decision)
+
+        if self.temp_goal is not None and np.hypot(*(obs.position - self.temp_goal)) <= p["vno_tolerance_m"]:
+            self._finish_escape(obs, decision)
+
+        components = firas_components(obs, p)
+        if p["goal_fade_m"] > 0:  # goals near obstacles stay reachable (GNRON)
+            components["repulsive"] *= min(1.0, obs.distance_to_goal() / p["goal_fade_m"]) ** 2
+        if self.temp_goal is not None:
+            decision.mode = "escaping"
+            target = self._next_waypoint(obs.position, self.escape_way, self.temp_goal)
+            pull = 2.0 * p["vno_gain"] * float(np.hypot(*(obs.position - self.temp_goal)))  # eq. 7
+            self._along_the_way(obs, components, target, pull)
+        elif self.following:
+            decision.mode = "following"
+            target = self._follow_target(obs, decision)
+            if decision.gave_up:
+                return decision
+            goal_pull = fields.attractive_force(
+                obs.position, obs.goal, p["attract_gain"], p["attract_radius"]
+            )
+            self._along_the_way(obs, components, target, float(np.hypot(*goal_pull)))
+        else:
+            self._update_avoidance(obs, decision)
+            if self.avoid_waypoint is not None:
+                decision.mode = "avoiding"
+                components["attractive"] = fields.attractive_force(
+                    obs.position, self.avoid_waypoint, p["attract_gain"], p["attract_radius"]
+                )
+        # While following the map's way the planes act as walls of the search instead: their
+        # force would push the robot off a way that skirts a plane's end.
+        components["virtual"] = np.zeros(2) if self.following else self._planes_force(obs.position)
+        decision.components = components
+        decision.force = sum(components.values(), np.zeros(2))
+        decision.objective = self.temp_goal
+        decision.planes = [(plane.e1, plane.e2) for plane in self.planes]
+        return decision
+
+    def _along_the_way(
+        self, obs: Observation, components: dict[str, np.ndarray], waypoint: np.ndarray, pull: float
+    ) -> None:
+        """Forces while the robot follows a way of the map: the attraction of the way's end
+        (magnitude `pull`) turned toward the next waypoint, and the repulsion of the echoes
+        within `follow_influence_m`. While no echo lies in the disc's own lane ahead, the part
+        of the repulsion against the way is dropped: the way already keeps the robot off the
+        mapped obstacles, and that part would stop it at every narrow gap."""
+        p = self.params
+        heading = unit(waypoint - obs.position)
+        components["attractive"] = pull * heading
+        echoes = obs.echo_points()
+        repulsive = fields.repulsive_force(obs.position, echoes, p["repulse_gain"], p["follow_influence_m"])
+        if p["goal_fade_m"] > 0:
+            repulsive *= min(1.0, obs.distance_to_goal() / p["goal_fade_m"]) ** 2
+        rel = echoes - obs.position
+        ahead = rel @ heading
+        lateral = np.abs(rel @ np.array([-heading[1], heading[0]]))
+        in_lane = (ahead > 0) & (ahead < p["follow_influence_m"]) & (lateral < self.radius + LANE_MARGIN_M)
+        if not in_lane.any():
+            repulsive = repulsive - min(float(repulsive @ heading), 0.0) * heading
+        components["repulsive"] = repulsive
+
+    # -- Algorithm 2 with the map ------------------------------------------------------------
+    def _start_escape(self, obs: Observation, decision: Decision) -> bool:
+        """Place a map-checked virtual objective and a pending plane, or switch to following."""
+        self.avoid_waypoint = None
+        self.temp_goal = None
+        self.pending_plane = None
+        self.detector.reset()
+        if self.escapes_tried >= self.params["fallback_after"]:
+            self._start_following(obs, decision, f"after {self.escapes_tried} escapes")
+            return True
+        trap = self._trap_obstacle(obs.position, obs.goal)
+        if trap is None:
+            self._start_following(obs, decision, "no mapped obstacle traps the robot")
+            return True
+        cells, others = trap
+        i1, i2, _ = angular_extremes(obs.position, cells)
+        e1, e2 = cells[i1], cells[i2]
+        # The map's sure cells place the trap's ends: the plane joins them as they are.
+        plane = make_plane(
+            e1, e2, cells, obs.position, obs.goal, extend=self._link_m() / 2, to_outermost=False
+        )
+        clearance = self.radius + self.params["escape_margin_m"]
+        window = self._window(obs.position, obs.goal, self.planes)
+        if self._spans_a_gap(plane, others):
+            decision.events.append(
+                f"no virtual plane: e1=({e1[0]:.2f}, {e1[1]:.2f}) e2=({e2[0]:.2f}, {e2[1]:.2f}) "
+                "would span a gap between obstacles"
+            )
+            plane = None
+        elif self._way(
+            self._window(obs.position, obs.goal, [*self.planes, plane], doubtful_walls=True),
+            obs.position,
+            obs.goal,
+        ):
+            decision.events.append(
+                f"no virtual plane: e1=({e1[0]:.2f}, {e1[1]:.2f}) e2=({e2[0]:.2f}, {e2[1]:.2f}) "
+                "would close no trap (the map shows another way out)"
+            )
+            plane = None
+        frame = plane or make_plane(e1, e2, cells, obs.position, obs.goal)
+        candidate = virtual_objective(obs.position, e1, e2, obs.goal, frame, clearance)
+        objective, way = self._reachable_objective(obs.position, candidate, plane, clearance, window)
+        if objective is None:
+            self._start_following(obs, decision, "no free, reachable cell outside the trap")
+            return True
+        self.temp_goal, self.escape_way, self.pending_plane = objective, way, plane
+        self.escape_started_s = obs.time_s
+        self.escapes_tried += 1
+        decision.events.append(
+            f"escape started: e1=({e1[0]:.2f}, {e1[1]:.2f}) e2=({e2[0]:.2f}, {e2[1]:.2f}) "
+            f"objective=({objective[0]:.2f}, {objective[1]:.2f})"
+        )
+        return True
+
+    def _finish_escape(self, obs: Observation, decision: Decision) -> None:
+        """Objective reached: re-activate the target and add the plane to L, unless the map
+        then holds no way from here to the goal (the plane would cut the only known way)."""
+        plane, self.temp_goal, self.pending_plane, self.escape_way = self.pending_plane, None, None, []
+        self.detector.reset()
+        decision.escape_completed = True
+        if plane is None:
+            decision.events.append("objective reached: target re-activated (no virtual plane)")
+            return
+        if (
+            self._way(self._window(obs.position, obs.goal, [*self.planes, plane]), obs.position, obs.goal)
+            is None
+        ):
+            decision.events.append(
+                "objective reached: target re-activated; no virtual plane, it would cut the only known "
+                "way to the goal"
+            )
+            return
+        self.planes.append(plane)
+        if len(self.planes) > self.params["max_planes"]:
+            self.planes.pop(0)
+            decision.events.append("oldest virtual plane retired")
+        decision.events.append("objective reached: virtual plane created, target re-activated")
+
+    def _trap_obstacle(self, position: np.ndarray, goal: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """Cell centres of the one obstacle that traps the robot, and of every other obstacle
+        cell near it; None when no obstacle cell is near. Only sure cells count: a doubtful
+        cell may be a phantom of a wide beam, and must not place a plane.
+
+        Obstacle cells belong to one obstacle when the gaps between them are narrower than
+        the robot's width plus clearance (so a gap the robot fits through separates two).
+        """
+        p = self.params
+        occupied = (self.map.grid >= p["map_sure"]) & ~self.map.swept
+        if self.map.origin is None or not occupied.any():
+            return None
+        reach = round(self._link_m() / 2 / self.map.cell_m)
+        offsets = (
+            np.hypot(*np.mgrid[-reach : reach + 1, -reach : reach + 1])
+            <= self._link_m() / 2 / self.map.cell_m
+        )
+        labels, _ = ndimage.label(
+            ndimage.binary_dilation(occupied, structure=offsets), structure=np.ones((3, 3), bool)
+        )
+        i, j = np.nonzero(occupied)
+        centres = (np.column_stack((i, j)) + self.map.origin + 0.5) * self.map.cell_m
+        rel = centres - position
+        distance = np.hypot(rel[:, 0], rel[:, 1])
+        near = distance <= TRAP_REACH_M
+        if not near.any():
+            return None
+        centres, rel, distance, cell_labels = (
+            centres[near],
+            rel[near],
+            distance[near],
+            labels[i[near], j[near]],
+        )
+        ahead = rel @ unit(goal - position) > 0.5 * distance
+        pool = np.flatnonzero(ahead) if ahead.any() else np.arange(len(centres))
+        trap = cell_labels == cell_labels[pool[np.argmin(distance[pool])]]
+        return centres[trap], centres[~trap]
+
+    def _spans_a_gap(self, plane: VirtualPlane, others: np.ndarray) -> bool:
+        """Whether the plane's segment passes within the robot's width of another obstacle:
+        it would then close a gap between two obstacles, not the mouth of one."""
+        if not len(others):
+            return False
+        span = plane.e2 - plane.e1
+        t = np.clip((others - plane.e1) @ span / max(float(span @ span), 1e-12), 0.0, 1.0)
+        gaps = np.hypot(*(others - (plane.e1 + t[:, None] * span)).T)
+        return bool(np.min(gaps) < self._link_m() / 2)
+
+    def _reachable_objective(
+        self,
+        robot: np.ndarray,
+        candidate: np.ndarray,
+        plane: VirtualPlane | None,
+        clearance: float,
+        window: gridsearch.Window,
+    ) -> tuple[np.ndarray | None, list[np.ndarray]]:
+        """The paper's objective if the map has seen it free, clear of obstacles and reachable,
+        else the nearest such cell outside the trap; with the map's way there. (None, []) when
+        there is none."""
+        start = window.free_cell_near(robot, 2 * self.radius)
+        if start is None:
+            return None, []
+        origin = np.array([np.ravel_multi_index(start, window.cost.shape)])
+        costs = gridsearch.cost_to_go(window.cost, origin, np.zeros(1), window.cell_m)
+        # Known free with room around it: far enough from mapped obstacles and from every cell
+        # the sonar has not seen free (an obstacle the map has not placed may stand there).
+        room = self.radius + OBJECTIVE_ROOM_M
+        roomy = gridsearch.clear_step_cost(
+            OBJECTIVE_ROOM_M, self.params["inflation_m"], self.params["inflation_weight"]
+        )
+        seen_around = ndimage.distance_transform_edt(window.seen) * window.cell_m >= room
+        usable = np.isfinite(costs) & seen_around & (window.cost <= roomy)
+        centres = window.centres()
+        if plane is not None:
+            usable &= (centres - plane.e1) @ plane.normal >= clearance
+        cell = window.cell_of(candidate)
+        if cell is None or not usable[cell]:
+            if not usable.any():
+                return None, []
+            distance = np.hypot(*np.moveaxis(centres - candidate, -1, 0))
+            cell = np.unravel_index(int(np.argmin(np.where(usable, distance, np.inf))), distance.shape)
+            candidate = window.centre(cell)
+        return candidate, self._way(window, robot, candidate)
+
+    # -- following the map's way -------------------------------------------------------------
+    def _start_following(self, obs: Observation, decision: Decision, why: str) -> None:
+        self.following = True
+        self.next_replan_s = obs.time_s
+        decision.events.append(f"following the map's way to the goal ({why})")
+
+    def _follow_target(self, obs: Observation, decision: Decision) -> np.ndarray:
+        """The waypoint on the map's way to the goal; replanned every `replan_period_s`.
+
+        Planes that close the only known way are retired; with no way at all the robot is
+        attracted to the goal itself, and gives up after `no_way_patience_s`.
+        """
+        p = self.params
+        waypoint = self._next_waypoint(obs.position, self.follow_way, obs.goal)
+        if obs.time_s < self.next_replan_s and self.follow_way:
+            return waypoint
+        self.next_replan_s = obs.time_s + p["replan_period_s"]
+        way = self._way_to_goal(obs, decision)
+        if way is None:
+            self.follow_way = []
+            if self.no_way_since is None:
+                self.no_way_since = obs.time_s
+                decision.events.append("the map holds no way to the goal")
+            elif obs.time_s - self.no_way_since >= p["no_way_patience_s"]:
+                decision.gave_up = True
+                decision.events.append(
+                    f"gave up: the map has held no way to the goal for {p['no_way_patience_s']:g} s"
+                )
+            return obs.goal
+        if self.no_way_since is not None:
+            decision.events.append("the map shows a way to the goal again")
+        self.no_way_since = None
+        self.follow_way = way
+        return self._next_waypoint(obs.position, way, obs.goal)
+
+    def _way_to_goal(self, obs: Observation, decision: Decision) -> list[np.ndarray] | None:
+        """The map's way to the goal with the planes as walls; planes that leave no way are
+        retired (newest first). None when the map holds no way even without planes."""
+        way = self._way(self._window(obs.position, obs.goal, self.planes), obs.position, obs.goal)
+        while way is None and self.planes:
+            self.planes.pop()
+            decision.events.append("virtual plane retired: it closed the only known way to the goal")
+            way = self._way(self._window(obs.position, obs.goal, self.planes), obs.position, obs.goal)
+        return way
+
+    # -- the map -----------------------------------------------------------------------------
+    def _window(
+        self, robot: np.ndarray, goal: np.ndarray, planes: list[VirtualPlane], doubtful_walls: bool = False
+    ) -> gridsearch.Window:
+        """Step costs for the robot's centre around the robot and the goal, planes as walls (and
+        doubtful obstacle cells too with `doubtful_walls`: does a plane close a trap?)."""
+        p, grid, cell = self.params, self.map.grid, self.map.cell_m
+        margin = p["search_margin_m"]
+        low = np.floor((np.minimum(robot, goal) - margin) / cell).astype(int) - self.map.origin
+        high = np.ceil((np.maximum(robot, goal) + margin) / cell).astype(int) - self.map.origin
+        low, high = np.clip(low, 0, self.map.n), np.clip(high, 0, self.map.n)
+        inside = (slice(low[0], high[0]), slice(low[1], high[1]))
+        certainty = np.where(self.map.swept[inside], 0, grid[inside])
+        cost = gridsearch.step_costs(
+            certainty >= p["map_sure"],
+            (certainty >= p["map_threshold"]) & (certainty < p["map_sure"]),
+            cell,
+            self.radius + p["path_clearance_m"],
+            p["inflation_m"],
+            p["inflation_weight"],
+            np.inf if doubtful_walls else p["doubt_cost"],
+        )
+        seen = self.map.seen[inside].copy()
+        window = gridsearch.Window(cost, (self.map.origin + low) * cell, cell, seen)
+        window.clear_disc(robot, self.radius)  # the robot stands there: its disc is free
+        for plane in planes:  # but no way crosses a virtual plane, even under the robot
+            window.block_segment(plane.e1, plane.e2)
+        return window
+
+    def _way(self, window: gridsearch.Window, start: np.ndarray, end: np.ndarray) -> list[np.ndarray] | None:
+        """Waypoints (m) of the map's shortest way from `start` to `end` (beyond the window:
+        toward it in a straight line from the window's edge); None when there is none."""
+        shape = window.cost.shape
+        end_cell = window.cell_of(end)
+        if end_cell is not None:
+            window.clear_disc(end, self.radius)
+            targets, target_costs = np.array([np.ravel_multi_index(end_cell, shape)]), np.zeros(1)
+        else:
+            edge = np.zeros(shape, dtype=bool)
+            edge[[0, -1], :] = edge[:, [0, -1]] = True
+            targets = np.flatnonzero(edge)
+            centres = window.centres().reshape(-1, 2)[targets]
+            target_costs = np.hypot(*(centres - end).T)
+        costs = gridsearch.cost_to_go(window.cost, targets, target_costs, window.cell_m)
+        start_cell = window.free_cell_near(start, 2 * self.radius)
+        if start_cell is None or not np.isfinite(costs[start_cell]):
+            return None
+        cells = gridsearch.descend(costs, start_cell, shape[0] * shape[1])
+        way = [window.centre(c) for c in cells[1:]]
+        if end_cell is not None:
+            way.append(np.asarray(end, float))
+        self.sight = window
+        return way
+
+    def _next_waypoint(self, position: np.ndarray, way: list[np.ndarray], end: np.ndarray) -> np.ndarray:
+        """The farthest point of the way within `waypoint_m` that the robot sees in a straight
+        line on the map; the way's end when the way is empty."""
+        if not way:
+            return end
+        reach = self.params["waypoint_m"]
+        distances = [float(np.hypot(*(point - position))) for point in way]
+        nearest = int(np.argmin(distances))
+        del way[:nearest]  # the robot has passed these
+        best = way[0]
+        for point in way[1:]:
+            if np.hypot(*(point - position)) > reach:
+                break
+            if self.sight is None or self.sight.line_of_sight(position, point):
+                best = point
+        return best
