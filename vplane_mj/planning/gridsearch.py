@@ -109,6 +109,11 @@ class Window:
             near[cell] = True
         self.cost[near & ~np.isfinite(self.cost)] = INFLATED_STEP_COST
 
+    def charge_disc(self, point: np.ndarray, radius_m: float, extra: float) -> None:
+        """Add `extra` to the step cost of the cells whose centre lies within `radius_m` of a
+        point (m)."""
+        self.cost[np.hypot(*np.moveaxis(self.centres() - point, -1, 0)) <= radius_m] += extra
+
     def block_segment(self, a: np.ndarray, b: np.ndarray) -> None:
         """Mark blocked the cells a segment (m) passes through, thickened so no diagonal step
         slips between them."""

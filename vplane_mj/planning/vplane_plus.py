@@ -26,6 +26,7 @@ Every decision is an event (`/events`), and objectives and planes appear in `/vi
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Mapping
 
 import numpy as np
@@ -40,8 +41,10 @@ from vplane_mj.planning.vplane import PARAMS as VPLANE_PARAMS
 from vplane_mj.planning.vplane import VPlanePlanner
 from vplane_mj.planning.vplane_geometry import VirtualPlane, make_plane, unit, virtual_objective
 
-LANE_MARGIN_M = 0.02
-"""An echo closer than the robot radius plus this to the way's line ahead blocks the robot's lane."""
+STALL_RADIUS_M = 0.3
+"""Passing within this distance (m) of where the way was held up costs as much as a doubtful cell."""
+BLOCK_LOOKAHEAD_M = 0.6
+"""The way this far ahead (m) is checked against the map every tick; if blocked, it is replanned."""
 SILENT_FREE_M = 1.0
 """A sonar that hears no echo shows its first metre free, for the choice of objectives only."""
 OBJECTIVE_ROOM_M = 0.05
@@ -76,6 +79,7 @@ PARAMS: dict[str, Param] = {
     "replan_period_s": Param(0.5, "s", "the map's way is searched again this often", gt=0),
     "search_margin_m": Param(2.5, "m", "the search covers the robot and the goal plus this margin", gt=0),
     "follow_influence_m": Param(0.35, "m", "f0 of the echo repulsion while following the map's way", gt=0),
+    "guard_m": Param(0.25, "m", "f0 of the repulsion of the nearest mapped obstacle cell", gt=0),
     "fallback_after": Param(
         2, "", "escapes before the map's way is followed to the goal", ge=0, integer=True
     ),
@@ -112,6 +116,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         self.next_replan_s = 0.0
         self.no_way_since: float | None = None
         self.sight: gridsearch.Window | None = None  # the window of the latest way, for sight lines
+        self.stalls: list[np.ndarray] = []  # where following the way was held up (m)
 
     # -- the loop -------------------------------------------------------------------------
     def step(self, obs: Observation) -> Decision:
@@ -127,7 +132,12 @@ class VPlanePlusPlanner(VPlanePlanner):
             decision.local_minimum = True
             decision.events.append("local minimum detected")
             if self.following:
-                self.next_replan_s = obs.time_s  # look for a way again at once
+                # Held up on the way: the map missed something there. Charge for passing that
+                # place again, and look for a way at once.
+                stuck_at = self._next_waypoint(obs.position, self.follow_way, obs.goal)
+                self.stalls.append(stuck_at)
+                decision.events.append(f"held up on the way near ({stuck_at[0]:.2f}, {stuck_at[1]:.2f})")
+                self.next_replan_s = obs.time_s
                 self.detector.reset()
             else:
                 self._start_escape(obs, decision)
@@ -143,6 +153,9 @@ class VPlanePlusPlanner(VPlanePlanner):
             components["repulsive"] *= min(1.0, obs.distance_to_goal() / p["goal_fade_m"]) ** 2
         if self.temp_goal is not None:
             decision.mode = "escaping"
+            if self._way_is_blocked(obs.position, self.escape_way):
+                window = self._window(obs.position, self.temp_goal, self.planes, margin=p["search_margin_m"])
+                self.escape_way = self._way(window, obs.position, self.temp_goal) or []
             target = self._next_waypoint(obs.position, self.escape_way, self.temp_goal)
             pull = 2.0 * p["vno_gain"] * float(np.hypot(*(obs.position - self.temp_goal)))  # eq. 7
             self._along_the_way(obs, components, target, pull)
@@ -165,6 +178,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         # While following the map's way the planes act as walls of the search instead: their
         # force would push the robot off a way that skirts a plane's end.
         components["virtual"] = np.zeros(2) if self.following else self._planes_force(obs.position)
+        components["map"] = self._nearest_cell_force(obs.position)
         decision.components = components
         decision.force = sum(components.values(), np.zeros(2))
         decision.objective = self.temp_goal
@@ -176,23 +190,56 @@ class VPlanePlusPlanner(VPlanePlanner):
     ) -> None:
         """Forces while the robot follows a way of the map: the attraction of the way's end
         (magnitude `pull`) turned toward the next waypoint, and the repulsion of the echoes
-        within `follow_influence_m`. While no echo lies in the disc's own lane ahead, the part
-        of the repulsion against the way is dropped: the way already keeps the robot off the
-        mapped obstacles, and that part would stop it at every narrow gap."""
+        within `follow_influence_m` without its part against the way. The way keeps the robot
+        off the mapped obstacles, and the nearest mapped cell still repels at close range
+        (`_nearest_cell_force`); the echoes' part against the way would stop the robot at
+        every narrow gap, since an echo is placed on its sonar's axis, up to half a beam away
+        from the obstacle that returned it."""
         p = self.params
         heading = unit(waypoint - obs.position)
         components["attractive"] = pull * heading
-        echoes = obs.echo_points()
-        repulsive = fields.repulsive_force(obs.position, echoes, p["repulse_gain"], p["follow_influence_m"])
+        repulsive = fields.repulsive_force(
+            obs.position, obs.echo_points(), p["repulse_gain"], p["follow_influence_m"]
+        )
         if p["goal_fade_m"] > 0:
             repulsive *= min(1.0, obs.distance_to_goal() / p["goal_fade_m"]) ** 2
-        rel = echoes - obs.position
-        ahead = rel @ heading
-        lateral = np.abs(rel @ np.array([-heading[1], heading[0]]))
-        in_lane = (ahead > 0) & (ahead < p["follow_influence_m"]) & (lateral < self.radius + LANE_MARGIN_M)
-        if not in_lane.any():
-            repulsive = repulsive - min(float(repulsive @ heading), 0.0) * heading
-        components["repulsive"] = repulsive
+        components["repulsive"] = repulsive - min(float(repulsive @ heading), 0.0) * heading
+
+    def _mapped_cells_near(self, position: np.ndarray, reach_m: float) -> np.ndarray:
+        """Centres (N, 2) of the mapped obstacle cells (not swept) within a square of half side
+        `reach_m` around a point (m)."""
+        p, cell = self.params, self.map.cell_m
+        reach = math.ceil(reach_m / cell) + 1
+        centre = np.floor(position / cell).astype(int) - self.map.origin
+        lo, hi = np.maximum(centre - reach, 0), np.minimum(centre + reach + 1, self.map.n)
+        if np.any(hi <= lo):
+            return np.empty((0, 2))
+        near = (slice(lo[0], hi[0]), slice(lo[1], hi[1]))
+        i, j = np.nonzero((self.map.grid[near] >= p["map_threshold"]) & ~self.map.swept[near])
+        return (np.column_stack((i, j)) + lo + self.map.origin + 0.5) * cell
+
+    def _way_is_blocked(self, position: np.ndarray, way: list[np.ndarray]) -> bool:
+        """Whether a mapped obstacle cell now lies within the robot's radius of the way's next
+        `BLOCK_LOOKAHEAD_M` (the sonar has seen something new on it)."""
+        ahead = [point for point in way if np.hypot(*(point - position)) <= BLOCK_LOOKAHEAD_M]
+        if not ahead:
+            return False
+        cells = self._mapped_cells_near(position, BLOCK_LOOKAHEAD_M + self.radius)
+        if not len(cells):
+            return False
+        points = np.array(ahead)
+        gaps = np.hypot(*(cells[:, None, :] - points[None, :, :]).transpose(2, 0, 1))
+        return bool(gaps.min() < self.radius)
+
+    def _nearest_cell_force(self, position: np.ndarray) -> np.ndarray:
+        """FIRAS repulsion (eq. 5) of the nearest mapped obstacle cell within `guard_m`: the map
+        remembers corners that fall between the sonar's rays at close range."""
+        p = self.params
+        cells = self._mapped_cells_near(position, p["guard_m"])
+        if not len(cells):
+            return np.zeros(2)
+        nearest = cells[np.argmin(np.hypot(*(cells - position).T))]
+        return fields.repulsive_force(position, nearest[None], p["repulse_gain"], p["guard_m"])
 
     # -- Algorithm 2 with the map ------------------------------------------------------------
     def _start_escape(self, obs: Observation, decision: Decision) -> bool:
@@ -216,18 +263,14 @@ class VPlanePlusPlanner(VPlanePlanner):
             e1, e2, cells, obs.position, obs.goal, extend=self._link_m() / 2, to_outermost=False
         )
         clearance = self.radius + self.params["escape_margin_m"]
-        window = self._window(obs.position, obs.goal, self.planes)
+        window = self._window(obs.position, obs.goal, self.planes, margin=self.params["search_margin_m"])
         if self._spans_a_gap(plane, others):
             decision.events.append(
                 f"no virtual plane: e1=({e1[0]:.2f}, {e1[1]:.2f}) e2=({e2[0]:.2f}, {e2[1]:.2f}) "
                 "would span a gap between obstacles"
             )
             plane = None
-        elif self._way(
-            self._window(obs.position, obs.goal, [*self.planes, plane], doubtful_walls=True),
-            obs.position,
-            obs.goal,
-        ):
+        elif self._find_way(obs.position, obs.goal, [*self.planes, plane], doubtful_walls=True):
             decision.events.append(
                 f"no virtual plane: e1=({e1[0]:.2f}, {e1[1]:.2f}) e2=({e2[0]:.2f}, {e2[1]:.2f}) "
                 "would close no trap (the map shows another way out)"
@@ -257,10 +300,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         if plane is None:
             decision.events.append("objective reached: target re-activated (no virtual plane)")
             return
-        if (
-            self._way(self._window(obs.position, obs.goal, [*self.planes, plane]), obs.position, obs.goal)
-            is None
-        ):
+        if self._find_way(obs.position, obs.goal, [*self.planes, plane]) is None:
             decision.events.append(
                 "objective reached: target re-activated; no virtual plane, it would cut the only known "
                 "way to the goal"
@@ -371,7 +411,9 @@ class VPlanePlusPlanner(VPlanePlanner):
         p = self.params
         waypoint = self._next_waypoint(obs.position, self.follow_way, obs.goal)
         if obs.time_s < self.next_replan_s and self.follow_way:
-            return waypoint
+            if not self._way_is_blocked(obs.position, self.follow_way):
+                return waypoint
+            decision.events.append("the way ahead is blocked on the map: searched again")
         self.next_replan_s = obs.time_s + p["replan_period_s"]
         way = self._way_to_goal(obs, decision)
         if way is None:
@@ -394,24 +436,42 @@ class VPlanePlusPlanner(VPlanePlanner):
     def _way_to_goal(self, obs: Observation, decision: Decision) -> list[np.ndarray] | None:
         """The map's way to the goal with the planes as walls; planes that leave no way are
         retired (newest first). None when the map holds no way even without planes."""
-        way = self._way(self._window(obs.position, obs.goal, self.planes), obs.position, obs.goal)
+        way = self._find_way(obs.position, obs.goal, self.planes)
         while way is None and self.planes:
             self.planes.pop()
             decision.events.append("virtual plane retired: it closed the only known way to the goal")
-            way = self._way(self._window(obs.position, obs.goal, self.planes), obs.position, obs.goal)
+            way = self._find_way(obs.position, obs.goal, self.planes)
         return way
+
+    def _find_way(
+        self, robot: np.ndarray, goal: np.ndarray, planes: list[VirtualPlane], doubtful_walls: bool = False
+    ) -> list[np.ndarray] | None:
+        """The map's way from the robot to the goal: searched near them first (quick), then over
+        the whole map before concluding there is none."""
+        for margin in (self.params["search_margin_m"], None):
+            way = self._way(self._window(robot, goal, planes, doubtful_walls, margin), robot, goal)
+            if way is not None:
+                return way
+        return None
 
     # -- the map -----------------------------------------------------------------------------
     def _window(
-        self, robot: np.ndarray, goal: np.ndarray, planes: list[VirtualPlane], doubtful_walls: bool = False
+        self,
+        robot: np.ndarray,
+        goal: np.ndarray,
+        planes: list[VirtualPlane],
+        doubtful_walls: bool = False,
+        margin: float | None = None,
     ) -> gridsearch.Window:
-        """Step costs for the robot's centre around the robot and the goal, planes as walls (and
-        doubtful obstacle cells too with `doubtful_walls`: does a plane close a trap?)."""
+        """Step costs for the robot's centre over the map cells within `margin` (m) of the box
+        around the robot and the goal (the whole map for None), planes as walls (and doubtful
+        obstacle cells too with `doubtful_walls`: does a plane close a trap?)."""
         p, grid, cell = self.params, self.map.grid, self.map.cell_m
-        margin = p["search_margin_m"]
-        low = np.floor((np.minimum(robot, goal) - margin) / cell).astype(int) - self.map.origin
-        high = np.ceil((np.maximum(robot, goal) + margin) / cell).astype(int) - self.map.origin
-        low, high = np.clip(low, 0, self.map.n), np.clip(high, 0, self.map.n)
+        low, high = np.zeros(2, dtype=int), np.full(2, self.map.n)
+        if margin is not None:
+            low = np.floor((np.minimum(robot, goal) - margin) / cell).astype(int) - self.map.origin
+            high = np.ceil((np.maximum(robot, goal) + margin) / cell).astype(int) - self.map.origin
+            low, high = np.clip(low, 0, self.map.n), np.clip(high, 0, self.map.n)
         inside = (slice(low[0], high[0]), slice(low[1], high[1]))
         certainty = np.where(self.map.swept[inside], 0, grid[inside])
         cost = gridsearch.step_costs(
@@ -425,6 +485,8 @@ class VPlanePlusPlanner(VPlanePlanner):
         )
         seen = self.map.seen[inside].copy()
         window = gridsearch.Window(cost, (self.map.origin + low) * cell, cell, seen)
+        for stall in self.stalls:
+            window.charge_disc(stall, STALL_RADIUS_M, p["doubt_cost"])
         window.clear_disc(robot, self.radius)  # the robot stands there: its disc is free
         for plane in planes:  # but no way crosses a virtual plane, even under the robot
             window.block_segment(plane.e1, plane.e2)

@@ -1,0 +1,207 @@
+"""Every planner on every scenario family, the paper's scenarios included: the clutter comparison.
+
+Families: `paper` (the four built-in scenarios of the paper's figures), and the generated
+`traps`, `clutter`, `corridors` (`--count` each, seed `--seed`) and `barn` (`--barn` worlds,
+seed 0, like `vplane-mj generate barn`). Each family also runs with noisy sonar when
+`--noise`/`--dropout` are given (by default 3 cm and 10% on `barn`, as `barn_noisy`). The
+scenario files are written to `OUT/cases/`; the runs go through `vplane_mj.bench.run_sweep`,
+so `OUT/bench.jsonl` journals them and the same command run again only does what is missing.
+
+Writes `OUT/clutter.csv` (per family and planner: runs, success rate, runs with a collision,
+timeouts, stuck, mean BARN score, median path ratio of the successes) and `OUT/clutter.png`
+(success and mean score per family, one bar per planner), and prints the table as Markdown.
+
+    python benchmarks/clutter.py [--jobs 2] [--barn 100] [--count 10] [--out logs/clutter]
+    python benchmarks/clutter.py --barn 4 --count 2 --planners vplane,vplane_plus --out /tmp/clutter
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import statistics
+import sys
+from pathlib import Path
+
+from vplane_mj.bench import plan_jobs, run_sweep
+from vplane_mj.errors import VPlaneError
+from vplane_mj.families import generate
+from vplane_mj.outputs import prepare_out_dir, write_atomically
+from vplane_mj.planning.registry import PLANNERS
+from vplane_mj.reference import shortest_path_length
+from vplane_mj.robot import robot_radius_m
+
+PAPER = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")
+NOISY_SUFFIX = "_noisy"
+COLUMNS = (
+    "family",
+    "planner",
+    "runs",
+    "success_rate",
+    "collision_rate",
+    "timeouts",
+    "stuck",
+    "mean_score",
+    "median_path_ratio",
+)
+
+
+def write_cases(out: Path, barn: int, count: int, seed: int) -> dict[str, list[str]]:
+    """Scenario files per family, written under `out/cases/`; the paper's by name."""
+    cases_dir = out / "cases"
+    cases_dir.mkdir(parents=True, exist_ok=True)
+    radius = robot_radius_m()
+    families = {"paper": list(PAPER)}
+    for family, number, family_seed in (
+        ("traps", count, seed),
+        ("clutter", count, seed),
+        ("corridors", count, seed),
+        ("barn", barn, 0),
+    ):
+        if number <= 0:
+            continue
+        cases = generate(
+            family,
+            number,
+            family_seed,
+            lambda scenario, clearance: shortest_path_length(scenario, radius, clearance) is not None,
+        )
+        paths = []
+        for case in cases:
+            path = cases_dir / f"{case.name}.toml"
+            path.write_text(case.toml(), encoding="utf-8")
+            paths.append(str(path))
+        families[family] = paths
+    return families
+
+
+def family_table(rows: list[dict], family_of: dict[str, str]) -> list[dict]:
+    """One row per family and planner, in the order they first appear."""
+    table = []
+    keys = dict.fromkeys((family_of[row["scenario"]], row["planner"]) for row in rows)
+    for family, planner in keys:
+        mine = [r for r in rows if family_of[r["scenario"]] == family and r["planner"] == planner]
+        scores = [r["score"] for r in mine if r.get("score") is not None]
+        ratios = [r["path_ratio"] for r in mine if r["success"] and r.get("path_ratio")]
+        table.append(
+            {
+                "family": family,
+                "planner": planner,
+                "runs": len(mine),
+                "success_rate": sum(r["success"] for r in mine) / len(mine),
+                "collision_rate": sum(r["collisions"] > 0 for r in mine) / len(mine),
+                "timeouts": sum(r["outcome"] == "timeout" for r in mine),
+                "stuck": sum(r["outcome"] == "stuck" for r in mine),
+                "mean_score": statistics.fmean(scores) if scores else None,
+                "median_path_ratio": statistics.median(ratios) if ratios else None,
+            }
+        )
+    return table
+
+
+def markdown(table: list[dict]) -> str:
+    def cell(key: str, value) -> str:
+        if value is None:
+            return "-"
+        if key.endswith("_rate"):
+            return f"{100 * value:.0f}%"
+        return f"{value:.2f}" if isinstance(value, float) else str(value)
+
+    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+    lines += ["| " + " | ".join(cell(k, row[k]) for k in COLUMNS) + " |" for row in table]
+    return "\n".join(lines)
+
+
+def plot(table: list[dict], path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    families = list(dict.fromkeys(row["family"] for row in table))
+    planners = list(dict.fromkeys(row["planner"] for row in table))
+    figure, axes = plt.subplots(1, 2, figsize=(13, 4.2))
+    width = 0.8 / len(planners)
+    for ax, key, label in (
+        (axes[0], "success_rate", "success rate"),
+        (axes[1], "mean_score", "mean BARN score"),
+    ):
+        for k, planner in enumerate(planners):
+            values = [
+                next(
+                    (row[key] or 0.0 for row in table if row["family"] == f and row["planner"] == planner),
+                    0.0,
+                )
+                for f in families
+            ]
+            ax.bar([i + k * width for i in range(len(families))], values, width, label=planner)
+        ax.set_xticks([i + width * (len(planners) - 1) / 2 for i in range(len(families))], families)
+        ax.set(ylabel=label, title=f"{label} per family")
+    axes[0].set_ylim(0, 1.05)
+    axes[1].set_ylim(0, 0.55)
+    axes[0].legend(fontsize=8, ncol=2)
+    figure.tight_layout()
+    write_atomically(path, lambda tmp: figure.savefig(tmp, format="png", dpi=100))
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--planners", default=",".join(sorted(PLANNERS)))
+    parser.add_argument("--barn", type=int, default=100, help="BARN-like worlds (seed 0)")
+    parser.add_argument("--count", type=int, default=10, help="worlds of each other generated family")
+    parser.add_argument("--seed", type=int, default=1, help="seed of the traps, clutter and corridors")
+    parser.add_argument("--noise", type=float, default=0.03, help="sonar noise of the noisy barn runs (m)")
+    parser.add_argument("--dropout", type=float, default=0.1, help="dropout of the noisy barn runs")
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--out", type=Path, default=Path("logs/clutter"))
+    args = parser.parse_args(argv)
+    planners = [p.strip() for p in args.planners.split(",")]
+    unknown = sorted(set(planners) - set(PLANNERS))
+    if unknown or args.barn < 0 or args.count < 0 or args.jobs < 1:
+        print(f"error: bad arguments (unknown planners: {unknown})", file=sys.stderr)
+        return 2
+    try:
+        out = prepare_out_dir(args.out, create=True)
+    except VPlaneError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    families = write_cases(out, args.barn, args.count, args.seed)
+    family_of = {}
+    jobs = []
+    for family, scenarios in families.items():
+        mine = plan_jobs(scenarios, planners, [0])
+        family_of.update((job.scenario, family) for job in mine)
+        jobs += mine
+    noisy = []
+    if "barn" in families and (args.noise > 0 or args.dropout > 0):
+        overrides = (f"sensors.noise_std={args.noise}", f"sensors.dropout={args.dropout}")
+        noisy = [
+            _renamed(job, job.scenario + NOISY_SUFFIX)
+            for job in plan_jobs(families["barn"], planners, [0], overrides)
+        ]
+        for job in noisy:
+            family_of[job.scenario] = "barn" + NOISY_SUFFIX
+    rows = run_sweep(jobs + noisy, out, args.jobs)
+    table = family_table(rows, family_of)
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=COLUMNS)
+    writer.writeheader()
+    writer.writerows(table)
+    write_atomically(out / "clutter.csv", lambda tmp: tmp.write_text(buffer.getvalue(), encoding="utf-8"))
+    plot(table, out / "clutter.png")
+    print(markdown(table))
+    print(f"wrote {out / 'clutter.csv'}\nwrote {out / 'clutter.png'}")
+    return 0
+
+
+def _renamed(job, name: str):
+    """The same run under another scenario name (the name is part of the scenario text)."""
+    from dataclasses import replace
+
+    toml = job.toml.replace(f'name = "{job.scenario}"', f'name = "{name}"', 1)
+    return replace(job, scenario=name, toml=toml)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
