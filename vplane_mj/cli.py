@@ -13,7 +13,7 @@ import mujoco
 from vplane_mj.errors import VPlaneError
 from vplane_mj.families import FAMILIES
 from vplane_mj.interrupts import Interrupted, signals_raise_interrupted
-from vplane_mj.outputs import prepare_out_dir, write_atomically, write_json
+from vplane_mj.outputs import output_directory, prepare_out_dir, write_atomically, write_json
 from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
 from vplane_mj.scenario import Scenario, builtin_scenarios, load_scenario
 
@@ -162,7 +162,7 @@ def _run(args: argparse.Namespace) -> int:
     from vplane_mj.sim import run_scenario
 
     scenario = load_scenario(args.scenario, _overrides(args))
-    out_dir = prepare_out_dir(args.out or DEFAULT_OUT, create=args.out is None)
+    out_dir = prepare_out_dir(args.out or DEFAULT_OUT)
     base = out_dir / f"{scenario.name}-{scenario.planner}-{scenario.run.seed}"
     mcap_path = base.with_suffix(".mcap")
     log = None if args.no_log else _open_log(scenario, mcap_path)
@@ -230,8 +230,7 @@ def _bench(args: argparse.Namespace) -> int:
         raise VPlaneError(f"--jobs: must be at least 1, got {args.jobs}")
     planners = sorted(PLANNERS) if args.planners is None else [p.strip() for p in args.planners.split(",")]
     seeds = parse_seeds(args.seeds)
-    out_dir = prepare_out_dir(args.out or DEFAULT_OUT, create=args.out is None)
-    with signals_raise_interrupted():
+    with signals_raise_interrupted(), output_directory(args.out or DEFAULT_OUT) as out_dir:
         try:
             return bench(args.scenarios, planners, seeds, out_dir, args.jobs, args.scheduler, tuple(args.set))
         except Interrupted as exc:
@@ -254,7 +253,7 @@ def _generate(args: argparse.Namespace) -> int:
         raise VPlaneError(f"--count: must be at least 1, got {args.count}")
     if args.seed < 0:
         raise VPlaneError(f"--seed: must be at least 0, got {args.seed}")
-    out_dir = prepare_out_dir(args.out, create=False)
+    out_dir = prepare_out_dir(args.out)
     radius = robot_radius_m()
     cases = generate(
         args.family, args.count, args.seed, lambda s: shortest_path_length(s, radius) is not None
