@@ -1,4 +1,4 @@
-"""The `vplane-mj` command line (INTERFACE.md section 2). `main(argv) -> exit status`."""
+"""The `vplane-mj` command line (README "Commands"). `main(argv) -> exit status`."""
 
 from __future__ import annotations
 
@@ -92,6 +92,7 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--out", type=Path, help=f"output directory (default {DEFAULT_OUT}/)")
     run.add_argument("--no-log", action="store_true", help="do not write the .mcap log")
     run.add_argument("--no-render", action="store_true", help="do not write the .png render")
+    run.add_argument("--video", action="store_true", help="also write an .mp4 replay of the run")
     run.set_defaults(handler=_run)
 
     sweep = commands.add_parser("bench", help="many runs: scenarios x planners x seeds")
@@ -142,6 +143,14 @@ def _parser() -> argparse.ArgumentParser:
     plot.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.png")
     plot.set_defaults(handler=_plot)
 
+    video = commands.add_parser("video", help="replay a run from its MCAP log as a top-down video")
+    video.add_argument("log", type=Path, metavar="LOG.mcap")
+    video.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.mp4|FILE.gif")
+    video.add_argument(
+        "--speed", type=float, default=1.0, help="simulated seconds per video second (default 1: real time)"
+    )
+    video.set_defaults(handler=_video)
+
     listing = commands.add_parser("list", help="built-in scenarios and planners")
     listing.set_defaults(handler=_list)
     return parser
@@ -162,6 +171,8 @@ def _run(args: argparse.Namespace) -> int:
     from vplane_mj.sim import run_scenario
 
     scenario = load_scenario(args.scenario, _overrides(args))
+    if args.video and args.no_log:
+        raise VPlaneError("--video: the video is made from the log: drop --no-log")
     out_dir = prepare_out_dir(args.out or DEFAULT_OUT)
     base = out_dir / f"{scenario.name}-{scenario.planner}-{scenario.run.seed}"
     mcap_path = base.with_suffix(".mcap")
@@ -185,6 +196,10 @@ def _run(args: argparse.Namespace) -> int:
     if not args.no_render:
         image = render_top_view(scenario, result.track())
         written.append(write_atomically(base.with_suffix(".png"), lambda tmp: write_png(image, tmp)))
+    if args.video:
+        from vplane_mj.video import write_video
+
+        written.append(write_video(mcap_path, base.with_suffix(".mp4")))
     print(_summary_line(scenario, result.summary))
     for path in written:
         print(f"wrote {path}")
@@ -333,6 +348,17 @@ def _plot(args: argparse.Namespace) -> int:
     _check_parent(args.output)
     figure = plot_log(args.log, contents, scenario, track_from_log(args.log, contents))
     write_atomically(args.output, lambda tmp: figure.savefig(tmp, format="png", dpi=100))
+    print(f"wrote {args.output}")
+    return 0
+
+
+def _video(args: argparse.Namespace) -> int:
+    from vplane_mj.video import check_speed, video_format, write_video
+
+    video_format(args.output)
+    check_speed(args.speed)
+    _check_parent(args.output)
+    write_video(args.log, args.output, args.speed)
     print(f"wrote {args.output}")
     return 0
 
