@@ -28,7 +28,8 @@ class PathSimplifier:
         self.tolerance_m = float(tolerance_m)
         self.max_pending = int(max_pending)
         self._vertices: list[tuple[float, float]] = []
-        self._pending: list[tuple[float, float]] = []
+        self._pending = np.empty((self.max_pending, 2))
+        self._held = 0  # positions held back, in _pending[:_held]
 
     def add(self, x: float, y: float) -> None:
         """Append the position (x, y) (m)."""
@@ -36,15 +37,29 @@ class PathSimplifier:
         if not self._vertices:
             self._vertices.append(point)
             return
-        if self._pending:
-            distances = distances_to_segment(
-                np.array(self._pending), np.array(self._vertices[-1]), np.array(point)
-            )
-            if distances.max() > self.tolerance_m or len(self._pending) >= self.max_pending:
-                self._vertices.append(self._pending[-1])
-                self._pending = []
-        self._pending.append(point)
+        held = self._held
+        if held:
+            pending = self._pending[:held]
+            if held >= self.max_pending or self._beyond_tolerance(pending, point):
+                self._vertices.append((float(pending[-1, 0]), float(pending[-1, 1])))
+                held = 0
+        self._pending[held] = point
+        self._held = held + 1
+
+    def _beyond_tolerance(self, pending: np.ndarray, point: tuple[float, float]) -> bool:
+        """Whether a held-back position is farther than the tolerance from the edge from the
+        last vertex to `point` (the arithmetic of `distances_to_segment`, squared, in scalars)."""
+        ax, ay = self._vertices[-1]
+        dx, dy = point[0] - ax, point[1] - ay
+        px, py = pending[:, 0] - ax, pending[:, 1] - ay
+        length2 = dx * dx + dy * dy
+        t = np.clip((px * dx + py * dy) / length2, 0.0, 1.0) if length2 > 0 else 0.0
+        ex, ey = px - t * dx, py - t * dy
+        return bool((ex * ex + ey * ey).max() > self.tolerance_m**2)
 
     def polyline(self) -> list[tuple[float, float]]:
         """The vertices from the first position to the newest one."""
-        return self._vertices + self._pending[-1:]
+        if not self._held:
+            return list(self._vertices)
+        newest = self._pending[self._held - 1]
+        return [*self._vertices, (float(newest[0]), float(newest[1]))]
