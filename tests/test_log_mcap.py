@@ -202,6 +202,7 @@ def test_metadata_holds_the_resolved_scenario_and_versions(run):
 def test_events_and_their_levels(run):
     events = run["contents"].events
     texts = [text for _, _, text in events]
+    assert events[0] == (0.0, "INFO", "run started: paper_c_escape, planner vplane, seed 0")
     assert "local minimum detected" in texts
     assert all(level == "INFO" for _, level, _ in events)
     detected = next(t for t, _, text in events if text == "local minimum detected")
@@ -431,6 +432,7 @@ def test_warning_levels_close_is_idempotent_and_ticks_after_close_are_ignored(tm
     log.on_event(2.0, "ignored")
     contents = read_log(path)
     assert contents.events == [
+        (0.0, "INFO", "run started: paper_c_escape, planner vplane, seed 0"),
         (0.5, "WARNING", "collision at (1.00, 2.00)"),
         (1.0, "WARNING", "gave up after 3 escapes"),
         (1.5, "INFO", "escape started"),

@@ -15,7 +15,7 @@ messages' own `timestamp` fields, is the integer nanosecond of *simulated* time,
 | `/forces` | `foxglove.SceneUpdate` | every tick: force arrows at the robot |
 | `/virtual` | `foxglove.SceneUpdate` | at time 0 (empty), then when the objective or planes change |
 | `/path` | `foxglove.SceneUpdate` | the path so far: first tick, about once per simulated second, close |
-| `/events` | `foxglove.Log` | one per event, name `vplane_mj` |
+| `/events` | `foxglove.Log` | `run started: ...` at time 0, then one per event, name `vplane_mj` |
 | `/metrics` | JSON (`vplane_mj.Metrics` JSON schema) | every tick (see below) |
 | `/robot/odometry` | `foxglove.PoseInFrame` | believed pose, every tick, if `sensors.pose = "odometry"` |
 
@@ -81,6 +81,8 @@ FOLLOW_FRAME = "base_link_xy"
 LOGGER_NAME = "vplane_mj"
 METADATA_NAME = "vplane_mj"
 """Name of the metadata record with the scenario, seed, planner and versions."""
+START_EVENT = "run started"
+"""The first `/events` message (time 0), from the log itself, so that the topic is never empty."""
 SUMMARY_METADATA_NAME = "summary"
 """Name of the metadata record written at close; its key `json` holds the summary."""
 METRICS_SCHEMA_NAME = "vplane_mj.Metrics"
@@ -285,6 +287,9 @@ class McapLog:
         self._log_world()
         # An empty /virtual update at time 0 keeps the topic in every file, even without escapes.
         self._virtual_ch.log(fm.SceneUpdate(), log_time=0)
+        self._log_event(
+            0, f"{START_EVENT}: {scenario.name}, planner {scenario.planner}, seed {scenario.run.seed}"
+        )
 
         start = np.asarray(scenario.robot.start, dtype=float)
         self._last_pose = (float(start[0]), float(start[1]), float(scenario.robot.start_yaw))
@@ -439,6 +444,9 @@ class McapLog:
             return
         ns = time_ns(time_s)
         self._last_ns = max(self._last_ns, ns)
+        self._log_event(ns, text)
+
+    def _log_event(self, ns: int, text: str) -> None:
         level = fm.LogLevel.Warning if text.startswith(_WARNING_PREFIXES) else fm.LogLevel.Info
         self._events_ch.log(
             fm.Log(timestamp=_stamp(ns), level=level, message=text, name=LOGGER_NAME), log_time=ns
