@@ -141,14 +141,16 @@ def write_video(log: Path, target: Path, speed: float = 1.0, show_progress: bool
             output_params=list(fmt.options),
         )
         writer.send(None)
-        frame = b""
-        for k in range(frames + hold):
-            if k < frames:
-                frame = canvas.frame(k * speed / fmt.fps)
-            writer.send(frame)
-            if progress:
-                progress.advance()
-        writer.close()
+        try:
+            frame = b""
+            for k in range(frames + hold):
+                if k < frames:
+                    frame = canvas.frame(k * speed / fmt.fps)
+                writer.send(frame)
+                if progress:
+                    progress.advance()
+        finally:
+            writer.close()  # ffmpeg finishes the file (or is stopped, on an interruption)
 
     try:
         return write_atomically(target, encode)
