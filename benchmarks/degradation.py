@@ -159,7 +159,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def sweep(args: argparse.Namespace) -> int:
     seeds = parse_seeds(args.seeds)
-    cases_dir = prepare_out_dir(args.out / "cases", create=True)
+    cases_dir = prepare_out_dir(args.out / "cases")
     paths = []
     for case in trap_suite()[: args.cases]:
         text = case.toml()

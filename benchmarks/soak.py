@@ -296,7 +296,7 @@ def main(argv: list[str] | None = None) -> int:
 
     started = time.monotonic()
     try:
-        failed_dir = prepare_out_dir(args.out / "failed", create=True)
+        failed_dir = prepare_out_dir(args.out / "failed")
     except VPlaneError as exc:
         parser.error(str(exc))
     runs = load_or_plan(args.out / PLAN, args.count, args.seed, args.time_limit)

@@ -10,13 +10,16 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from vplane_mj.bench import JOURNAL, family_of, parse_seeds, read_journal
 from vplane_mj.cli import main
 from vplane_mj.errors import VPlaneError
+from vplane_mj.scenario import load_scenario
 from vplane_mj.sim import TIMING_KEYS
 
+OUTPUTS = ("bench.csv", "bench.json", "bench.png", "bench-scenarios.png", "bench.html")
 ARGS = ["bench", "open_field", "paper_c_escape", "--planners", "apf,vplane", "--seeds", "0-1", "--jobs", "2"]
 
 
@@ -37,6 +40,18 @@ def test_a_sweep_writes_rows_table_and_plot_and_resumes(tmp_path, capsys):
     assert "success_rate" in captured.out and "vplane" in captured.out
     assert len((tmp_path / "bench.csv").read_text().splitlines()) == 9
     assert (tmp_path / "bench.png").stat().st_size > 10_000
+    assert (tmp_path / "bench-scenarios.png").stat().st_size > 5_000
+    assert "path_xy" not in (tmp_path / "bench.csv").read_text().splitlines()[0]
+    for r in rows:  # the travelled path, simplified, from the start to where the run ended
+        path = r["path_xy"]
+        assert 2 <= len(path) < 200
+        assert path[0] == pytest.approx(list(load_scenario(r["scenario"]).robot.start), abs=0.01)
+        assert r["final_distance_to_goal_m"] == pytest.approx(
+            np.hypot(*(np.array(path[-1]) - load_scenario(r["scenario"]).robot.goal)), abs=0.01
+        )
+    page = (tmp_path / "bench.html").read_text()
+    assert page.count("<details") == 8 and page.count("<polyline") == 8
+    assert "http://" not in page and "https://" not in page and "<script" not in page
 
     # Rerunning the same command runs nothing again and gives the same rows.
     assert main([*ARGS, "--out", str(tmp_path)]) == 0
@@ -185,9 +200,9 @@ def end_session(process):
 
 
 def assert_only_complete_files(out_dir):
-    """The journal's lines are whole rows; bench.csv, .json and .png are complete or absent."""
+    """The journal's lines are whole rows; the other outputs are complete or absent."""
     names = {path.name for path in out_dir.iterdir()}
-    assert names <= {JOURNAL, "bench.csv", "bench.json", "bench.png"}, names
+    assert names <= {JOURNAL, *OUTPUTS}, names
     text = (out_dir / JOURNAL).read_text(encoding="utf-8")
     assert text.endswith("\n")
     rows = [json.loads(line) for line in text.splitlines()]
@@ -199,9 +214,12 @@ def assert_only_complete_files(out_dir):
         with open(out_dir / "bench.csv", newline="") as stream:
             table = list(csv.reader(stream))
         assert "scenario" in table[0] and all(len(row) == len(table[0]) for row in table[1:])
-    if "bench.png" in names:
-        data = (out_dir / "bench.png").read_bytes()
-        assert data.startswith(b"\x89PNG\r\n\x1a\n") and data.endswith(b"IEND\xaeB`\x82")
+    for name in ("bench.png", "bench-scenarios.png"):
+        if name in names:
+            data = (out_dir / name).read_bytes()
+            assert data.startswith(b"\x89PNG\r\n\x1a\n") and data.endswith(b"IEND\xaeB`\x82")
+    if "bench.html" in names:
+        assert (out_dir / "bench.html").read_text().rstrip().endswith("</html>")
     return rows
 
 
@@ -211,7 +229,7 @@ def assert_the_rerun_completes_the_sweep(out_dir, done):
     assert finished.returncode == 0, finished.stderr
     assert f"{len(SWEEP_KEYS)} runs: {done} already done, {len(SWEEP_KEYS) - done} to run" in finished.stderr
     assert len(assert_only_complete_files(out_dir)) == len(SWEEP_KEYS)
-    assert {"bench.csv", "bench.json", "bench.png"} <= {path.name for path in out_dir.iterdir()}
+    assert set(OUTPUTS) <= {path.name for path in out_dir.iterdir()}
     with open(out_dir / "bench.csv", newline="") as stream:
         rows = list(csv.DictReader(stream))
     assert len(rows) == len(SWEEP_KEYS)

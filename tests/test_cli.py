@@ -137,9 +137,24 @@ def test_invalid_scenario_file_is_named_with_key_and_reason(tmp_path, capsys):
     assert list(out_dir.iterdir()) == []
 
 
-def test_missing_output_directory_is_an_error(tmp_path, capsys):
-    code, _, err = run_cli(capsys, "run", "open_field", "--out", str(tmp_path / "missing"))
-    assert code == 2 and "no such directory" in err
+def test_a_missing_output_directory_is_created_with_its_parents(tmp_path, capsys):
+    out_dir = tmp_path / "results" / "today"
+    code, out, _ = run_cli(capsys, "run", "open_field", "--planner", "apf", "--no-log", "--out", str(out_dir))
+    assert code == 0 and str(out_dir / "open_field-apf-0.json") in out
+    assert sorted(p.name for p in out_dir.iterdir()) == ["open_field-apf-0.json", "open_field-apf-0.png"]
+
+
+def test_generate_creates_its_output_directory_too(tmp_path, capsys):
+    out_dir = tmp_path / "scenarios" / "traps"
+    code, out, _ = run_cli(capsys, "generate", "traps", "--count", "1", "--seed", "3", "--out", str(out_dir))
+    assert code == 0 and [p.suffix for p in out_dir.iterdir()] == [".toml"] and str(out_dir) in out
+
+
+def test_an_output_directory_is_not_created_for_rejected_input(tmp_path, capsys):
+    out_dir = tmp_path / "results" / "today"
+    code, _, err = run_cli(capsys, "bench", "open_field", "--planners", "nope", "--out", str(out_dir))
+    assert code == 2 and "nope" in err
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_check_exit_codes(tmp_path, capsys):

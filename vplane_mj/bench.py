@@ -3,8 +3,9 @@
 Every finished run is appended at once to `bench.jsonl` in the output directory (one JSON
 summary per line), so an interrupted sweep loses nothing finished: the same command run
 again skips the runs whose rows exist (same scenario text, planner and seed) and does the
-rest. At the end `bench.csv`, `bench.json` (rows and table) and `bench.png` are written
-(each atomically) and the table is printed. An interruption (SIGINT, SIGTERM) stops the
+rest. At the end `bench.csv`, `bench.json` (rows and table), `bench.png`,
+`bench-scenarios.png` and `bench.html` (see `bench_report`) are written (each atomically)
+and the table is printed. An interruption (SIGINT, SIGTERM) stops the
 workers at once: the runs they had under way are done again by the next invocation.
 """
 
@@ -97,13 +98,25 @@ def plan_jobs(
     return jobs
 
 
+PATH_KEY = "path_xy"
+"""The row key of a run's travelled path, [[x, y], ...] (m)."""
+PATH_TOLERANCE_M = 0.02
+"""A run's path is kept for the report simplified to within this distance (m)."""
+
+
 def run_job(job: Job) -> dict:
-    """Run one job (in a worker process); its summary plus the job's key."""
+    """Run one job (in a worker process): its summary, the job's key and, under PATH_KEY,
+    the travelled path simplified to PATH_TOLERANCE_M (for the report's picture of it)."""
+    from vplane_mj.polyline import PathSimplifier
     from vplane_mj.scenario import parse_scenario
     from vplane_mj.sim import run_scenario
 
-    summary = run_scenario(parse_scenario(job.toml, f"{job.scenario} (bench)")).summary
-    return {"key": job.key, **summary}
+    result = run_scenario(parse_scenario(job.toml, f"{job.scenario} (bench)"))
+    path = PathSimplifier(PATH_TOLERANCE_M)
+    for x, y in (*result.positions, result.final_pose[:2]):
+        path.add(x, y)
+    track = [[round(x, 3), round(y, 3)] for x, y in path.polyline()]
+    return {"key": job.key, **result.summary, PATH_KEY: track}
 
 
 def read_journal(path: Path) -> dict[str, dict]:
@@ -298,9 +311,11 @@ def format_table(table: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def write_outputs(rows: list[dict], table: list[dict], out_dir: Path) -> list[Path]:
-    """bench.csv (one row per run), bench.json (rows and table) and bench.png."""
-    columns = sorted({key for row in rows for key in row if not isinstance(row[key], dict)})
+def write_outputs(rows: list[dict], table: list[dict], out_dir: Path, jobs: list[Job]) -> list[Path]:
+    """bench.csv (one row per run), bench.json (rows and table), the figures and bench.html."""
+    from vplane_mj import bench_report
+
+    columns = sorted({key for row in rows for key in row if not isinstance(row[key], dict | list)})
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=columns, extrasaction="ignore")
     writer.writeheader()
@@ -311,9 +326,23 @@ def write_outputs(rows: list[dict], table: list[dict], out_dir: Path) -> list[Pa
         ),
         write_json(out_dir / "bench.json", {"format": 1, "rows": rows, "table": table}),
     ]
-    figure = _plot(rows)
+    figures = {
+        "bench.png": bench_report.png_bytes(bench_report.summary_figure(rows)),
+        "bench-scenarios.png": bench_report.png_bytes(bench_report.scenario_figure(rows)),
+    }
+    for name, data in figures.items():
+        written.append(write_atomically(out_dir / name, lambda tmp, data=data: tmp.write_bytes(data)))
+    page = bench_report.write_html_text(
+        rows,
+        table,
+        {job.key: job.toml for job in jobs},
+        {
+            "success per planner and family, times to goal, path ratios": figures["bench.png"],
+            "success per scenario and planner": figures["bench-scenarios.png"],
+        },
+    )
     written.append(
-        write_atomically(out_dir / "bench.png", lambda tmp: figure.savefig(tmp, format="png", dpi=100))
+        write_atomically(out_dir / "bench.html", lambda tmp: tmp.write_text(page, encoding="utf-8"))
     )
     return written
 
@@ -324,42 +353,6 @@ def family_of(scenario: str) -> str:
     while len(parts) > 1 and parts[-1].isdigit():
         parts.pop()
     return "_".join(parts)
-
-
-def _plot(rows: list[dict]):
-    """Success rate per planner and scenario, and the times to goal."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    planners = list(dict.fromkeys(row["planner"] for row in rows))
-    scenarios = list(dict.fromkeys(family_of(row["scenario"]) for row in rows))
-    figure, (rates, times, ratios) = plt.subplots(1, 3, figsize=(18, 4.5))
-    width = 0.8 / len(planners)
-    for k, planner in enumerate(planners):
-        values = []
-        for name in scenarios:
-            mine = [r for r in rows if r["planner"] == planner and family_of(r["scenario"]) == name]
-            values.append(sum(r["success"] for r in mine) / len(mine) if mine else 0.0)
-        rates.bar([i + k * width for i in range(len(scenarios))], values, width, label=planner)
-    rates.set_xticks(
-        [i + width * (len(planners) - 1) / 2 for i in range(len(scenarios))],
-        scenarios,
-        rotation=30,
-        ha="right",
-        fontsize=8,
-    )
-    rates.set(ylim=(0, 1.05), ylabel="success rate", title="success per planner and family")
-    rates.legend()
-    data = [[r["time_to_goal_s"] for r in rows if r["planner"] == p and r["reached"]] for p in planners]
-    times.boxplot([d if d else [float("nan")] for d in data], tick_labels=planners)
-    times.set(ylabel="time to goal (s)", title="time to goal of the runs that reached it")
-    data = [[r["path_ratio"] for r in rows if r["planner"] == p and r.get("path_ratio")] for p in planners]
-    ratios.boxplot([d if d else [float("nan")] for d in data], tick_labels=planners)
-    ratios.set(ylabel="path length / shortest path", title="path ratio of the runs that reached the goal")
-    figure.tight_layout()
-    return figure
 
 
 def bench(
@@ -376,6 +369,6 @@ def bench(
     rows = run_sweep(jobs, out_dir, workers, scheduler)
     table = summarize(rows)
     print(format_table(table))
-    for path in write_outputs(rows, table, out_dir):
+    for path in write_outputs(rows, table, out_dir, jobs):
         print(f"wrote {path}")
     return 0

@@ -1,4 +1,4 @@
-"""The `vplane-mj` command line (INTERFACE.md section 2). `main(argv) -> exit status`."""
+"""The `vplane-mj` command line (README "Commands"). `main(argv) -> exit status`."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import mujoco
 from vplane_mj.errors import VPlaneError
 from vplane_mj.families import FAMILIES
 from vplane_mj.interrupts import Interrupted, signals_raise_interrupted
-from vplane_mj.outputs import prepare_out_dir, write_atomically, write_json
+from vplane_mj.outputs import output_directory, prepare_out_dir, write_atomically, write_json
 from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
 from vplane_mj.scenario import Scenario, builtin_scenarios, load_scenario
 
@@ -92,6 +92,7 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--out", type=Path, help=f"output directory (default {DEFAULT_OUT}/)")
     run.add_argument("--no-log", action="store_true", help="do not write the .mcap log")
     run.add_argument("--no-render", action="store_true", help="do not write the .png render")
+    run.add_argument("--video", action="store_true", help="also write an .mp4 replay of the run")
     run.set_defaults(handler=_run)
 
     sweep = commands.add_parser("bench", help="many runs: scenarios x planners x seeds")
@@ -142,6 +143,14 @@ def _parser() -> argparse.ArgumentParser:
     plot.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.png")
     plot.set_defaults(handler=_plot)
 
+    video = commands.add_parser("video", help="replay a run from its MCAP log as a top-down video")
+    video.add_argument("log", type=Path, metavar="LOG.mcap")
+    video.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.mp4|FILE.gif")
+    video.add_argument(
+        "--speed", type=float, default=1.0, help="simulated seconds per video second (default 1: real time)"
+    )
+    video.set_defaults(handler=_video)
+
     listing = commands.add_parser("list", help="built-in scenarios and planners")
     listing.set_defaults(handler=_list)
     return parser
@@ -162,7 +171,9 @@ def _run(args: argparse.Namespace) -> int:
     from vplane_mj.sim import run_scenario
 
     scenario = load_scenario(args.scenario, _overrides(args))
-    out_dir = prepare_out_dir(args.out or DEFAULT_OUT, create=args.out is None)
+    if args.video and args.no_log:
+        raise VPlaneError("--video: the video is made from the log: drop --no-log")
+    out_dir = prepare_out_dir(args.out or DEFAULT_OUT)
     base = out_dir / f"{scenario.name}-{scenario.planner}-{scenario.run.seed}"
     mcap_path = base.with_suffix(".mcap")
     log = None if args.no_log else _open_log(scenario, mcap_path)
@@ -185,6 +196,10 @@ def _run(args: argparse.Namespace) -> int:
     if not args.no_render:
         image = render_top_view(scenario, result.track())
         written.append(write_atomically(base.with_suffix(".png"), lambda tmp: write_png(image, tmp)))
+    if args.video:
+        from vplane_mj.video import write_video
+
+        written.append(write_video(mcap_path, base.with_suffix(".mp4")))
     print(_summary_line(scenario, result.summary))
     for path in written:
         print(f"wrote {path}")
@@ -230,8 +245,7 @@ def _bench(args: argparse.Namespace) -> int:
         raise VPlaneError(f"--jobs: must be at least 1, got {args.jobs}")
     planners = sorted(PLANNERS) if args.planners is None else [p.strip() for p in args.planners.split(",")]
     seeds = parse_seeds(args.seeds)
-    out_dir = prepare_out_dir(args.out or DEFAULT_OUT, create=args.out is None)
-    with signals_raise_interrupted():
+    with signals_raise_interrupted(), output_directory(args.out or DEFAULT_OUT) as out_dir:
         try:
             return bench(args.scenarios, planners, seeds, out_dir, args.jobs, args.scheduler, tuple(args.set))
         except Interrupted as exc:
@@ -254,7 +268,7 @@ def _generate(args: argparse.Namespace) -> int:
         raise VPlaneError(f"--count: must be at least 1, got {args.count}")
     if args.seed < 0:
         raise VPlaneError(f"--seed: must be at least 0, got {args.seed}")
-    out_dir = prepare_out_dir(args.out, create=False)
+    out_dir = prepare_out_dir(args.out)
     radius = robot_radius_m()
     cases = generate(
         args.family,
@@ -337,6 +351,17 @@ def _plot(args: argparse.Namespace) -> int:
     _check_parent(args.output)
     figure = plot_log(args.log, contents, scenario, track_from_log(args.log, contents))
     write_atomically(args.output, lambda tmp: figure.savefig(tmp, format="png", dpi=100))
+    print(f"wrote {args.output}")
+    return 0
+
+
+def _video(args: argparse.Namespace) -> int:
+    from vplane_mj.video import check_speed, video_format, write_video
+
+    video_format(args.output)
+    check_speed(args.speed)
+    _check_parent(args.output)
+    write_video(args.log, args.output, args.speed)
     print(f"wrote {args.output}")
     return 0
 

@@ -1,4 +1,4 @@
-"""The MCAP log of one run (INTERFACE.md section 4), written with foxglove-sdk, and read back.
+"""The MCAP log of one run (README "Replaying a run in Foxglove"), written with foxglove-sdk, and read back.
 
 Writing: `McapLog` is an `Observer` of `run_scenario`. It owns a private
 `foxglove.Context`, so several runs (threads, tests) never share channels, and an
@@ -9,14 +9,14 @@ messages' own `timestamp` fields, is the integer nanosecond of *simulated* time,
 | topic | schema | when |
 |---|---|---|
 | `/robot/pose` | `foxglove.PoseInFrame` | every control tick, frame `world`, z = 0 |
-| `/tf` | `foxglove.FrameTransforms` | every tick, `world` -> `base_link` |
+| `/tf` | `foxglove.FrameTransforms` | every tick, `world` -> `base_link` and `base_link_xy` |
 | `/scan` | `foxglove.LaserScan` | every tick, frame `base_link`, NaN where no echo |
-| `/world` | `foxglove.SceneUpdate` | once at time 0: arena, obstacles, border, start, goal |
+| `/world` | `foxglove.SceneUpdate` | once at time 0: arena, obstacles, border, start, goal, robot |
 | `/forces` | `foxglove.SceneUpdate` | every tick: force arrows at the robot |
 | `/virtual` | `foxglove.SceneUpdate` | at time 0 (empty), then when the objective or planes change |
-| `/path` | `foxglove.SceneUpdate` | a new path segment about once per simulated second and at close |
-| `/events` | `foxglove.Log` | one per event, name `vplane_mj` |
-| `/metrics` | JSON (`vplane_mj.Metrics` JSON schema) | every tick |
+| `/path` | `foxglove.SceneUpdate` | the path so far: first tick, about once per simulated second, close |
+| `/events` | `foxglove.Log` | `run started: ...` at time 0, then one per event, name `vplane_mj` |
+| `/metrics` | JSON (`vplane_mj.Metrics` JSON schema) | every tick (see below) |
 | `/robot/odometry` | `foxglove.PoseInFrame` | believed pose, every tick, if `sensors.pose = "odometry"` |
 
 Force arrows start at the robot's centre and point along the force (world frame);
@@ -24,9 +24,17 @@ their length is `ARROW_M_PER_UNIT` (0.5 m) per unit of force, clipped to
 `ARROW_MAX_M` (1.5 m); an arrow whose force is (near) zero or not finite is deleted
 until it comes back. Entity ids: `/forces` `attractive`, `repulsive`, `virtual`,
 `total`; `/virtual` `objective`, `plane_0`, `plane_1`, ... (by position in the
-planner's list); `/path` `path_0`, `path_1`, ... (one segment about every simulated
-second); `/world` `arena`, `border`, `obstacle_<i>`, `start`, `goal`. Entities that
-vanish are removed with `SceneUpdate.deletions`.
+planner's list); `/path` `path` (one line strip from the start to the robot, replaced
+by every message, so that the latest message before any time, all a viewer keeps of a
+scene topic after a seek, shows the whole path up to then; simplified to within
+`PATH_TOLERANCE_M` of every logged pose, which keeps it a few hundred points long);
+`/world` `arena`, `border`, `obstacle_<i>`, `start`, `goal` (frame `world`) and `robot`
+(a disc of `robot_radius_m` with a heading arrow in frame `base_link`, frame-locked, so
+it moves with `/tf`). Entities that vanish are removed with `SceneUpdate.deletions`.
+
+`/metrics` uses only plain JSON schema types (`number`, `string`), as viewers require:
+a number that is missing (`force_virtual` without a virtual force, `odometry_error_m`
+without odometry) or not finite is omitted from the message instead of being null.
 
 The file metadata: record `vplane_mj` (scenario name, resolved TOML text, seed,
 planner and its parameters, package versions, time base, plus the caller's
@@ -60,6 +68,7 @@ from mcap.stream_reader import StreamReader
 from mcap_protobuf.decoder import DecoderFactory
 
 from vplane_mj import __version__, shapes
+from vplane_mj.polyline import PathSimplifier
 from vplane_mj.robot import SONAR_MOUNT_HEIGHT_M
 from vplane_mj.scenario import Scenario
 from vplane_mj.sim import Tick
@@ -67,9 +76,13 @@ from vplane_mj.world import OBSTACLE_HEIGHT_M
 
 WORLD_FRAME = "world"
 ROBOT_FRAME = "base_link"
+FOLLOW_FRAME = "base_link_xy"
+"""At base_link's position with the world's orientation: a camera following it never turns."""
 LOGGER_NAME = "vplane_mj"
 METADATA_NAME = "vplane_mj"
 """Name of the metadata record with the scenario, seed, planner and versions."""
+START_EVENT = "run started"
+"""The first `/events` message (time 0), from the log itself, so that the topic is never empty."""
 SUMMARY_METADATA_NAME = "summary"
 """Name of the metadata record written at close; its key `json` holds the summary."""
 METRICS_SCHEMA_NAME = "vplane_mj.Metrics"
@@ -80,12 +93,16 @@ ARROW_MAX_M = 1.5
 """Longest force arrow (m); stronger forces are drawn at this length."""
 ARROW_MIN_FORCE = 1e-4
 """Forces weaker than this are not drawn (their arrow is deleted)."""
+ROBOT_BODY_HEIGHT_M = 0.12
+"""Height (m) of the robot's disc in `/world`."""
 ARROW_HEIGHT_M = 0.3
 """Height (m) above the floor at which the force arrows are drawn."""
 FLUSH_PERIOD_S = 1.0
 """Simulated time between two writer flushes (and /path updates)."""
-PATH_MIN_STEP_M = 0.01
-"""The drawn path skips positions closer than this to its previous point."""
+PATH_TOLERANCE_M = 0.01
+"""The drawn path passes within this distance of every logged pose."""
+PATH_ID = "path"
+"""The one `/path` entity, replaced by every message."""
 
 _FORCE_STYLE: dict[str, tuple[tuple[float, float, float, float], float]] = {
     # name: (RGBA colour, extra height (m) so that overlapping arrows stay visible)
@@ -101,19 +118,20 @@ METRICS_JSON_SCHEMA: dict[str, Any] = {
     "type": "object",
     "properties": {
         "time_s": {"type": "number", "description": "simulated time (s)"},
-        "speed_mps": {"type": ["number", "null"], "description": "base speed (m/s)"},
-        "distance_to_goal_m": {"type": ["number", "null"], "description": "to the goal centre (m)"},
-        "force_attractive": {"type": ["number", "null"], "description": "magnitude"},
-        "force_repulsive": {"type": ["number", "null"], "description": "magnitude"},
-        "force_virtual": {"type": ["number", "null"], "description": "magnitude, null without one"},
-        "force_total": {"type": ["number", "null"], "description": "magnitude"},
+        "speed_mps": {"type": "number", "description": "base speed (m/s)"},
+        "distance_to_goal_m": {"type": "number", "description": "to the goal centre (m)"},
+        "force_attractive": {"type": "number", "description": "magnitude"},
+        "force_repulsive": {"type": "number", "description": "magnitude"},
+        "force_virtual": {"type": "number", "description": "magnitude, omitted without one"},
+        "force_total": {"type": "number", "description": "magnitude"},
         "mode": {"type": "string", "description": "planner mode"},
-        "command_v_mps": {"type": ["number", "null"], "description": "forward speed command"},
-        "command_omega_radps": {"type": ["number", "null"], "description": "turn rate command"},
-        "odometry_error_m": {"type": ["number", "null"], "description": "believed to true position"},
+        "command_v_mps": {"type": "number", "description": "forward speed command (m/s)"},
+        "command_omega_radps": {"type": "number", "description": "turn rate command (rad/s)"},
+        "odometry_error_m": {"type": "number", "description": "believed to true position, odometry only"},
     },
     "required": ["time_s", "mode"],
 }
+"""Every value optional but `time_s` and `mode`: a missing or non-finite one is omitted."""
 
 _WARNING_PREFIXES = ("collision", "gave up")
 
@@ -126,6 +144,8 @@ _COLOURS = {
     "objective": (0.70, 0.25, 0.90, 1.0),
     "plane": (0.70, 0.25, 0.90, 0.45),
     "path": (0.10, 0.35, 0.95, 1.0),
+    "robot": (0.20, 0.24, 0.32, 0.9),
+    "heading": (1.00, 1.00, 1.00, 1.0),
 }
 
 
@@ -155,16 +175,10 @@ def _colour(rgba: tuple[float, float, float, float]) -> fm.Color:
     return fm.Color(r=rgba[0], g=rgba[1], b=rgba[2], a=rgba[3])
 
 
-def _finite(value: float) -> float | None:
-    """The value as a float when finite, else None (JSON null)."""
-    value = float(value)
-    return value if math.isfinite(value) else None
-
-
 def _magnitude(vector: np.ndarray | None) -> float | None:
     if vector is None:
         return None
-    return _finite(math.hypot(float(vector[0]), float(vector[1])))
+    return math.hypot(float(vector[0]), float(vector[1]))
 
 
 def _package_version(name: str) -> str:
@@ -273,6 +287,9 @@ class McapLog:
         self._log_world()
         # An empty /virtual update at time 0 keeps the topic in every file, even without escapes.
         self._virtual_ch.log(fm.SceneUpdate(), log_time=0)
+        self._log_event(
+            0, f"{START_EVENT}: {scenario.name}, planner {scenario.planner}, seed {scenario.run.seed}"
+        )
 
         start = np.asarray(scenario.robot.start, dtype=float)
         self._last_pose = (float(start[0]), float(start[1]), float(scenario.robot.start_yaw))
@@ -280,12 +297,9 @@ class McapLog:
         self._shown_forces: set[str] = set()
         self._virtual_state: tuple[tuple[float, ...] | None, tuple[tuple[float, ...], ...]] = (None, ())
         self._shown_planes = 0
-        self._path: list[tuple[float, float]] = []
-        self._path_end = (0.0, 0.0)
+        self._path = PathSimplifier(PATH_TOLERANCE_M)
         self._path_dirty = False
-        self._path_sent = 0
-        self._path_segments = 0
-        self._next_flush_s = FLUSH_PERIOD_S
+        self._next_flush_s = 0.0  # the first tick flushes, so /path starts with the run
 
     # -- metadata and the static world -------------------------------------------------------
     def _run_metadata(self, extra: dict[str, str]) -> dict[str, str]:
@@ -367,7 +381,37 @@ class McapLog:
                 cylinders=[_flat_disc(robot.goal, tol, _COLOURS["goal"])],
             )
         )
+        entities.append(self._robot_body(stamp))
         self._world_ch.log(fm.SceneUpdate(entities=entities), log_time=0)
+
+    def _robot_body(self, stamp: fm.Timestamp) -> fm.SceneEntity:
+        """The robot as a disc of `robot_radius_m` with a heading arrow, locked to base_link."""
+        radius = self.robot_radius_m
+        return fm.SceneEntity(
+            timestamp=stamp,
+            frame_id=ROBOT_FRAME,
+            id="robot",
+            frame_locked=True,
+            cylinders=[
+                fm.CylinderPrimitive(
+                    pose=_pose(0.0, 0.0, ROBOT_BODY_HEIGHT_M / 2),
+                    size=fm.Vector3(x=2 * radius, y=2 * radius, z=ROBOT_BODY_HEIGHT_M),
+                    bottom_scale=1.0,
+                    top_scale=1.0,
+                    color=_colour(_COLOURS["robot"]),
+                )
+            ],
+            arrows=[
+                fm.ArrowPrimitive(
+                    pose=_pose(0.0, 0.0, ROBOT_BODY_HEIGHT_M + 0.01),
+                    shaft_length=0.7 * radius,
+                    shaft_diameter=0.03,
+                    head_length=0.3 * radius + 0.03,
+                    head_diameter=0.08,
+                    color=_colour(_COLOURS["heading"]),
+                )
+            ],
+        )
 
     # -- the Observer protocol ---------------------------------------------------------------
     def on_tick(self, tick: Tick) -> None:
@@ -387,7 +431,8 @@ class McapLog:
         self._log_forces(ns, stamp, x, y, tick)
         self._log_virtual(ns, stamp, tick)
         self._log_metrics(ns, tick)
-        self._add_path_point(x, y)
+        self._path.add(x, y)
+        self._path_dirty = True
         if tick.time_s >= self._next_flush_s - 1e-9:
             self._log_path(ns)
             self._writer.flush()
@@ -399,6 +444,9 @@ class McapLog:
             return
         ns = time_ns(time_s)
         self._last_ns = max(self._last_ns, ns)
+        self._log_event(ns, text)
+
+    def _log_event(self, ns: int, text: str) -> None:
         level = fm.LogLevel.Warning if text.startswith(_WARNING_PREFIXES) else fm.LogLevel.Info
         self._events_ch.log(
             fm.Log(timestamp=_stamp(ns), level=level, message=text, name=LOGGER_NAME), log_time=ns
@@ -428,14 +476,17 @@ class McapLog:
     def _log_pose(self, ns: int, stamp: fm.Timestamp, x: float, y: float, yaw: float) -> None:
         pose = _pose(x, y, 0.0, yaw)
         self._pose_ch.log(fm.PoseInFrame(timestamp=stamp, frame_id=WORLD_FRAME, pose=pose), log_time=ns)
-        transform = fm.FrameTransform(
-            timestamp=stamp,
-            parent_frame_id=WORLD_FRAME,
-            child_frame_id=ROBOT_FRAME,
-            translation=fm.Vector3(x=x, y=y, z=0.0),
-            rotation=_yaw_quaternion(yaw),
-        )
-        self._tf_ch.log(fm.FrameTransforms(transforms=[transform]), log_time=ns)
+        transforms = [
+            fm.FrameTransform(
+                timestamp=stamp,
+                parent_frame_id=WORLD_FRAME,
+                child_frame_id=child,
+                translation=fm.Vector3(x=x, y=y, z=0.0),
+                rotation=_yaw_quaternion(rotation),
+            )
+            for child, rotation in ((ROBOT_FRAME, yaw), (FOLLOW_FRAME, 0.0))
+        ]
+        self._tf_ch.log(fm.FrameTransforms(transforms=transforms), log_time=ns)
 
     def _log_belief(self, ns: int, stamp: fm.Timestamp, pose: tuple[float, float, float] | None) -> None:
         if self._odometry_ch is None or pose is None or not all(map(math.isfinite, pose)):
@@ -525,58 +576,44 @@ class McapLog:
         distance = math.hypot(
             self._goal[0] - float(tick.position[0]), self._goal[1] - float(tick.position[1])
         )
-        record = {
+        values = {
             "time_s": tick.time_s,
-            "speed_mps": _finite(tick.speed),
-            "distance_to_goal_m": _finite(distance),
+            "speed_mps": tick.speed,
+            "distance_to_goal_m": distance,
             "force_attractive": _magnitude(components.get("attractive")),
             "force_repulsive": _magnitude(components.get("repulsive")),
             "force_virtual": _magnitude(components.get("virtual")),
             "force_total": _magnitude(tick.decision.force),
-            "mode": tick.decision.mode,
-            "command_v_mps": _finite(tick.command[0]),
-            "command_omega_radps": _finite(tick.command[1]),
-            "odometry_error_m": None,
+            "command_v_mps": tick.command[0],
+            "command_omega_radps": tick.command[1],
         }
         if tick.believed_pose is not None:
-            error = math.dist(tick.believed_pose[:2], (float(tick.position[0]), float(tick.position[1])))
-            record["odometry_error_m"] = _finite(error)
+            position = (float(tick.position[0]), float(tick.position[1]))
+            values["odometry_error_m"] = math.dist(tick.believed_pose[:2], position)
+        record: dict[str, float | str] = {
+            key: float(value) for key, value in values.items() if value is not None and math.isfinite(value)
+        }
+        record["mode"] = tick.decision.mode
         self._metrics_ch.log(record, log_time=ns)
 
     # -- the path ----------------------------------------------------------------------------
-    def _add_path_point(self, x: float, y: float) -> None:
-        """Keep a point when it is PATH_MIN_STEP_M from the last kept one; always the newest."""
-        if not self._path or math.hypot(x - self._path[-1][0], y - self._path[-1][1]) >= PATH_MIN_STEP_M:
-            self._path.append((x, y))
-        self._path_end = (x, y)
-        self._path_dirty = True
-
     def _log_path(self, ns: int) -> None:
-        """Log the path travelled since the last call as a new entity `path_<k>`.
+        """Log the path from the start to the newest pose as the one entity `path`.
 
-        Earlier segments stay in the scene, so the whole path shows while the log grows
-        linearly with the run (re-sending the whole path every second would grow it
-        quadratically).
+        Each message replaces the previous one, so a viewer that keeps only the latest
+        message of the topic (after a seek) still draws the whole path up to its time.
         """
-        if not self._path:
-            return
-        strip = self._path[self._path_sent :]
-        if strip[-1] != self._path_end:
-            strip = [*strip, self._path_end]
-        points = [fm.Point3(x=px, y=py, z=0.01) for px, py in strip]
+        points = [fm.Point3(x=px, y=py) for px, py in self._path.polyline()]
         line = fm.LinePrimitive(
             type=fm.LinePrimitiveLineType.LineStrip,
-            pose=_pose(0.0, 0.0),
+            pose=_pose(0.0, 0.0, 0.01),
             thickness=0.03,
             scale_invariant=False,
             points=points,
             color=_colour(_COLOURS["path"]),
         )
-        entity_id = f"path_{self._path_segments}"
-        entity = fm.SceneEntity(timestamp=_stamp(ns), frame_id=WORLD_FRAME, id=entity_id, lines=[line])
+        entity = fm.SceneEntity(timestamp=_stamp(ns), frame_id=WORLD_FRAME, id=PATH_ID, lines=[line])
         self._path_ch.log(fm.SceneUpdate(entities=[entity]), log_time=ns)
-        self._path_segments += 1
-        self._path_sent = len(self._path) - 1  # the next segment starts where this one did end
         self._path_dirty = False
 
 

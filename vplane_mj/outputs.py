@@ -2,27 +2,51 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
-from collections.abc import Callable
+import tempfile
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from vplane_mj.errors import VPlaneError
 
 
-def prepare_out_dir(path: Path, create: bool) -> Path:
-    """Check that `path` is a writable directory (creating it only when `create`)."""
-    if create and not path.exists():
+def prepare_out_dir(path: Path) -> Path:
+    """`path` as a directory that files can be written into, created with its parents if missing.
+
+    Writability is tried with a temporary file, so that a read-only file system or a
+    directory that even root cannot write (such as /sys) is found before any work;
+    a VPlaneError names the directory and the reason.
+    """
+    if not path.is_dir():
+        if path.exists():
+            raise VPlaneError(f"{path}: output directory: is not a directory")
         try:
-            path.mkdir(parents=True)
+            path.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise VPlaneError(f"{path}: cannot create the output directory: {exc.strerror}") from exc
-    if not path.is_dir():
-        reason = "is not a directory" if path.exists() else "no such directory"
-        raise VPlaneError(f"{path}: output directory: {reason}")
-    if not os.access(path, os.W_OK | os.X_OK):
-        raise VPlaneError(f"{path}: output directory is not writable")
+    try:
+        with tempfile.TemporaryFile(dir=path, prefix=".vplane-mj-probe-"):
+            pass
+    except OSError as exc:
+        raise VPlaneError(f"{path}: output directory is not writable: {exc.strerror}") from exc
     return path
+
+
+@contextlib.contextmanager
+def output_directory(path: Path) -> Iterator[Path]:
+    """`prepare_out_dir(path)` for a command: if the command then fails on bad input (a
+    VPlaneError), the directories made here are removed again while they are empty, so
+    that a rejected command leaves nothing behind."""
+    missing = [parent for parent in (path, *path.parents) if not parent.exists()]
+    try:
+        yield prepare_out_dir(path)
+    except VPlaneError:
+        for directory in missing:  # deepest first
+            with contextlib.suppress(OSError):
+                directory.rmdir()
+        raise
 
 
 def write_atomically(path: Path, write: Callable[[Path], None]) -> Path:

@@ -165,10 +165,9 @@ def _boundary_points(scenario: Scenario) -> np.ndarray:
 def _draw_series(speed_axes, mode_axes, path: Path) -> None:
     metrics = [m.message for m in iter_messages(path, ("/metrics",))]
     t = np.array([m["time_s"] for m in metrics])
-    speed = np.array([np.nan if m["speed_mps"] is None else m["speed_mps"] for m in metrics])
-    distance = np.array(
-        [np.nan if m["distance_to_goal_m"] is None else m["distance_to_goal_m"] for m in metrics]
-    )
+    # A value left out (or null, in logs of earlier versions) is a gap.
+    speed = np.array([m.get("speed_mps") for m in metrics], dtype=float)
+    distance = np.array([m.get("distance_to_goal_m") for m in metrics], dtype=float)
     speed_axes.plot(t, speed, color="#1f77b4", label="speed (m/s)")
     speed_axes.set_ylabel("speed (m/s)")
     twin = speed_axes.twinx()

@@ -1,0 +1,96 @@
+"""Cost of `vplane-mj video`, measured side by side with the logged run it replays.
+
+For each scenario: one logged run (`vplane-mj run`'s simulation and MCAP log, no render)
+takes T_run wall seconds; the MP4 at real time (25 fps) and the GIF at 2x (10 fps) made
+from that log take T_mp4 and T_gif. Reported: the frames, the encoding's wall time per
+simulated second and its ratio to T_run (the medians of `--repeat` measurements), and the
+file sizes.
+
+    python benchmarks/video.py [SCENARIO ...] [--planner vplane] [--repeat 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from vplane_mj.log_mcap import McapLog, read_log
+from vplane_mj.robot import robot_radius_m
+from vplane_mj.scenario import load_scenario
+from vplane_mj.sim import run_scenario
+from vplane_mj.video import FORMATS, frame_count, write_video
+from vplane_mj.world import SonarLayout
+
+DEFAULT_SCENARIOS = ("paper_c_escape", "paper_h_escape")
+MP4_SPEED, GIF_SPEED = 1.0, 2.0
+
+
+def logged_run(scenario, path: Path) -> float:
+    """Wall seconds of one run writing its MCAP log to `path`."""
+    started = time.perf_counter()
+    bearings = SonarLayout.from_spec(scenario.sensors).bearings
+    log = McapLog(path, scenario, robot_radius_m(), bearings, scenario.sensors.range_max, {})
+    result = run_scenario(scenario, observers=(log,))
+    log.close(result.summary)
+    return time.perf_counter() - started
+
+
+def encoding(log: Path, target: Path, speed: float) -> float:
+    """Wall seconds of one `write_video`."""
+    started = time.perf_counter()
+    write_video(log, target, speed, show_progress=False)
+    return time.perf_counter() - started
+
+
+def measure(name: str, planner: str, repeat: int, work: Path) -> dict:
+    scenario = load_scenario(name, [f"planner.name={planner}"])
+    log, mp4, gif = work / f"{name}.mcap", work / f"{name}.mp4", work / f"{name}.gif"
+    times = {"run": [], "mp4": [], "gif": []}
+    for _ in range(repeat):
+        times["run"].append(logged_run(scenario, log))
+        times["mp4"].append(encoding(log, mp4, MP4_SPEED))
+        times["gif"].append(encoding(log, gif, GIF_SPEED))
+    median = {key: statistics.median(values) for key, values in times.items()}
+    simulated = read_log(log).times_ns[-1] / 1e9
+    return {
+        "scenario": name,
+        "simulated_s": simulated,
+        "run_s": median["run"],
+        "mp4_frames": sum(frame_count(simulated, MP4_SPEED, FORMATS[".mp4"].fps)),
+        "mp4_s": median["mp4"],
+        "mp4_kb": mp4.stat().st_size / 1000,
+        "gif_frames": sum(frame_count(simulated, GIF_SPEED, FORMATS[".gif"].fps)),
+        "gif_s": median["gif"],
+        "gif_kb": gif.stat().st_size / 1000,
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scenarios", nargs="*", default=list(DEFAULT_SCENARIOS))
+    parser.add_argument("--planner", default="vplane")
+    parser.add_argument("--repeat", type=int, default=3)
+    args = parser.parse_args(argv)
+    print(
+        "| scenario | simulated s | MP4 frames | MP4: wall s per simulated s | MP4 / run | MP4 kB "
+        "| GIF frames (2x) | GIF / run | GIF kB |"
+    )
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    with tempfile.TemporaryDirectory() as work:
+        for name in args.scenarios:
+            r = measure(name, args.planner, args.repeat, Path(work))
+            print(
+                f"| {r['scenario']} | {r['simulated_s']:.1f} | {r['mp4_frames']} | "
+                f"{r['mp4_s'] / r['simulated_s']:.2f} | {r['mp4_s'] / r['run_s']:.1f} | {r['mp4_kb']:.0f} | "
+                f"{r['gif_frames']} | {r['gif_s'] / r['run_s']:.1f} | {r['gif_kb']:.0f} |",
+                flush=True,
+            )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,105 @@
+"""`vplane-mj video` and `run --video`: a run replayed from its log as MP4 and GIF."""
+
+import math
+
+import imageio_ffmpeg
+import numpy as np
+import pytest
+from PIL import Image
+
+from vplane_mj.cli import main
+from vplane_mj.log_mcap import read_log
+from vplane_mj.timeline import timeline_from_log
+
+TIME_LIMIT_S = 6.0  # vplane detects the trap at 5.45 s: the escape starts on screen
+
+
+@pytest.fixture(scope="module")
+def logged(tmp_path_factory):
+    """A short `run --video`: its output directory."""
+    out_dir = tmp_path_factory.mktemp("video")
+    argv = ["run", "paper_c_escape", "--set", f"run.time_limit_s={TIME_LIMIT_S}", "--video"]
+    assert main([*argv, "--no-render", "--out", str(out_dir)]) == 1  # timeout
+    return out_dir
+
+
+def decode(path) -> tuple[dict, list[np.ndarray]]:
+    """The stream's metadata and every frame as an (H, W, 3) array."""
+    reader = imageio_ffmpeg.read_frames(str(path))
+    meta = next(reader)
+    width, height = meta["size"]
+    frames = [np.frombuffer(frame, np.uint8).reshape(height, width, 3) for frame in reader]
+    return meta, frames
+
+
+def test_run_writes_an_h264_mp4_in_real_time_beside_the_log(logged, capsys):
+    video = logged / "paper_c_escape-vplane-0.mp4"
+    assert video.is_file() and not list(logged.glob(".*partial"))
+    meta, frames = decode(video)
+    assert meta["codec"].startswith("h264") and meta["fps"] == 25
+    assert meta["size"] == (720, meta["size"][1]) and meta["size"][1] % 2 == 0
+    assert len(frames) == TIME_LIMIT_S * 25 + 1 + 25  # every 40 ms of the run, then a 1 s hold
+    first, last = frames[0].astype(int), frames[-1].astype(int)
+    assert np.abs(first - last).mean() > 0.5  # the robot moved and the path grew
+    assert np.abs(frames[-25].astype(int) - last).mean() < 0.1  # the held end (H.264 is lossy)
+    orange = (np.abs(last - (255, 127, 14)).sum(axis=2) < 60).sum()
+    assert orange > 20  # sonar echoes
+
+
+def test_gif_at_a_speed(logged, capsys, tmp_path):
+    target = tmp_path / "run.gif"
+    log = logged / "paper_c_escape-vplane-0.mcap"
+    assert main(["video", str(log), "-o", str(target), "--speed", "3"]) == 0
+    assert f"wrote {target}" in capsys.readouterr().out
+    with Image.open(target) as gif:
+        assert gif.format == "GIF" and gif.size[0] == 480
+        frames = gif.n_frames
+        assert gif.info.get("loop") == 0 and gif.info.get("duration") == 100
+    assert frames == TIME_LIMIT_S / 3 * 10 + 1 + 10
+    assert target.stat().st_size < 200_000
+
+
+@pytest.mark.parametrize(
+    "extra, fragment",
+    [
+        (["-o", "{tmp}/run.avi"], "-o must end in .mp4 or .gif"),
+        (["-o", "{tmp}/run.mp4", "--speed", "0"], "--speed: must be greater than 0"),
+        (["-o", "{tmp}/run.mp4", "--speed", "nan"], "--speed"),
+        (["-o", "{tmp}/run.mp4", "--speed", "1e6"], "--speed"),
+        (["-o", "{tmp}/run.mp4", "--speed", "0.001"], "raise --speed"),
+        (["-o", "{tmp}/missing/run.mp4"], "no such directory"),
+    ],
+)
+def test_bad_arguments_exit_2_and_write_nothing(logged, capsys, tmp_path, extra, fragment):
+    argv = ["video", str(logged / "paper_c_escape-vplane-0.mcap"), *[a.format(tmp=tmp_path) for a in extra]]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and fragment in err and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_missing_log_and_video_without_a_log(capsys, tmp_path):
+    assert main(["video", str(tmp_path / "none.mcap"), "-o", str(tmp_path / "x.mp4")]) == 2
+    assert "no such log file" in capsys.readouterr().err
+    assert main(["run", "open_field", "--video", "--no-log", "--out", str(tmp_path)]) == 2
+    assert "--video" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_timeline_of_a_log(logged):
+    log = logged / "paper_c_escape-vplane-0.mcap"
+    contents = read_log(log)
+    timeline = timeline_from_log(log, contents)
+    ticks = len(contents.times_ns)
+    assert len(timeline.times_s) == len(timeline.echoes) == len(timeline.forces) == ticks
+    assert timeline.index_at(-1.0) == 0 and timeline.index_at(1e9) == ticks - 1
+    assert timeline.times_s[timeline.index_at(2.0)] <= 2.0 < timeline.times_s[timeline.index_at(2.0) + 1]
+    escape = next(t for t, _, text in timeline.events if text.startswith("escape started"))
+    for k, t in enumerate(timeline.times_s):
+        # the objective exists from the escape on (until the final state); echoes lie within range
+        assert (timeline.objectives[k] is not None) == (escape <= t < timeline.times_s[-1]), t
+        reach = np.hypot(*(timeline.echoes[k] - timeline.poses[k, :2]).T)
+        assert np.all(reach <= 3.0 + 0.1 + 1e-9)
+        for x, y, dx, dy in timeline.forces[k].values():
+            assert (x, y) == pytest.approx(tuple(timeline.poses[k, :2])) and math.hypot(dx, dy) <= 1.5 + 1e-9
+    assert sum(len(echoes) for echoes in timeline.echoes) > 5 * ticks
