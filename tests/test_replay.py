@@ -91,7 +91,7 @@ def test_plot_from_the_log(tmp_path, capsys):
     assert main(["plot", log, "-o", str(tmp_path / "missing" / "x.png")]) == 2
 
 
-@pytest.mark.parametrize("planner", ["vfh", "bug2"])
+@pytest.mark.parametrize("planner", ["vfh", "bug2", "dwa"])
 def test_plot_of_a_planner_without_a_potential_field(tmp_path, capsys, planner):
     """The field panel falls back to APF's gains for planners that have none of their own."""
     run_logged(tmp_path, capsys, "open_field", "--planner", planner, "--set", "run.time_limit_s=3")
