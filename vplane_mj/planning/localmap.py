@@ -99,16 +99,18 @@ class LocalMap:
         `min_certainty`), over the square of cells within `reach_m` of `centre`: a Euclidean
         distance transform of that square alone. Obstacle cells outside it are not seen, so a
         distance d is exact for points at least d inside the square."""
-        middle = np.floor(np.asarray(centre, float) / self.cell_m).astype(int) - self.origin
         reach = math.ceil(reach_m / self.cell_m)
-        lo = np.clip(middle - reach, 0, self.n - 2)
-        hi = np.clip(middle + reach + 1, lo + 2, self.n)
+        lo, hi = [], []
+        for axis in range(2):
+            middle = math.floor(centre[axis] / self.cell_m) - int(self.origin[axis])
+            lo.append(min(max(middle - reach, 0), self.n - 2))
+            hi.append(min(max(middle + reach + 1, lo[axis] + 2), self.n))
         free = self.grid[lo[0] : hi[0], lo[1] : hi[1]] < min_certainty
         if free.all():  # farther than any cell of the map could be
             values = np.full(free.shape, 2.0 * self.n * self.cell_m)
         else:
             values = ndimage.distance_transform_edt(free) * self.cell_m
-        return ClearanceField(values, self.origin + lo, self.cell_m)
+        return ClearanceField(values, self.origin + np.array(lo), self.cell_m)
 
     def _follow(self, position: np.ndarray) -> None:
         """Keep the robot in the grid's middle half, shifting the grid by whole cells."""
