@@ -13,8 +13,8 @@ DWA searches the space of commands (v, omega) rather than of directions. Each co
    of its obstacle cells, bilinear between cell centres). dist is the length travelled before
    the robot's disc plus `margin_m` reaches an obstacle cell, `lookahead_m` (Fox's "large
    constant") when it does not; the arc after it enters the goal tolerance does not count.
-   Should the map already put a cell within the disc plus margin, arcs may only not come
-   closer than the robot is.
+   When the map already puts a cell within the disc plus margin, an arc is blocked only
+   where it comes closer to a cell than the robot already is.
 4. Admissible: the robot stops within dist: one control period at v (a command holds until
    the next tick), then braking at `accel_mps2`.
 5. Objective: G = sigma(alpha heading + beta dist + gamma velocity), each term in [0, 1]:
