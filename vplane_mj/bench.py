@@ -350,8 +350,13 @@ def _plot(rows: list[dict]):
         ha="right",
         fontsize=8,
     )
-    rates.set(ylim=(0, 1.05), ylabel="success rate", title="success per planner and family")
-    rates.legend()
+    rates.set(
+        ylim=(0, 1.3),
+        yticks=[0.0, 0.2, 0.4, 0.6, 0.8, 1.0],
+        ylabel="success rate",
+        title="success per planner and family",
+    )
+    rates.legend(loc="upper center", ncol=min(len(planners), 6), fontsize=8)  # in the headroom above 1
     data = [[r["time_to_goal_s"] for r in rows if r["planner"] == p and r["reached"]] for p in planners]
     times.boxplot([d if d else [float("nan")] for d in data], tick_labels=planners)
     times.set(ylabel="time to goal (s)", title="time to goal of the runs that reached it")
