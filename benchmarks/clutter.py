@@ -162,7 +162,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: bad arguments (unknown planners: {unknown})", file=sys.stderr)
         return 2
     try:
-        out = prepare_out_dir(args.out, create=True)
+        out = prepare_out_dir(args.out)
     except VPlaneError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

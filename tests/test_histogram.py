@@ -67,3 +67,15 @@ def test_nearest_wide_valley_skips_narrow_ones_and_measures_distance():
     valley, distance = nearest_wide_valley(valleys, math.radians(5 * 10), 36, min_sectors=3)
     assert (valley.first, valley.count) == (10, 4) and distance == 5
     assert nearest_wide_valley(valleys, 0.0, 36, min_sectors=5) == (None, 36)
+
+
+def test_an_obstacle_behind_a_gap_closes_the_gap_while_it_is_in_the_window():
+    """A 0.9 m gap 1 m ahead, which the enlarged robot (0.38 m) fits through, and a post 0.8 m
+    behind it: the way ahead is blocked as long as the window reaches the post, although the
+    robot could pass the gap and turn (why VFH stops short in clutter)."""
+    walls = [[1.0, y] for y in np.arange(0.45, 1.5, 0.05)] + [[1.0, -y] for y in np.arange(0.45, 1.5, 0.05)]
+    post = [[1.8, 0.0]]
+    ahead = sector_of(0.0, N)
+    assert not blocked_by(walls, window=2.0)[ahead]
+    assert blocked_by(walls + post, window=2.0)[ahead]
+    assert not blocked_by(walls + post, window=1.5)[ahead]

@@ -97,3 +97,31 @@ def test_extreme_points_of_an_obstacle_ahead():
     assert points[i1] == pytest.approx([2.0, -1.0])  # clockwise end first
     assert points[i2] == pytest.approx([2.0, 1.0])
     assert span == pytest.approx(2 * math.atan(0.5))
+
+
+def test_the_clearance_field_is_the_distance_to_the_nearest_obstacle_cell():
+    rng = np.random.default_rng(0)
+    grid = LocalMap(cell_m=0.1, size_m=8.0)
+    grid.update(np.zeros(2), 0.0, BEARINGS, np.full(16, np.nan), BEAM)  # places the grid around (0, 0)
+    index = rng.integers(25, 55, size=(12, 2))
+    grid.grid[index[:, 0], index[:, 1]] = 6
+    cells, _ = grid.cells(4)
+    field = grid.clearance_field(4, np.zeros(2), reach_m=1.5)
+
+    def exact(points):
+        return np.min(np.hypot(*(points[:, None, :] - cells[None]).transpose(2, 0, 1)), axis=1)
+
+    centres = (np.argwhere(np.ones(field.values.shape, bool)) + field.first_cell + 0.5) * 0.1
+    seen = np.all(np.abs(centres) < 1.5 - exact(centres)[:, None], axis=1)  # nearest cell in the square
+    np.testing.assert_allclose(field.at(centres)[seen], exact(centres)[seen], atol=1e-9)
+    points = rng.uniform(-1.2, 1.2, size=(4000, 2))
+    near = exact(points) < 0.3  # where a robot's clearance is judged
+    assert near.sum() > 100
+    error = field.at(points[near]) - exact(points[near])  # bilinear between cell centres
+    assert error.min() > -0.05 and error.max() < 0.02  # at most 2 cm above the truth, up to 5 cm below
+
+
+def test_the_clearance_field_sees_only_its_square():
+    grid = mapped(WALL, (0.0, 0.0))  # the wall 1.95 m ahead
+    assert grid.clearance_field(4, np.zeros(2), reach_m=3.0).at(np.zeros((1, 2)))[0] < 2.0
+    assert grid.clearance_field(4, np.zeros(2), reach_m=1.0).at(np.zeros((1, 2)))[0] > 8.0  # none in it

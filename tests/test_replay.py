@@ -89,3 +89,12 @@ def test_plot_from_the_log(tmp_path, capsys):
     assert np.std(image[..., :3]) > 0.1
     log = str(tmp_path / "paper_c_escape-vplane-0.mcap")
     assert main(["plot", log, "-o", str(tmp_path / "missing" / "x.png")]) == 2
+
+
+@pytest.mark.parametrize("planner", ["vfh", "bug2", "dwa"])
+def test_plot_of_a_planner_without_a_potential_field(tmp_path, capsys, planner):
+    """The field panel falls back to APF's gains for planners that have none of their own."""
+    run_logged(tmp_path, capsys, "open_field", "--planner", planner, "--set", "run.time_limit_s=3")
+    target = tmp_path / "plot.png"
+    assert main(["plot", str(tmp_path / f"open_field-{planner}-0.mcap"), "-o", str(target)]) == 0
+    assert np.std(matplotlib.image.imread(target)[..., :3]) > 0.1

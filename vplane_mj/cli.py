@@ -381,5 +381,5 @@ def _list(args: argparse.Namespace) -> int:
         print(f"  {name}{default}: {info.summary}")
         print(f"    after: {info.citation}")
         for key, param in info.params.items():
-            print(f"    {key:<22} {param.default:<8g} {param.unit:<5} {param.doc}")
+            print(f"    {key:<22} {param.default:<8g} {param.unit:<7} {param.doc}")
     return 0

@@ -18,6 +18,7 @@ from matplotlib.patches import Circle, Polygon
 from vplane_mj import shapes
 from vplane_mj.log_mcap import METADATA_NAME, LogContents, iter_messages
 from vplane_mj.planning import fields
+from vplane_mj.planning.apf import FIELD_PARAMS
 from vplane_mj.planning.registry import planner_info
 from vplane_mj.render import MODE_RGBA, OTHER_MODE_RGBA, Track
 from vplane_mj.scenario import Scenario
@@ -93,10 +94,12 @@ def _draw_field(axes, contents: LogContents, scenario: Scenario) -> None:
     """The FIRAS total force (eqs. 3, 5, 6) around the first local minimum (or the start).
 
     Obstacle boundaries sampled every 5 cm stand in for the sonar echoes, so this is the
-    field a robot with perfect sensing would follow: the trap that APF falls into.
+    field a robot with perfect sensing would follow: the trap that APF falls into. The run's
+    field gains when its planner has them, APF's defaults otherwise.
     """
     info = contents.metadata[METADATA_NAME]
-    params = planner_info(scenario.planner).resolve(json.loads(info.get("planner_params", "{}")))
+    resolved = planner_info(scenario.planner).resolve(json.loads(info.get("planner_params", "{}")))
+    params = {key: resolved.get(key, param.default) for key, param in FIELD_PARAMS.items()}
     times = contents.times_ns / 1e9
     minima = [t for t, _, text in contents.events if text.startswith("local minimum")]
     if minima:

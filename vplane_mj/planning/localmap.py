@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import functools
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import ndimage
@@ -137,6 +138,24 @@ class LocalMap:
         values[inside] = grid_values[index[inside, 0], index[inside, 1]]
         return values
 
+    def clearance_field(self, min_certainty: int, centre: np.ndarray, reach_m: float) -> ClearanceField:
+        """The distance (m) from each cell's centre to the nearest obstacle cell's centre (at
+        `min_certainty`), over the square of cells within `reach_m` of `centre`: a Euclidean
+        distance transform of that square alone. Obstacle cells outside it are not seen, so a
+        distance d is exact for points at least d inside the square."""
+        reach = math.ceil(reach_m / self.cell_m)
+        lo, hi = [], []
+        for axis in range(2):
+            middle = math.floor(centre[axis] / self.cell_m) - int(self.origin[axis])
+            lo.append(min(max(middle - reach, 0), self.n - 2))
+            hi.append(min(max(middle + reach + 1, lo[axis] + 2), self.n))
+        free = self.grid[lo[0] : hi[0], lo[1] : hi[1]] < min_certainty
+        if free.all():  # farther than any cell of the map could be
+            values = np.full(free.shape, 2.0 * self.n * self.cell_m)
+        else:
+            values = ndimage.distance_transform_edt(free) * self.cell_m
+        return ClearanceField(values, self.origin + np.array(lo), self.cell_m)
+
     def _follow(self, position: np.ndarray) -> None:
         """Keep the robot in the grid's middle half, shifting the grid by whole cells."""
         centre_cell = np.floor(np.asarray(position) / self.cell_m).astype(int) - self.n // 2
@@ -153,6 +172,31 @@ class LocalMap:
             moved[dst[0], dst[1]] = getattr(self, name)[src[0], src[1]]
             setattr(self, name, moved)
         self.origin = centre_cell
+
+
+@dataclass(frozen=True)
+class ClearanceField:
+    """Distances (m) to the nearest obstacle cell, at the centres of a block of map cells."""
+
+    values: np.ndarray
+    first_cell: np.ndarray
+    """World cell index (i, j) of values[0, 0]."""
+    cell_m: float
+
+    def at(self, points: np.ndarray) -> np.ndarray:
+        """The distance at world points (N, 2), bilinear between the cell centres; points beyond
+        the outermost centres take the border's values."""
+        rows, cols = self.values.shape
+        u = np.asarray(points, float) / self.cell_m - self.first_cell - 0.5
+        i = np.minimum(np.maximum(np.floor(u[:, 0]).astype(int), 0), rows - 2)
+        j = np.minimum(np.maximum(np.floor(u[:, 1]).astype(int), 0), cols - 2)
+        fx = np.minimum(np.maximum(u[:, 0] - i, 0.0), 1.0)
+        fy = np.minimum(np.maximum(u[:, 1] - j, 0.0), 1.0)
+        flat = self.values.ravel()
+        index = i * cols + j
+        below = flat[index] + (flat[index + cols] - flat[index]) * fx
+        above = flat[index + 1] + (flat[index + cols + 1] - flat[index + 1]) * fx
+        return below + (above - below) * fy
 
 
 @functools.cache

@@ -59,10 +59,15 @@ class PlannerInfo:
         return values
 
 
-SONAR_MAP_PARAMS: dict[str, Param] = {
+LOCAL_MAP_PARAMS: dict[str, Param] = {
     "map_cell_m": Param(0.1, "m", "cell size of the local sonar map", ge=0.05, le=1.0),
     "map_size_m": Param(8.0, "m", "side of the square local map that follows the robot", gt=0, le=20.0),
     "map_threshold": Param(4, "", "certainty at which a map cell counts as an obstacle", ge=1, integer=True),
+}
+"""The sonar certainty grid (localmap.py), shared by the planners that keep one."""
+
+SONAR_MAP_PARAMS: dict[str, Param] = {
+    **LOCAL_MAP_PARAMS,
     "sector_deg": Param(5.0, "deg", "polar histogram sector width", ge=0.5, le=45),
     "window_m": Param(2.0, "m", "radius of the histogram's active window", gt=0),
     "histogram_threshold": Param(1.0, "", "sector density above which a sector is blocked", gt=0),

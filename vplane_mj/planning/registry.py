@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Protocol
 
-from vplane_mj.planning import apf, bug2, vfh, vobs, vplane, vplane_plus
+from vplane_mj.planning import apf, bug2, dwa, vfh, vobs, vplane, vplane_plus
 from vplane_mj.planning.params import PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
 
@@ -27,6 +27,7 @@ PLANNERS: dict[str, tuple[PlannerInfo, Factory]] = {
     vobs.INFO.name: (vobs.INFO, lambda params, _radius: vobs.VobsPlanner(params)),
     vfh.INFO.name: (vfh.INFO, vfh.VfhPlanner),
     bug2.INFO.name: (bug2.INFO, lambda params, _radius: bug2.Bug2Planner(params)),
+    dwa.INFO.name: (dwa.INFO, dwa.DwaPlanner),
 }
 
 DEFAULT_PLANNER = vplane.INFO.name

@@ -1,0 +1,119 @@
+"""Planner cost per control tick: every planner on the same observations, side by side.
+
+For each scenario, one run driven by `--driver` records what its planner observed at every
+control tick (pose, goal, sonar scan). Every planner then steps through that same sequence
+from a fresh state, `--repeat` times, in turn (a, b, c, a, b, c, ...). The time is the
+process's CPU time, which a busy machine delays but does not inflate the way it does wall
+time; the median over the repeats of each planner's mean per tick is reported, and its
+ratio to `vfh`'s. The sonar map that vfh, vplane and dwa keep is the same code; its update
+alone is reported as `map`. The default scenarios are a generated BARN-like world (the one
+of tests/test_dwa.py), paper_c_escape and single_box.
+
+    python benchmarks/planner_cost.py [SCENARIO ...] [--driver dwa] [--repeat 5]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import statistics
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from vplane_mj.families import random_barn
+from vplane_mj.planning.localmap import LocalMap
+from vplane_mj.planning.registry import PLANNERS, make_planner, planner_info
+from vplane_mj.planning.types import Observation
+from vplane_mj.robot import robot_radius_m
+from vplane_mj.scenario import load_scenario, parse_scenario
+from vplane_mj.sim import run_scenario
+from vplane_mj.world import SonarLayout
+
+BARN_SEED = 8
+"""The generated BARN-like world of the default set (47 boxes; tests/test_dwa.py drives it)."""
+
+
+class _Recorder:
+    """Rebuilds each tick's Observation (the planner sees the true pose by default)."""
+
+    def __init__(self, scenario):
+        self.scenario = scenario
+        self.bearings = SonarLayout.from_spec(scenario.sensors).bearings
+        self.observations: list[Observation] = []
+
+    def on_tick(self, tick) -> None:
+        if tick.decision.mode == "finished":
+            return
+        robot, sensors = self.scenario.robot, self.scenario.sensors
+        self.observations.append(
+            Observation(
+                tick.time_s,
+                np.array(tick.position),
+                tick.yaw,
+                np.asarray(robot.goal, float),
+                robot.goal_tolerance,
+                self.bearings,
+                np.array(tick.ranges),
+                math.radians(sensors.beam_deg),
+            )
+        )
+
+    def on_event(self, time_s: float, text: str) -> None:
+        pass
+
+
+def scenarios(names: list[str], driver: str):
+    if names:
+        return [load_scenario(name, [f"planner.name={driver}"]) for name in names]
+    barn = random_barn(f"barn_seed{BARN_SEED}", np.random.default_rng(BARN_SEED))
+    return [
+        parse_scenario(barn.toml(), f"{barn.name}.toml", [f"planner.name={driver}"]),
+        load_scenario("paper_c_escape", [f"planner.name={driver}"]),
+        load_scenario("single_box", [f"planner.name={driver}"]),
+    ]
+
+
+def map_only(params: dict) -> Callable[[Observation], None]:
+    """One tick of the sonar map alone, as vfh, vplane and dwa update it."""
+    grid = LocalMap(params["map_cell_m"], params["map_size_m"])
+    return lambda obs: grid.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
+
+
+def per_tick_ms(planners: list[str], observations: list[Observation], repeat: int) -> dict[str, float]:
+    """Median over `repeat` rounds of each planner's (and the map's) mean CPU time per tick (ms)."""
+    times: dict[str, list[float]] = {name: [] for name in [*planners, "map"]}
+    for _ in range(repeat):
+        for name in times:
+            if name == "map":
+                step = map_only(planner_info("vfh").resolve({}))
+            else:
+                step = make_planner(name, {}, robot_radius_m()).step
+            start = time.process_time()
+            for obs in observations:
+                step(obs)
+            times[name].append(1e3 * (time.process_time() - start) / len(observations))
+    return {name: statistics.median(values) for name, values in times.items()}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scenarios", nargs="*")
+    parser.add_argument("--driver", default="dwa", choices=sorted(PLANNERS))
+    parser.add_argument("--repeat", type=int, default=5)
+    args = parser.parse_args()
+    planners = sorted(PLANNERS)
+    columns = [*planners, "map"]
+    print("| scenario | ticks | " + " | ".join(f"`{p}` ms (x vfh)" for p in columns) + " |")
+    print("|---|---:|" + "---:|" * len(columns))
+    for scenario in scenarios(args.scenarios, args.driver):
+        recorder = _Recorder(scenario)
+        run_scenario(scenario, observers=(recorder,))
+        cost = per_tick_ms(planners, recorder.observations, args.repeat)
+        cells = " | ".join(f"{cost[p]:.3f} ({cost[p] / cost['vfh']:.2f})" for p in columns)
+        print(f"| {scenario.name} | {len(recorder.observations)} | {cells} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
