@@ -125,6 +125,17 @@ class Window:
             inside = (i >= 0) & (i < self.cost.shape[0]) & (j >= 0) & (j < self.cost.shape[1])
             self.cost[i[inside], j[inside]] = np.inf
 
+    def path_cost(self, points: np.ndarray) -> float:
+        """The cost of a polyline of world points (m): each segment's length times the mean step
+        cost of its ends (1 outside the window); inf when a point lies on a blocked cell."""
+        points = np.asarray(points, float).reshape(-1, 2)
+        cells = np.floor((points - self.corner) / self.cell_m).astype(int)
+        inside = np.all((cells >= 0) & (cells < self.cost.shape), axis=1)
+        step = np.ones(len(points))
+        step[inside] = self.cost[cells[inside, 0], cells[inside, 1]]
+        lengths = np.hypot(*np.diff(points, axis=0).T)
+        return float(np.sum(lengths * 0.5 * (step[:-1] + step[1:])))
+
     def line_of_sight(self, a: np.ndarray, b: np.ndarray) -> bool:
         """Whether the straight segment between two world points (m) stays on free cells (or
         leaves the window), sampled every half cell."""

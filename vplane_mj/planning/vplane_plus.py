@@ -41,6 +41,10 @@ from vplane_mj.planning.vplane import PARAMS as VPLANE_PARAMS
 from vplane_mj.planning.vplane import VPlanePlanner
 from vplane_mj.planning.vplane_geometry import VirtualPlane, make_plane, unit, virtual_objective
 
+CLOSE_ECHO_MARGIN_M = 0.1
+"""An echo this close beyond the robot's disc (m) repels in full, even against the way."""
+KEEP_WAY_RATIO = 1.25
+"""A new way replaces the one being followed only when that one costs this much more."""
 STALL_RADIUS_M = 0.3
 """Passing within this distance (m) of where the way was held up costs as much as a doubtful cell."""
 BLOCK_LOOKAHEAD_M = 0.6
@@ -158,7 +162,7 @@ class VPlanePlusPlanner(VPlanePlanner):
                 self.escape_way = self._way(window, obs.position, self.temp_goal) or []
             target = self._next_waypoint(obs.position, self.escape_way, self.temp_goal)
             pull = 2.0 * p["vno_gain"] * float(np.hypot(*(obs.position - self.temp_goal)))  # eq. 7
-            self._along_the_way(obs, components, target, pull)
+            self._along_the_way(obs, components, target, pull, bool(self.escape_way))
         elif self.following:
             decision.mode = "following"
             target = self._follow_target(obs, decision)
@@ -167,7 +171,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             goal_pull = fields.attractive_force(
                 obs.position, obs.goal, p["attract_gain"], p["attract_radius"]
             )
-            self._along_the_way(obs, components, target, float(np.hypot(*goal_pull)))
+            self._along_the_way(obs, components, target, float(np.hypot(*goal_pull)), bool(self.follow_way))
         else:
             self._update_avoidance(obs, decision)
             if self.avoid_waypoint is not None:
@@ -186,24 +190,34 @@ class VPlanePlusPlanner(VPlanePlanner):
         return decision
 
     def _along_the_way(
-        self, obs: Observation, components: dict[str, np.ndarray], waypoint: np.ndarray, pull: float
+        self,
+        obs: Observation,
+        components: dict[str, np.ndarray],
+        waypoint: np.ndarray,
+        pull: float,
+        on_a_way: bool,
     ) -> None:
-        """Forces while the robot follows a way of the map: the attraction of the way's end
-        (magnitude `pull`) turned toward the next waypoint, and the repulsion of the echoes
-        within `follow_influence_m` without its part against the way. The way keeps the robot
-        off the mapped obstacles, and the nearest mapped cell still repels at close range
+        """Forces while the robot heads for `waypoint`: the attraction of the way's end
+        (magnitude `pull`) turned toward it, and, `on_a_way` of the map, the repulsion of the
+        echoes within `follow_influence_m` without its part against the way. The way keeps the
+        robot off the mapped obstacles, and the nearest mapped cell still repels at close range
         (`_nearest_cell_force`); the echoes' part against the way would stop the robot at
         every narrow gap, since an echo is placed on its sonar's axis, up to half a beam away
-        from the obstacle that returned it."""
+        from the obstacle that returned it. Echoes closer than the robot radius plus
+        CLOSE_ECHO_MARGIN_M, and without a way (the map shows none) all echoes, repel in full,
+        as in normal mode."""
         p = self.params
         heading = unit(waypoint - obs.position)
         components["attractive"] = pull * heading
-        repulsive = fields.repulsive_force(
-            obs.position, obs.echo_points(), p["repulse_gain"], p["follow_influence_m"]
-        )
-        if p["goal_fade_m"] > 0:
-            repulsive *= min(1.0, obs.distance_to_goal() / p["goal_fade_m"]) ** 2
-        components["repulsive"] = repulsive - min(float(repulsive @ heading), 0.0) * heading
+        if not on_a_way:
+            return
+        echoes = obs.echo_points()
+        close = np.hypot(*(echoes - obs.position).T) < self.radius + CLOSE_ECHO_MARGIN_M
+        fade = min(1.0, obs.distance_to_goal() / p["goal_fade_m"]) ** 2 if p["goal_fade_m"] > 0 else 1.0
+        gain, influence = p["repulse_gain"], p["follow_influence_m"]
+        farther = fade * fields.repulsive_force(obs.position, echoes[~close], gain, influence)
+        near = fade * fields.repulsive_force(obs.position, echoes[close], gain, influence)
+        components["repulsive"] = near + farther - min(float(farther @ heading), 0.0) * heading
 
     def _mapped_cells_near(self, position: np.ndarray, reach_m: float) -> np.ndarray:
         """Centres (N, 2) of the mapped obstacle cells (not swept) within a square of half side
@@ -430,8 +444,10 @@ class VPlanePlusPlanner(VPlanePlanner):
         if self.no_way_since is not None:
             decision.events.append("the map shows a way to the goal again")
         self.no_way_since = None
-        self.follow_way = way
-        return self._next_waypoint(obs.position, way, obs.goal)
+        kept = self.sight.path_cost(np.array([obs.position, *self.follow_way])) if self.follow_way else np.inf
+        if kept > KEEP_WAY_RATIO * self.sight.path_cost(np.array([obs.position, *way])):
+            self.follow_way = way  # else the current way stays: no flip-flop between similar ways
+        return self._next_waypoint(obs.position, self.follow_way, obs.goal)
 
     def _way_to_goal(self, obs: Observation, decision: Decision) -> list[np.ndarray] | None:
         """The map's way to the goal with the planes as walls; planes that leave no way are
