@@ -1,6 +1,7 @@
 """Every planner on every scenario family, the paper's scenarios included: the clutter comparison.
 
-Families: `paper` (the four built-in scenarios of the paper's figures), and the generated
+Families: `paper` (the four built-in scenarios of the paper's figures), `suite` (the 34 cases
+of the trap suite, `vplane_mj.families.trap_suite`), and the generated
 `traps`, `clutter`, `corridors` (`--count` each, seed `--seed`) and `barn` (`--barn` worlds,
 seed 0, like `vplane-mj generate barn`). Each family also runs with noisy sonar when
 `--noise`/`--dropout` are given (by default 3 cm and 10% on `barn`, as `barn_noisy`). The
@@ -26,7 +27,7 @@ from pathlib import Path
 
 from vplane_mj.bench import plan_jobs, run_sweep
 from vplane_mj.errors import VPlaneError
-from vplane_mj.families import generate
+from vplane_mj.families import generate, trap_suite
 from vplane_mj.outputs import prepare_out_dir, write_atomically
 from vplane_mj.planning.registry import PLANNERS
 from vplane_mj.reference import shortest_path_length
@@ -52,7 +53,11 @@ def write_cases(out: Path, barn: int, count: int, seed: int) -> dict[str, list[s
     cases_dir = out / "cases"
     cases_dir.mkdir(parents=True, exist_ok=True)
     radius = robot_radius_m()
-    families = {"paper": list(PAPER)}
+    families = {"paper": list(PAPER), "suite": []}
+    for case in trap_suite():
+        path = cases_dir / f"{case.name}.toml"
+        path.write_text(case.toml(), encoding="utf-8")
+        families["suite"].append(str(path))
     for family, number, family_seed in (
         ("traps", count, seed),
         ("clutter", count, seed),

@@ -34,9 +34,10 @@ def inside_trap(scenario, positions):
     return shapes.Footprints(interiors).distance(positions) < 0
 
 
+@pytest.mark.parametrize("planner", ["vplane", "vplane_plus"])
 @pytest.mark.parametrize("name", PAPER)
-def test_vplane_reaches_the_goal_in_the_paper_scenarios(shipped, name):
-    scenario = shipped(name)
+def test_vplane_reaches_the_goal_in_the_paper_scenarios(shipped, name, planner):
+    scenario = shipped(name, f"planner.name={planner}")
     summary = run_scenario(scenario).summary
     straight = math.dist(scenario.robot.start, scenario.robot.goal)
     assert summary["outcome"] == "reached" and summary["success"], summary
@@ -74,16 +75,18 @@ def _run_case(job):
 
 def test_trap_suite_vplane_succeeds_where_apf_is_trapped():
     cases = trap_suite()
-    jobs = [(case.toml(), case.name, planner) for case in cases for planner in ("vplane", "apf")]
+    planners = ("vplane", "vplane_plus", "apf")
+    jobs = [(case.toml(), case.name, planner) for case in cases for planner in planners]
     with ProcessPoolExecutor(max_workers=2) as pool:
         rows = list(pool.map(_run_case, jobs))
-    rate = {p: np.mean([ok for _, planner, ok, _, _ in rows if planner == p]) for p in ("vplane", "apf")}
+    rate = {p: np.mean([ok for _, planner, ok, _, _ in rows if planner == p]) for p in planners}
     times = [t for _, planner, ok, t, _ in rows if planner == "vplane" and ok]
     print(
-        f"\ntrap suite of {len(cases)}: vplane {rate['vplane']:.0%}, apf {rate['apf']:.0%}, "
-        f"vplane median time to goal {statistics.median(times):.1f} s"
+        f"\ntrap suite of {len(cases)}: vplane {rate['vplane']:.0%}, vplane_plus {rate['vplane_plus']:.0%}, "
+        f"apf {rate['apf']:.0%}, vplane median time to goal {statistics.median(times):.1f} s"
     )
     assert rate["vplane"] >= 0.95
+    assert rate["vplane_plus"] >= 0.95
     assert rate["apf"] <= 0.1
 
 

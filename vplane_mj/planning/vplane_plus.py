@@ -43,6 +43,8 @@ from vplane_mj.planning.vplane_geometry import VirtualPlane, make_plane, unit, v
 
 CLOSE_ECHO_MARGIN_M = 0.1
 """An echo this close beyond the robot's disc (m) repels in full, even against the way."""
+SCAN_MOVE_M, SCAN_TURN_RAD = 0.02, math.radians(3.0)
+"""A scan is folded into the map only after the robot has moved or turned this much since the last."""
 KEEP_WAY_RATIO = 1.25
 """A new way replaces the one being followed only when that one costs this much more."""
 STALL_RADIUS_M = 0.3
@@ -121,12 +123,14 @@ class VPlanePlusPlanner(VPlanePlanner):
         self.no_way_since: float | None = None
         self.sight: gridsearch.Window | None = None  # the window of the latest way, for sight lines
         self.stalls: list[np.ndarray] = []  # where following the way was held up (m)
+        self.last_scan_pose: tuple[float, float, float] | None = None
 
     # -- the loop -------------------------------------------------------------------------
     def step(self, obs: Observation) -> Decision:
         p = self.params
-        self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
-        self.map.sweep(obs.position, self.radius)
+        if self._moved_since_last_scan(obs):
+            self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
+            self.map.sweep(obs.position, self.radius)
         decision = Decision(force=np.zeros(2), mode="normal")
         self._retire_planes(obs, decision)
 
@@ -188,6 +192,19 @@ class VPlanePlusPlanner(VPlanePlanner):
         decision.objective = self.temp_goal
         decision.planes = [(plane.e1, plane.e2) for plane in self.planes]
         return decision
+
+    def _moved_since_last_scan(self, obs: Observation) -> bool:
+        """Whether the robot has moved or turned enough since the last scan folded into the map:
+        scans from one pose repeat the same phantoms of a wide beam, and are no new evidence."""
+        last = self.last_scan_pose
+        if last is not None:
+            turned = abs((obs.yaw - last[2] + math.pi) % (2 * math.pi) - math.pi)
+            if math.hypot(obs.position[0] - last[0], obs.position[1] - last[1]) < SCAN_MOVE_M and (
+                turned < SCAN_TURN_RAD
+            ):
+                return False
+        self.last_scan_pose = (float(obs.position[0]), float(obs.position[1]), obs.yaw)
+        return True
 
     def _along_the_way(
         self,
@@ -463,9 +480,10 @@ class VPlanePlusPlanner(VPlanePlanner):
         self, robot: np.ndarray, goal: np.ndarray, planes: list[VirtualPlane], doubtful_walls: bool = False
     ) -> list[np.ndarray] | None:
         """The map's way from the robot to the goal: searched near them first (quick), then over
-        the whole map before concluding there is none."""
-        for margin in (self.params["search_margin_m"], None):
-            way = self._way(self._window(robot, goal, planes, doubtful_walls, margin), robot, goal)
+        the whole map, then over the whole map relaxed, before concluding there is none."""
+        for margin, relaxed in ((self.params["search_margin_m"], False), (None, False), (None, True)):
+            window = self._window(robot, goal, planes, doubtful_walls, margin, relaxed)
+            way = self._way(window, robot, goal)
             if way is not None:
                 return way
         return None
@@ -478,10 +496,15 @@ class VPlanePlusPlanner(VPlanePlanner):
         planes: list[VirtualPlane],
         doubtful_walls: bool = False,
         margin: float | None = None,
+        relaxed: bool = False,
     ) -> gridsearch.Window:
         """Step costs for the robot's centre over the map cells within `margin` (m) of the box
         around the robot and the goal (the whole map for None), planes as walls (and doubtful
-        obstacle cells too with `doubtful_walls`: does a plane close a trap?)."""
+        obstacle cells too with `doubtful_walls`: does a plane close a trap?).
+
+        A place where the way was held up twice is a wall; `relaxed` (when the map holds no
+        other way) makes it only dear again, and only obstacle cells of the greatest
+        certainty sure."""
         p, grid, cell = self.params, self.map.grid, self.map.cell_m
         low, high = np.zeros(2, dtype=int), np.full(2, self.map.n)
         if margin is not None:
@@ -490,9 +513,10 @@ class VPlanePlusPlanner(VPlanePlanner):
             low, high = np.clip(low, 0, self.map.n), np.clip(high, 0, self.map.n)
         inside = (slice(low[0], high[0]), slice(low[1], high[1]))
         certainty = np.where(self.map.swept[inside], 0, grid[inside])
+        sure = self.map.max_certainty if relaxed else p["map_sure"]
         cost = gridsearch.step_costs(
-            certainty >= p["map_sure"],
-            (certainty >= p["map_threshold"]) & (certainty < p["map_sure"]),
+            certainty >= sure,
+            (certainty >= p["map_threshold"]) & (certainty < sure),
             cell,
             self.radius + p["path_clearance_m"],
             p["inflation_m"],
@@ -501,8 +525,9 @@ class VPlanePlusPlanner(VPlanePlanner):
         )
         seen = self.map.seen[inside].copy()
         window = gridsearch.Window(cost, (self.map.origin + low) * cell, cell, seen)
-        for stall in self.stalls:
-            window.charge_disc(stall, STALL_RADIUS_M, p["doubt_cost"])
+        for k, stall in enumerate(self.stalls):
+            again = any(np.hypot(*(stall - earlier)) < STALL_RADIUS_M for earlier in self.stalls[:k])
+            window.charge_disc(stall, STALL_RADIUS_M, np.inf if again and not relaxed else p["doubt_cost"])
         window.clear_disc(robot, self.radius)  # the robot stands there: its disc is free
         for plane in planes:  # but no way crosses a virtual plane, even under the robot
             window.block_segment(plane.e1, plane.e2)
