@@ -301,7 +301,7 @@ class VPlanePlusPlanner(VPlanePlanner):
                 "would span a gap between obstacles"
             )
             plane = None
-        elif self._find_way(obs.position, obs.goal, [*self.planes, plane], doubtful_walls=True):
+        elif self._find_way(obs.position, obs.goal, [*self.planes, plane]):
             decision.events.append(
                 f"no virtual plane: e1=({e1[0]:.2f}, {e1[1]:.2f}) e2=({e2[0]:.2f}, {e2[1]:.2f}) "
                 "would close no trap (the map shows another way out)"
@@ -468,22 +468,27 @@ class VPlanePlusPlanner(VPlanePlanner):
 
     def _way_to_goal(self, obs: Observation, decision: Decision) -> list[np.ndarray] | None:
         """The map's way to the goal with the planes as walls; planes that leave no way are
-        retired (newest first). None when the map holds no way even without planes."""
+        retired (newest first); without planes, places held up twice are only dear instead of
+        walls. None when the map holds no way even so."""
         way = self._find_way(obs.position, obs.goal, self.planes)
         while way is None and self.planes:
             self.planes.pop()
             decision.events.append("virtual plane retired: it closed the only known way to the goal")
             way = self._find_way(obs.position, obs.goal, self.planes)
-        return way
+        return way or self._find_way(obs.position, obs.goal, self.planes, relaxed=True)
 
     def _find_way(
-        self, robot: np.ndarray, goal: np.ndarray, planes: list[VirtualPlane], doubtful_walls: bool = False
+        self,
+        robot: np.ndarray,
+        goal: np.ndarray,
+        planes: list[VirtualPlane],
+        doubtful_walls: bool = False,
+        relaxed: bool = False,
     ) -> list[np.ndarray] | None:
         """The map's way from the robot to the goal: searched near them first (quick), then over
-        the whole map, then over the whole map relaxed, before concluding there is none."""
-        for margin, relaxed in ((self.params["search_margin_m"], False), (None, False), (None, True)):
-            window = self._window(robot, goal, planes, doubtful_walls, margin, relaxed)
-            way = self._way(window, robot, goal)
+        the whole map before concluding there is none."""
+        for margin in (self.params["search_margin_m"], None):
+            way = self._way(self._window(robot, goal, planes, doubtful_walls, margin, relaxed), robot, goal)
             if way is not None:
                 return way
         return None
@@ -503,8 +508,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         obstacle cells too with `doubtful_walls`: does a plane close a trap?).
 
         A place where the way was held up twice is a wall; `relaxed` (when the map holds no
-        other way) makes it only dear again, and only obstacle cells of the greatest
-        certainty sure."""
+        other way) makes it only dear again."""
         p, grid, cell = self.params, self.map.grid, self.map.cell_m
         low, high = np.zeros(2, dtype=int), np.full(2, self.map.n)
         if margin is not None:
@@ -513,10 +517,9 @@ class VPlanePlusPlanner(VPlanePlanner):
             low, high = np.clip(low, 0, self.map.n), np.clip(high, 0, self.map.n)
         inside = (slice(low[0], high[0]), slice(low[1], high[1]))
         certainty = np.where(self.map.swept[inside], 0, grid[inside])
-        sure = self.map.max_certainty if relaxed else p["map_sure"]
         cost = gridsearch.step_costs(
-            certainty >= sure,
-            (certainty >= p["map_threshold"]) & (certainty < sure),
+            certainty >= p["map_sure"],
+            (certainty >= p["map_threshold"]) & (certainty < p["map_sure"]),
             cell,
             self.radius + p["path_clearance_m"],
             p["inflation_m"],
