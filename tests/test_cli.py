@@ -1,4 +1,4 @@
-"""The command line of INTERFACE.md section 2: outputs, exit codes, and nothing written on bad input."""
+"""The command line (docs/interface.md section 2): outputs, exit codes, and nothing written on bad input."""
 
 import json
 import signal

@@ -1,4 +1,4 @@
-"""The MCAP log (INTERFACE.md section 4): a real short run written, read back and checked."""
+"""The MCAP log (docs/interface.md section 4): a real short run written, read back and checked."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Obstacle footprints and distances against hand-computed points (INTERFACE.md section 1)."""
+"""Obstacle footprints and distances against hand-computed points (docs/interface.md section 1)."""
 
 import math
 

@@ -263,7 +263,7 @@ def _dask_rows(jobs: list[Job], scheduler: str) -> Iterator[dict]:
 
 
 def summarize(rows: list[dict]) -> list[dict]:
-    """One table row per planner (INTERFACE bench table), in first-seen order."""
+    """One table row per planner (the bench table of docs/interface.md), in first-seen order."""
     table = []
     for planner in dict.fromkeys(row["planner"] for row in rows):
         mine = [row for row in rows if row["planner"] == planner]

@@ -1,4 +1,4 @@
-"""Scenario files: TOML text -> validated, frozen dataclasses (INTERFACE.md section 1).
+"""Scenario files: TOML text -> validated, frozen dataclasses (docs/interface.md section 1).
 
 Every rule of the contract is checked here, before anything runs. Any failure
 is a ScenarioError naming the source, the key path (`world.obstacles[2].width`)

@@ -77,7 +77,7 @@ class Observer(Protocol):
 
 @dataclass
 class RunResult:
-    """The summary of INTERFACE.md section 3, the path at control ticks and the wheel torques."""
+    """The summary of docs/interface.md section 3, the path at control ticks and the wheel torques."""
 
     summary: dict
     times: np.ndarray

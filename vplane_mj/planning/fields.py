@@ -1,4 +1,4 @@
-"""Khatib's FIRAS potentials and forces (paper eqs. 2-6), as corrected in DESIGN.md section 3.
+"""Khatib's FIRAS potentials and forces (paper eqs. 2-6), as read in docs/method.md.
 
 Positions in metres; potentials and forces are in the planner's own force units
 (the controller maps a force of magnitude 1 to its cruise speed).
