@@ -72,7 +72,7 @@ PARAMS: dict[str, Param] = {
         2, "", "certainty a reading removes from the cells it shows free", ge=0, le=15, integer=True
     ),
     "path_clearance_m": Param(
-        0.0, "m", "the map's ways never pass closer than the robot radius plus this", ge=0, le=1.0
+        0.01, "m", "the map's ways never pass closer than the robot radius plus this", ge=0, le=1.0
     ),
     "inflation_m": Param(0.3, "m", "beyond that, the map's ways pay for passing closer than this", gt=0),
     "inflation_weight": Param(4.0, "", "extra step cost right at the clearance (costmap inflation)", ge=0),
