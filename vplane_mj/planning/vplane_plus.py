@@ -482,13 +482,12 @@ class VPlanePlusPlanner(VPlanePlanner):
         robot: np.ndarray,
         goal: np.ndarray,
         planes: list[VirtualPlane],
-        doubtful_walls: bool = False,
         relaxed: bool = False,
     ) -> list[np.ndarray] | None:
         """The map's way from the robot to the goal: searched near them first (quick), then over
         the whole map before concluding there is none."""
         for margin in (self.params["search_margin_m"], None):
-            way = self._way(self._window(robot, goal, planes, doubtful_walls, margin, relaxed), robot, goal)
+            way = self._way(self._window(robot, goal, planes, margin, relaxed), robot, goal)
             if way is not None:
                 return way
         return None
@@ -499,13 +498,11 @@ class VPlanePlusPlanner(VPlanePlanner):
         robot: np.ndarray,
         goal: np.ndarray,
         planes: list[VirtualPlane],
-        doubtful_walls: bool = False,
         margin: float | None = None,
         relaxed: bool = False,
     ) -> gridsearch.Window:
         """Step costs for the robot's centre over the map cells within `margin` (m) of the box
-        around the robot and the goal (the whole map for None), planes as walls (and doubtful
-        obstacle cells too with `doubtful_walls`: does a plane close a trap?).
+        around the robot and the goal (the whole map for None), planes as walls.
 
         A place where the way was held up twice is a wall; `relaxed` (when the map holds no
         other way) makes it only dear again."""
@@ -524,7 +521,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             self.radius + p["path_clearance_m"],
             p["inflation_m"],
             p["inflation_weight"],
-            np.inf if doubtful_walls else p["doubt_cost"],
+            p["doubt_cost"],
         )
         seen = self.map.seen[inside].copy()
         window = gridsearch.Window(cost, (self.map.origin + low) * cell, cell, seen)
@@ -563,7 +560,8 @@ class VPlanePlusPlanner(VPlanePlanner):
 
     def _next_waypoint(self, position: np.ndarray, way: list[np.ndarray], end: np.ndarray) -> np.ndarray:
         """The farthest point of the way within `waypoint_m` that the robot sees in a straight
-        line on the map; the way's end when the way is empty."""
+        line on the map; the way's end when the way is empty. The points before the one nearest
+        the robot are dropped from `way`: the robot has passed them."""
         if not way:
             return end
         reach = self.params["waypoint_m"]
