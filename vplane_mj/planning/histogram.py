@@ -47,13 +47,14 @@ def polar_histogram(
     half = np.arcsin(np.minimum(1.0, enlarge_m / np.maximum(d, 1e-6)))
     magnitude = c * c * (window_m - d)
     # Each cell adds its magnitude to the run of sectors [first, last] (indices may wrap):
-    # a difference array over two laps of the circle, folded back onto one.
+    # a difference array over two laps of the circle (every start, then every end, each in
+    # cell order), folded back onto one.
     first = np.floor((bearing - half) / sector).astype(int) + n_sectors
     last = np.floor((bearing + half) / sector).astype(int) + n_sectors
     last = np.minimum(last, first + n_sectors - 1)
-    steps = np.zeros(3 * n_sectors + 1)
-    np.add.at(steps, first, magnitude)
-    np.add.at(steps, last + 1, -magnitude)
+    steps = np.bincount(
+        np.concatenate((first, last + 1)), np.concatenate((magnitude, -magnitude)), 3 * n_sectors + 1
+    )
     laps = np.cumsum(steps)[: 3 * n_sectors].reshape(3, n_sectors)
     return laps.sum(axis=0)
 
