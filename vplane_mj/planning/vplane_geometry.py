@@ -6,6 +6,7 @@ away from the trap), never with fixed x/y comparisons, so it holds for any orien
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -33,11 +34,11 @@ class VirtualPlane:
     normal: np.ndarray
     slide: float
 
-    @property
+    @functools.cached_property
     def tangent(self) -> np.ndarray:
         return unit(self.e2 - self.e1)
 
-    @property
+    @functools.cached_property
     def length(self) -> float:
         return float(np.hypot(*(self.e2 - self.e1)))
 
