@@ -7,10 +7,11 @@ Obstacles: a 20 x 20 m arena with N random 0.1 m boxes (seeded), the robot drivi
 physics floor (the same world with MuJoCo's sensor stage off, replaying the run's
 torques) and of the world as exported, whose rangefinders cast every ray at every step.
 Sonar rays: the same with 16 sonars of 1, 3 and 5 rays, and 32 sonars of 3. Throughput:
-the same 20 runs through `bench.run_sweep`'s process pool with 1 and 2 workers, side by
-side (wall clock). `--sweep N`: the wall time of a sweep of N runs (the paper scenarios
-and generated traps and clutter, every planner, seeds with 2 cm sonar noise, 60 simulated
-seconds at most), from an empty reference-path cache.
+the same 40 runs (paper scenarios, every planner, two seeds with 2 cm sonar noise) through
+`bench.run_sweep`'s process pool with 1 and 2 workers, side by side (wall clock).
+`--sweep N`: the wall time of a sweep of N runs (the paper scenarios and generated traps
+and clutter, every planner, seeds with 2 cm sonar noise, 60 simulated seconds at most),
+from an empty reference-path cache.
 """
 
 from __future__ import annotations
@@ -107,7 +108,7 @@ def main() -> int:
         sensors = {"count": sonars, "rays_per_sonar": rays}
         run, floor, built = cost(clutter_document(10, args.seconds, sensors))
         print(f"| {sonars} x {rays} | {run:.1f} | {floor:.1f} | {built:.1f} |")
-    jobs = plan_jobs(PAPER, sorted(PLANNERS), [0])
+    jobs = plan_jobs(PAPER, sorted(PLANNERS), [0, 1], ["sensors.noise_std=0.02"])
     rates = {}
     for workers in (1, 2):
         with tempfile.TemporaryDirectory() as tmp:
