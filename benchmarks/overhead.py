@@ -1,22 +1,29 @@
-"""Overhead of the run loop over bare physics, measured side by side in one process.
+"""Overhead of whole runs over the physics floor, measured side by side in one process.
 
-For each scenario: a full run (sonar, planner, controller, metrics; no log, no render)
-takes N physics steps in T_full seconds. Then, on a fresh MjData of the same compiled
-model, bare physics replays the run's own wheel torques (one `mj_step(nstep=k)` per motor
-period, the same N steps, the same motion and contacts) in T_bare. The overhead ratio is
-T_full / T_bare; the real-time factor is simulated time over T_full. A second baseline
-steps the robot standing still (`mj_step(nstep=N)` in one call). Each measurement is
-repeated and the median reported.
+For each scenario and planner: a full run (sonar, planner, controller, metrics; no log, no
+render) takes N physics steps. The floor is MuJoCo alone on the same world with the sensor
+stage disabled (no rays), replaying the run's own wheel torques (one `mj_step` of k steps
+per motor period: the same N steps, the same motion and contacts). The same replay on the
+world as exported, whose rangefinders cast every sonar ray at every physics step, is the
+physics "as built" before the sonar cast its rays only when it pings. Reported: run over
+floor, run writing its MCAP log (into a temporary directory) over floor, as built over
+floor, and run over as built. Times are the process's CPU time, which other processes on a
+shared machine do not inflate; from a run's is subtracted that of a run of one control tick
+of the same scenario (building its models: what the loop's wall time in the summary leaves
+out too). Run over floor in wall-clock time (the summary's `wall_time_s`) is shown beside. Each measurement is
+repeated, interleaved, and the median kept. `--profile` prints, for the first scenario and
+planner, where a run's time goes.
 
-With `--log` every full run also writes its MCAP log (to a temporary directory), and the
-log's size per simulated minute is reported.
+    python benchmarks/overhead.py [SCENARIO ...] [--planners vplane,apf] [--repeat 3] [--no-log] [--profile]
 
-    python benchmarks/overhead.py [SCENARIO ...] [--repeat 3] [--planner apf] [--log]
+SCENARIO is a built-in name or a scenario file (e.g. one of `vplane-mj generate`).
 """
 
 from __future__ import annotations
 
 import argparse
+import cProfile
+import pstats
 import statistics
 import sys
 import tempfile
@@ -31,86 +38,122 @@ from vplane_mj.scenario import load_scenario
 from vplane_mj.sim import run_scenario
 from vplane_mj.world import SonarLayout, build_model
 
-DEFAULT_SCENARIOS = ("open_field", "single_box", "paper_c_escape", "paper_h_avoid")
+DEFAULT_SCENARIOS = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")
 
 
-def replay_time(model: mujoco.MjModel, torques, steps: int) -> float:
-    """Wall time of bare physics replaying recorded wheel torques over `steps` steps."""
+def replay_time(model: mujoco.MjModel, torques, steps: int, clock=time.process_time) -> float:
+    """Time (s, by `clock`) of bare physics replaying recorded wheel torques over `steps` steps."""
     data = mujoco.MjData(model)
     per_update = steps // len(torques)
-    start = time.perf_counter()
+    start = clock()
     for left, right in torques:
         data.ctrl[0], data.ctrl[1] = left, right
-        mujoco.mj_step(model, data, nstep=per_update)
-    return time.perf_counter() - start
+        mujoco.mj_step(model, data, per_update)
+    return clock() - start
 
 
-def full_run(scenario, log_dir: Path | None):
-    """One run, with its MCAP log written into `log_dir` when given; (result, log bytes)."""
-    if log_dir is None:
-        return run_scenario(scenario), 0
-    path = log_dir / f"{scenario.name}.mcap"
+def logged_run(scenario, log_dir: Path) -> tuple[float, int]:
+    """CPU time (s) of one run that writes its MCAP log into `log_dir`, and the log's bytes."""
+    path = log_dir / f"{scenario.name}-{scenario.planner}.mcap"
     bearings = SonarLayout.from_spec(scenario.sensors).bearings
+    start = time.process_time()
     log = McapLog(path, scenario, robot_radius_m(), bearings, scenario.sensors.range_max, {})
     result = run_scenario(scenario, observers=(log,))
     log.close(result.summary)
-    return result, path.stat().st_size
+    return time.process_time() - start, path.stat().st_size
 
 
-def measure(name: str, planner: str, repeat: int, log_dir: Path | None) -> dict:
-    scenario = load_scenario(name, [f"planner.name={planner}"])
-    model = build_model(scenario)
-    ratios, still_ratios, factors = [], [], []
-    for _ in range(repeat):
-        result, log_bytes = full_run(scenario, log_dir)
-        steps, full = result.summary["steps"], result.summary["wall_time_s"]
-        ratios.append(full / replay_time(model, result.torques, steps))
-        data = mujoco.MjData(model)
-        start = time.perf_counter()
-        mujoco.mj_step(model, data, nstep=steps)
-        still_ratios.append(full / (time.perf_counter() - start))
-        factors.append(result.summary["sim_time_s"] / full)
-    return {
-        "scenario": name,
-        "outcome": result.summary["outcome"],
-        "steps": steps,
-        "sim_s": result.summary["sim_time_s"],
-        "overhead": statistics.median(ratios),
-        "overhead_still": statistics.median(still_ratios),
-        "realtime": statistics.median(factors),
-        "log_mb_per_min": log_bytes / 1e6 / (result.summary["sim_time_s"] / 60.0),
+def measure(ref: str, planner: str, repeat: int, log_dir: Path | None) -> dict:
+    scenario = load_scenario(ref, [f"planner.name={planner}"])
+    built = build_model(scenario)
+    floor = build_model(scenario)
+    floor.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_SENSOR
+    run_scenario(scenario)  # warm up: imports, caches
+    times: dict[str, list[float]] = {
+        key: [] for key in ("run", "floor", "built", "log", "run wall", "floor wall")
     }
+    one_tick = load_scenario(
+        ref, [f"planner.name={planner}", f"run.time_limit_s={1 / scenario.run.control_hz}"]
+    )
+    log_bytes = 0
+    for _ in range(repeat):
+        start = time.process_time()
+        run_scenario(one_tick)
+        setup = time.process_time() - start
+        start = time.process_time()
+        result = run_scenario(scenario)
+        times["run"].append(time.process_time() - start - setup)
+        summary = result.summary
+        times["run wall"].append(summary["wall_time_s"])
+        times["floor"].append(replay_time(floor, result.torques, summary["steps"]))
+        times["floor wall"].append(replay_time(floor, result.torques, summary["steps"], time.perf_counter))
+        times["built"].append(replay_time(built, result.torques, summary["steps"]))
+        if log_dir is not None:
+            cpu, log_bytes = logged_run(scenario, log_dir)
+            times["log"].append(cpu - setup)
+    median = {key: statistics.median(values) for key, values in times.items() if values}
+    return {
+        "scenario": scenario.name,
+        "planner": planner,
+        "outcome": summary["outcome"],
+        "steps": summary["steps"],
+        "run": median["run"] / median["floor"],
+        "log": median["log"] / median["floor"] if "log" in median else None,
+        "built": median["built"] / median["floor"],
+        "run_vs_built": median["run"] / median["built"],
+        "run_wall": median["run wall"] / median["floor wall"],
+        "floor_us": 1e6 * median["floor"] / summary["steps"],
+        "planner_ms": summary["planner_cpu_ms_mean"],
+        "log_mb_per_min": log_bytes / 1e6 / (summary["sim_time_s"] / 60.0),
+    }
+
+
+def profile(ref: str, planner: str, top: int = 18) -> None:
+    """Print the functions where one full run spends most of its own time."""
+    scenario = load_scenario(ref, [f"planner.name={planner}"])
+    run_scenario(scenario)
+    profiler = cProfile.Profile()
+    profiler.enable()
+    run_scenario(scenario)
+    profiler.disable()
+    print(f"\nprofile of one {planner} run of {scenario.name} (cProfile, by own time):\n")
+    pstats.Stats(profiler, stream=sys.stdout).strip_dirs().sort_stats("tottime").print_stats(top)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scenarios", nargs="*", default=list(DEFAULT_SCENARIOS))
+    parser.add_argument("--planners", default="vplane", help="comma-separated planner names")
     parser.add_argument("--repeat", type=int, default=3)
-    parser.add_argument("--planner", default="apf")
-    parser.add_argument("--log", action="store_true", help="write the MCAP log in every full run")
+    parser.add_argument("--no-log", action="store_true", help="do not time runs that write their log")
+    parser.add_argument("--profile", action="store_true", help="profile one run of the first combination")
     args = parser.parse_args(argv)
+    planners = [name.strip() for name in args.planners.split(",")]
     with tempfile.TemporaryDirectory() as tmp:
-        report(args, Path(tmp) if args.log else None)
+        report(args.scenarios, planners, args.repeat, None if args.no_log else Path(tmp))
+    if args.profile:
+        profile(args.scenarios[0], planners[0])
     return 0
 
 
-def report(args: argparse.Namespace, log_dir: Path | None) -> None:
-    logging = "with the MCAP log" if log_dir else "without log"
-    print(f"planner {args.planner}, {logging}, median of {args.repeat} runs each")
-    print(f"mujoco {mujoco.__version__}\n")
+def report(scenarios: list[str], planners: list[str], repeat: int, log_dir: Path | None) -> None:
+    print(f"median of {repeat} interleaved repeats, CPU time; mujoco {mujoco.__version__}\n")
     print(
-        "| scenario | outcome | physics steps | simulated s | overhead ratio "
-        "| ratio vs robot standing still | real-time factor | log MB per simulated minute |"
+        "| scenario | planner | outcome | physics steps | floor us/step | run / floor | run with log / floor "
+        "| as built / floor | run / as built | run / floor, wall clock | planner ms/tick | log MB/min |"
     )
-    print("|---|---|---:|---:|---:|---:|---:|---:|")
-    for name in args.scenarios:
-        row = measure(name, args.planner, args.repeat, log_dir)
-        size = f"{row['log_mb_per_min']:.2f}" if log_dir else "-"
-        print(
-            f"| {row['scenario']} | {row['outcome']} | {row['steps']} | {row['sim_s']:.1f} "
-            f"| {row['overhead']:.2f} | {row['overhead_still']:.2f} | {row['realtime']:.0f}x | {size} |"
-        )
-        sys.stdout.flush()
+    print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for planner in planners:
+        for ref in scenarios:
+            row = measure(ref, planner, repeat, log_dir)
+            logged = "-" if row["log"] is None else f"{row['log']:.2f}"
+            size = "-" if row["log"] is None else f"{row['log_mb_per_min']:.2f}"
+            print(
+                f"| {row['scenario']} | `{row['planner']}` | {row['outcome']} | {row['steps']} "
+                f"| {row['floor_us']:.1f} | {row['run']:.2f} | {logged} | {row['built']:.2f} "
+                f"| {row['run_vs_built']:.2f} | {row['run_wall']:.2f} | {row['planner_ms']:.3f} | {size} |"
+            )
+            sys.stdout.flush()
 
 
 if __name__ == "__main__":

@@ -1,27 +1,40 @@
-"""How one run's cost grows with the number of obstacles and of sonar rays, and how a sweep
-scales from one worker process to two.
+"""How a run's cost grows with obstacles and sonar rays, and how sweeps scale with workers.
 
-    python benchmarks/scaling.py [--seconds 10]
+    python benchmarks/scaling.py [--seconds 10] [--sweep 1000]
 
-Obstacles: an arena of 20 x 20 m with N random boxes (seeded), the robot driving with
-`apf` for a fixed simulated time; reported as wall time per simulated second and per
-physics step. Sonar rays: the same with 16 sonars of 1, 3 and 5 rays, and 32 sonars of 3.
-Throughput: the same 12 runs through `bench.run_sweep`'s process pool with 1 and 2 workers.
+Obstacles: a 20 x 20 m arena with N random 0.1 m boxes (seeded), the robot driving with
+`apf` for a fixed simulated time; CPU time per physics step of the whole run, of the
+physics floor (the same world with MuJoCo's sensor stage off, replaying the run's
+torques) and of the world as exported, whose rangefinders cast every ray at every step.
+Sonar rays: the same with 16 sonars of 1, 3 and 5 rays, and 32 sonars of 3. Throughput:
+the same 40 runs (paper scenarios, every planner, two seeds with 2 cm sonar noise) through
+`bench.run_sweep`'s process pool with 1 and 2 workers, side by side (wall clock).
+`--sweep N`: the wall time of a sweep of N runs (the paper scenarios and generated traps
+and clutter, every planner, seeds with 2 cm sonar noise, 60 simulated seconds at most),
+from an empty reference-path cache.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import tempfile
 import time
 from pathlib import Path
 
+import mujoco
 import numpy as np
 import tomli_w
 
 from vplane_mj.bench import plan_jobs, run_sweep
+from vplane_mj.cache import CACHE_ENV
+from vplane_mj.families import generate
+from vplane_mj.planning.registry import PLANNERS
 from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim import run_scenario
+from vplane_mj.world import build_model
+
+PAPER = ["paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape"]
 
 
 def clutter_document(count: int, seconds: float, sensors: dict | None = None) -> str:
@@ -45,29 +58,57 @@ def clutter_document(count: int, seconds: float, sensors: dict | None = None) ->
     )
 
 
-def cost(document: str) -> tuple[float, float]:
-    """(wall ms per simulated second, wall microseconds per physics step) of one run."""
-    summary = run_scenario(parse_scenario(document, "scaling")).summary
+def replay_us(model: mujoco.MjModel, torques: np.ndarray, steps: int) -> float:
+    """CPU microseconds per step of bare physics replaying a run's wheel torques."""
+    data = mujoco.MjData(model)
+    per_update = steps // len(torques)
+    start = time.process_time()
+    for left, right in torques:
+        data.ctrl[0], data.ctrl[1] = left, right
+        mujoco.mj_step(model, data, per_update)
+    return 1e6 * (time.process_time() - start) / steps
+
+
+def cost(document: str) -> tuple[float, float, float]:
+    """CPU microseconds per physics step: the run, the floor (sensors off), the world as exported."""
+    scenario = parse_scenario(document, "scaling")
+    run_scenario(scenario)  # warm up
+    start = time.process_time()
+    result = run_scenario(scenario)
+    run = time.process_time() - start
+    steps = result.summary["steps"]
+    floor, built = build_model(scenario), build_model(scenario)
+    floor.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_SENSOR
     return (
-        1e3 * summary["wall_time_s"] / summary["sim_time_s"],
-        1e6 * summary["wall_time_s"] / summary["steps"],
+        1e6 * run / steps,
+        replay_us(floor, result.torques, steps),
+        replay_us(built, result.torques, steps),
     )
+
+
+def sweep_documents(count: int) -> list[str]:
+    """Scenario files for a sweep of `count` runs: paper scenarios, then generated worlds."""
+    worlds = count // (len(PLANNERS) * 10)
+    cases = generate("traps", worlds, 0, lambda s: True) + generate("clutter", worlds, 1, lambda s: True)
+    return PAPER + [case.toml() for case in cases][: max(0, worlds - len(PAPER))]
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10.0, help="simulated seconds per run")
-    seconds = parser.parse_args().seconds
-    print("| boxes | wall ms per simulated s | wall us per physics step |\n|---:|---:|---:|")
+    parser.add_argument("--sweep", type=int, default=0, help="also time a sweep of this many runs")
+    args = parser.parse_args()
+    header = "| CPU us per physics step: run | floor (sensors off) | as exported (rays every step) |"
+    print(f"| boxes {header}\n|---:|---:|---:|---:|")
     for count in (10, 100, 1000):
-        per_second, per_step = cost(clutter_document(count, seconds))
-        print(f"| {count} | {per_second:.0f} | {per_step:.1f} |")
-    print("\n| sonars x rays | wall ms per simulated s | wall us per physics step |\n|---|---:|---:|")
+        run, floor, built = cost(clutter_document(count, args.seconds))
+        print(f"| {count} | {run:.1f} | {floor:.1f} | {built:.1f} |")
+    print(f"\n| sonars x rays {header}\n|---|---:|---:|---:|")
     for sonars, rays in ((16, 1), (16, 3), (16, 5), (32, 3)):
         sensors = {"count": sonars, "rays_per_sonar": rays}
-        per_second, per_step = cost(clutter_document(10, seconds, sensors))
-        print(f"| {sonars} x {rays} | {per_second:.0f} | {per_step:.1f} |")
-    jobs = plan_jobs(["paper_c_escape", "paper_h_escape", "single_box"], ["apf", "vplane"], [0, 1])
+        run, floor, built = cost(clutter_document(10, args.seconds, sensors))
+        print(f"| {sonars} x {rays} | {run:.1f} | {floor:.1f} | {built:.1f} |")
+    jobs = plan_jobs(PAPER, sorted(PLANNERS), [0, 1], ["sensors.noise_std=0.02"])
     rates = {}
     for workers in (1, 2):
         with tempfile.TemporaryDirectory() as tmp:
@@ -78,7 +119,33 @@ def main() -> int:
         f"\nsweep of {len(jobs)} runs: {rates[1]:.2f} runs/s with 1 worker, {rates[2]:.2f} runs/s "
         f"with 2 workers: {rates[2] / rates[1]:.2f}x"
     )
+    if args.sweep:
+        time_sweep(args.sweep)
     return 0
+
+
+def time_sweep(count: int) -> None:
+    """Wall time of a sweep of about `count` runs on 2 workers, from an empty cache."""
+    with tempfile.TemporaryDirectory() as tmp:
+        os.environ[CACHE_ENV] = str(Path(tmp) / "cache")
+        paths = []
+        for index, text in enumerate(sweep_documents(count)):
+            if text in PAPER:
+                paths.append(text)
+                continue
+            path = Path(tmp) / f"world_{index:03d}.toml"
+            path.write_text(text)
+            paths.append(str(path))
+        overrides = ["sensors.noise_std=0.02", "run.time_limit_s=60"]
+        jobs = plan_jobs(paths, sorted(PLANNERS), range(10), overrides)
+        start = time.perf_counter()
+        rows = run_sweep(jobs, Path(tmp), 2)
+        wall = time.perf_counter() - start
+        loops = sum(row["wall_time_s"] for row in rows)
+    print(
+        f"\nsweep of {len(jobs)} runs on 2 workers: {wall:.0f} s wall ({len(jobs) / wall:.2f} runs/s), "
+        f"{loops:.0f} s of simulation loops"
+    )
 
 
 if __name__ == "__main__":

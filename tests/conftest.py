@@ -1,12 +1,27 @@
 """Shared fixtures: scenarios from text, and quick access to the shipped ones.
 
 Property-based tests are derandomised: every run of the suite tries the same examples.
+The on-disk cache is a fresh temporary directory for each run of the suite.
 """
+
+import os
+import shutil
+import tempfile
 
 import pytest
 from hypothesis import settings
 
+from vplane_mj.cache import CACHE_ENV
 from vplane_mj.scenario import load_scenario, parse_scenario
+
+# The tests keep their cached reference paths apart from the user's (and start without any).
+_CACHE = tempfile.mkdtemp(prefix="vplane-mj-test-cache-")
+os.environ[CACHE_ENV] = _CACHE
+
+
+def pytest_sessionfinish(session, exitstatus):
+    shutil.rmtree(_CACHE, ignore_errors=True)
+
 
 settings.register_profile("deterministic", derandomize=True, database=None)
 settings.load_profile("deterministic")

@@ -1,6 +1,7 @@
 """The command line (docs/interface.md section 2): outputs, exit codes, and nothing written on bad input."""
 
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -11,6 +12,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from vplane_mj.cache import CACHE_ENV
 from vplane_mj.cli import main
 from vplane_mj.log_mcap import read_log
 
@@ -190,6 +192,26 @@ def test_installed_entry_points(launcher):
     done = subprocess.run([*launcher, "check", "single_box"], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert "ok: single_box" in done.stdout
+
+
+LOADED = """
+import sys
+from vplane_mj.cli import main
+status = main(sys.argv[1:])
+heavy = ("OpenGL", "matplotlib", "scipy", "dm_control")
+print(status, sorted(name for name in heavy if name in sys.modules))
+"""
+
+
+def test_a_run_without_render_or_log_loads_only_what_it_uses(tmp_path):
+    args = ["run", "single_box", "--no-render", "--no-log", "--out", str(tmp_path)]
+    env = {key: value for key, value in os.environ.items() if key not in ("MUJOCO_GL", "PYOPENGL_PLATFORM")}
+    env[CACHE_ENV] = str(tmp_path / "cache")  # empty: the first run computes the reference path
+    first = subprocess.run([sys.executable, "-c", LOADED, *args], capture_output=True, text=True, env=env)
+    assert first.returncode == 0, first.stderr
+    again = subprocess.run([sys.executable, "-c", LOADED, *args], capture_output=True, text=True, env=env)
+    assert again.stdout.split("\n")[-2] == "0 []"  # the reference path came from the cache: no scipy
+    assert first.stdout.split("\n")[-2] == "0 ['scipy']"  # the first run computed it
 
 
 def start_long_run(tmp_path):

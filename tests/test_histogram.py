@@ -79,3 +79,37 @@ def test_an_obstacle_behind_a_gap_closes_the_gap_while_it_is_in_the_window():
     assert not blocked_by(walls, window=2.0)[ahead]
     assert blocked_by(walls + post, window=2.0)[ahead]
     assert not blocked_by(walls + post, window=1.5)[ahead]
+
+
+def reference_histogram(origin, cells, certainty, n_sectors, window_m, enlarge_m):
+    """The histogram summed cell by cell into a difference array (np.add.at, in cell order)."""
+    h = np.zeros(n_sectors)
+    rel = np.asarray(cells, float).reshape(-1, 2) - origin
+    d = np.hypot(rel[:, 0], rel[:, 1])
+    inside = d < window_m
+    if not inside.any():
+        return h
+    rel, d, c = rel[inside], d[inside], np.asarray(certainty, float)[inside]
+    sector = 2 * math.pi / n_sectors
+    bearing = np.arctan2(rel[:, 1], rel[:, 0]) % (2 * math.pi)
+    half = np.arcsin(np.minimum(1.0, enlarge_m / np.maximum(d, 1e-6)))
+    magnitude = c * c * (window_m - d)
+    first = np.floor((bearing - half) / sector).astype(int) + n_sectors
+    last = np.minimum(np.floor((bearing + half) / sector).astype(int) + n_sectors, first + n_sectors - 1)
+    steps = np.zeros(3 * n_sectors + 1)
+    np.add.at(steps, first, magnitude)
+    np.add.at(steps, last + 1, -magnitude)
+    return np.cumsum(steps)[: 3 * n_sectors].reshape(3, n_sectors).sum(axis=0)
+
+
+def test_the_histogram_equals_the_cell_by_cell_sum_bit_for_bit():
+    rng = np.random.default_rng(0)
+    for trial in range(500):
+        count = int(rng.integers(0, 300))
+        # coordinates on a coarse lattice too: cells straight ahead, behind, at sector edges
+        cells = np.round(rng.uniform(-3, 3, (count, 2)), int(rng.integers(1, 4)))
+        certainty = rng.integers(4, 16, count)
+        origin = np.round(rng.uniform(-1, 1, 2), 1) if trial % 2 else np.zeros(2)
+        args = (int(rng.choice([8, 36, 72, 720])), float(rng.uniform(0.5, 3)), float(rng.uniform(0, 1)))
+        expected = reference_histogram(origin, cells, certainty, *args)
+        np.testing.assert_array_equal(polar_histogram(origin, cells, certainty, *args), expected)

@@ -125,3 +125,96 @@ def test_the_clearance_field_sees_only_its_square():
     grid = mapped(WALL, (0.0, 0.0))  # the wall 1.95 m ahead
     assert grid.clearance_field(4, np.zeros(2), reach_m=3.0).at(np.zeros((1, 2)))[0] < 2.0
     assert grid.clearance_field(4, np.zeros(2), reach_m=1.0).at(np.zeros((1, 2)))[0] > 8.0  # none in it
+
+
+def dense_update(
+    grid: np.ndarray, origin, cell, position, yaw, bearings, ranges, beam, hit=3, miss=1, top=15
+):
+    """The map's update rule applied to every cell within reach of the longest echo (reference)."""
+    if not np.isfinite(ranges).any():
+        return
+    n = grid.shape[0]
+    reach = math.ceil(float(np.nanmax(ranges)) / cell) + 1
+    centre = np.floor(np.asarray(position) / cell).astype(int) - origin
+    lo, hi = np.maximum(centre - reach, 0), np.minimum(centre + reach + 1, n)
+    if np.any(hi <= lo):
+        return
+    rel_x = (origin[0] + np.arange(lo[0], hi[0]) + 0.5) * cell - position[0]
+    rel_y = (origin[1] + np.arange(lo[1], hi[1]) + 0.5) * cell - position[1]
+    distance = np.hypot(rel_x[:, None], rel_y[None, :])
+    bearing = np.arctan2(rel_y[None, :], rel_x[:, None]) - (yaw + bearings[0])
+    spacing = 2 * math.pi / len(bearings)
+    sonar = np.round(bearing / spacing).astype(int) % len(bearings)
+    offset = (bearing - sonar * spacing + math.pi) % (2 * math.pi) - math.pi
+    reading = ranges[sonar]
+    in_cone = (np.abs(offset) <= beam / 2) & np.isfinite(reading)
+    reading = np.where(in_cone, reading, -1.0)
+    window = grid[lo[0] : hi[0], lo[1] : hi[1]]
+    window -= miss * (in_cone & (distance < reading - cell))
+    window += hit * (np.abs(distance - reading) <= 0.75 * cell)
+    np.clip(window, 0, top, out=window)
+
+
+@pytest.mark.parametrize(
+    "count, beam_deg, cell, size, range_max, yaw_scale",
+    [
+        (16, 20.0, 0.1, 8.0, 3.0, math.pi),  # the defaults
+        (7, 60.0, 0.05, 3.0, 2.0, math.pi),  # beams wider than the spacing: cones clipped to sectors
+        (128, 1.0, 0.25, 5.0, 6.0, math.pi),
+        (4, 40.0, 1.0, 12.0, 9.0, math.pi),  # cells as large as readings
+        (16, 20.0, 0.1, 4.0, 3.0, 1e3),  # yaw far outside [-pi, pi]
+    ],
+)
+def test_the_update_equals_a_pass_over_every_cell_within_reach(
+    count, beam_deg, cell, size, range_max, yaw_scale
+):
+    rng = np.random.default_rng(count)
+    bearings = np.arange(count) * (2 * math.pi / count)
+    beam = math.radians(beam_deg)
+    fast = LocalMap(cell_m=cell, size_m=size)
+    position = np.array([3.0, -2.0])
+    reference = None
+    for step in range(150):
+        position = position + rng.normal(0.0, 0.4 * cell, 2) if step % 40 else rng.uniform(-9, 9, 2)
+        yaw = float(rng.uniform(-yaw_scale, yaw_scale))
+        ranges = rng.uniform(0.1, range_max + 0.1, count)
+        ranges[rng.random(count) < 0.3] = np.nan
+        ranges[rng.random(count) < 0.1] = rng.uniform(0.1, 0.2)  # echoes inside the robot's own cell
+        moved_from = None if fast.origin is None else fast.origin.copy()
+        fast.update(position, yaw, bearings, ranges, beam)
+        if reference is None or not np.array_equal(moved_from, fast.origin):
+            # the grid shifted (or started): shift the reference the same way
+            shifted = np.zeros_like(fast.grid)
+            if reference is not None and np.max(np.abs(fast.origin - moved_from)) < fast.n:
+                s = fast.origin - moved_from
+                n = fast.n
+                src = [slice(max(0, k), n + min(0, k)) for k in s]
+                dst = [slice(max(0, -k), n + min(0, -k)) for k in s]
+                shifted[dst[0], dst[1]] = reference[src[0], src[1]]
+            reference = shifted
+            dense_update(reference, fast.origin, cell, position, yaw, bearings, ranges, beam)
+        else:
+            dense_update(reference, fast.origin, cell, position, yaw, bearings, ranges, beam)
+        np.testing.assert_array_equal(fast.grid, reference)
+    assert fast.grid.max() > 0  # the scans did mark cells
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_clusters_are_the_regions_of_the_grown_obstacle_cells(seed):
+    ndimage = pytest.importorskip("scipy.ndimage")
+    rng = np.random.default_rng(seed)
+    grid = LocalMap(cell_m=0.1, size_m=6.0)
+    grid.update(np.zeros(2), 0.0, BEARINGS, np.full(16, np.nan), BEAM)  # anchor the grid
+    grid.grid[...] = (rng.random(grid.grid.shape) < 0.02 * (seed + 1)) * rng.integers(1, 16, grid.grid.shape)
+    link = [0.15, 0.48, 0.9, 2.0][seed]
+    occupied = grid.grid >= 4
+    reach = max(1, math.ceil(link / 2 / 0.1 - 1e-9))
+    disk = np.hypot(*np.mgrid[-reach : reach + 1, -reach : reach + 1]) <= reach
+    expected, _ = ndimage.label(ndimage.binary_dilation(occupied, structure=disk))
+    cells, labels, label_grid = grid.clusters(4, link)
+    assert len(cells) == occupied.sum() > 0
+    np.testing.assert_array_equal(label_grid == 0, expected == 0)
+    # the same regions: a one-to-one correspondence between the two labellings
+    pairs = set(zip(label_grid.ravel().tolist(), expected.ravel().tolist(), strict=True))
+    assert len(pairs) == len(set(label_grid.ravel().tolist())) == len(set(expected.ravel().tolist()))
+    np.testing.assert_array_equal(labels, label_grid[occupied])

@@ -99,8 +99,8 @@ def test_a_non_finite_planner_force_ends_the_run_as_error(shipped, monkeypatch):
 
 
 def test_an_unstable_simulation_ends_as_error_with_mujocos_warning(shipped, monkeypatch):
-    def unstable(scenario):
-        model = build_model(scenario)
+    def unstable(scenario, **options):
+        model = build_model(scenario, **options)
         model.dof_damping[:] = -1e6  # negative damping: the state blows up within a step
         return model
 

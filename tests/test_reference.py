@@ -1,11 +1,15 @@
 """Reference shortest path against hand-computed answers (tangent segments and arcs)."""
 
+import json
 import math
+import time
+from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 import pytest
 
-from vplane_mj.reference import ReferencePath, _cached_length, shortest_path, shortest_path_length
+from vplane_mj import cache, reference
+from vplane_mj.reference import ReferencePath, shortest_path, shortest_path_length, world_key
 from vplane_mj.scenario import load_scenario, parse_scenario
 
 RADIUS = 0.11  # vplane_mj.robot.robot_radius_m(), fixed here so the hand values are explicit
@@ -153,10 +157,76 @@ def test_a_winding_way_through_two_walls():
     assert_path_is_clear(sc, ref)
 
 
-def test_length_is_cached_per_scenario_content():
+def test_the_key_is_the_world_alone():
+    base = load_scenario("paper_c_escape")
+    same_world = load_scenario(
+        "paper_c_escape",
+        ["planner.name=bug2", "run.seed=7", "sensors.noise_std=0.1", "robot.goal_tolerance=0.3"],
+    )
+    assert world_key(base, RADIUS) == world_key(same_world, RADIUS)
+    for other in (
+        load_scenario("paper_c_escape", ["world.obstacles[0].yaw_deg=1"]),
+        load_scenario("paper_c_escape", ["robot.start=[4.3, 5.2]"]),
+        load_scenario("paper_c_escape", ["robot.goal=[8.8, 5.3]"]),
+        load_scenario("paper_c_escape", ["world.border=false"]),
+    ):
+        assert world_key(other, RADIUS) != world_key(base, RADIUS)
+    assert world_key(base, RADIUS + 0.01) != world_key(base, RADIUS)
+
+
+def test_the_length_is_computed_once_and_read_back_from_disk(monkeypatch, tmp_path):
+    monkeypatch.setenv(cache.CACHE_ENV, str(tmp_path))
+    monkeypatch.setattr(reference, "_LENGTHS", {})
     sc = load_scenario("paper_c_escape")
     first = shortest_path_length(sc, RADIUS)
-    hits = _cached_length.cache_info().hits
-    again = shortest_path_length(load_scenario("paper_c_escape"), RADIUS)  # equal content, new object
-    assert again == first and _cached_length.cache_info().hits == hits + 1
     assert first == pytest.approx(shortest_path(sc, RADIUS).length_m)
+    assert len(list((tmp_path / "reference").glob("*.json"))) == 1
+
+    def fail(*args):
+        raise AssertionError("computed again")
+
+    monkeypatch.setattr(reference, "shortest_path", fail)
+    # another planner and seed, in memory ...
+    assert (
+        shortest_path_length(load_scenario("paper_c_escape", ["planner.name=apf", "run.seed=3"]), RADIUS)
+        == first
+    )
+    monkeypatch.setattr(reference, "_LENGTHS", {})  # ... and from disk, as a new process would
+    assert shortest_path_length(sc, RADIUS) == first
+
+
+def test_a_damaged_or_unwritable_cache_only_costs_a_computation(monkeypatch, tmp_path):
+    monkeypatch.setenv(cache.CACHE_ENV, str(tmp_path))
+    monkeypatch.setattr(reference, "_LENGTHS", {})
+    sc = scenario(wall(5.0, 2.0, 5.0, 8.0))
+    expected = shortest_path(sc, RADIUS).length_m
+    shortest_path_length(sc, RADIUS)
+    (entry,) = (tmp_path / "reference").glob("*.json")
+    entry.write_text(entry.read_text()[:20])  # torn
+    monkeypatch.setattr(reference, "_LENGTHS", {})
+    assert shortest_path_length(sc, RADIUS) == pytest.approx(expected)
+    assert json.loads(entry.read_text())["value"] == pytest.approx(expected)  # and stored whole again
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    monkeypatch.setenv(cache.CACHE_ENV, str(blocker / "cache"))  # below a file: cannot exist
+    monkeypatch.setattr(reference, "_LENGTHS", {})
+    assert shortest_path_length(sc, RADIUS) == pytest.approx(expected)
+
+
+def _slow_square(log: str) -> int:
+    def compute():
+        with open(log, "a") as stream:
+            stream.write("computed\n")
+        time.sleep(0.3)
+        return 49
+
+    return cache.cached("test", {"x": 7}, compute)
+
+
+def test_processes_that_miss_the_same_key_compute_it_once(monkeypatch, tmp_path):
+    monkeypatch.setenv(cache.CACHE_ENV, str(tmp_path / "cache"))
+    log = tmp_path / "log"
+    with ProcessPoolExecutor(4) as pool:
+        values = list(pool.map(_slow_square, [str(log)] * 4))
+    assert values == [49] * 4
+    assert log.read_text().splitlines() == ["computed"]

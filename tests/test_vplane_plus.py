@@ -39,18 +39,19 @@ def world(extra: str = ""):
     return scenario, shapes.scene_footprints(scenario.world.obstacles, scenario.world.size)
 
 
-def hold(planner, footprints, position, goal, seconds, yaw=0.0, start_s=0.0):
-    """Keep the robot still at 20 Hz; return every decision."""
+def hold(planner, footprints, position, goal, seconds, yaw=0.0, start_s=0.0, turn_rad_per_s=0.0):
+    """Keep the robot in place at 20 Hz, turning at `turn_rad_per_s`; return every decision."""
     decisions = []
     for k in range(round(seconds * 20)):
+        heading = yaw + turn_rad_per_s * k * 0.05
         obs = Observation(
             start_s + k * 0.05,
             np.asarray(position, float),
-            yaw,
+            heading,
             np.asarray(goal, float),
             0.15,
             BEARINGS,
-            scan(footprints, position, yaw),
+            scan(footprints, position, heading),
             BEAM,
         )
         decisions.append(planner.step(obs))
@@ -119,7 +120,8 @@ size = [0.1, 1.8]
 """
     scenario, footprints = world(closed)
     planner = make_planner("vplane_plus", {"no_way_patience_s": 4.0}, RADIUS)
-    decisions = hold(planner, footprints, (5.0, 5.0), scenario.robot.goal, 40.0)
+    # A trapped robot turns on the spot: scans from new headings are folded into the map.
+    decisions = hold(planner, footprints, (5.0, 5.0), scenario.robot.goal, 40.0, turn_rad_per_s=1.0)
     assert any(d.gave_up for d in decisions)
     assert any("gave up: the map has held no way" in e for d in decisions for e in d.events)
 

@@ -8,7 +8,7 @@ import pytest
 
 from vplane_mj.resources import data_dir
 from vplane_mj.robot import robot_geometry
-from vplane_mj.sonar import SonarRing
+from vplane_mj.sonar import SonarRays, SonarRing
 from vplane_mj.world import BUMP_SENSOR, ROBOT_PREFIX, SonarLayout, build_model, standalone_xml
 
 SHIPPED = sorted(p.stem for p in data_dir("scenarios").glob("*.toml"))
@@ -41,6 +41,88 @@ def test_every_shipped_scenario_compiles(shipped, name):
         model.geom(g).name for g in range(model.ngeom) if model.geom(g).name.startswith("obstacle")
     ]
     assert len(obstacle_geoms) == sum(len(o.footprint()) for o in scenario.world.obstacles)
+
+
+def test_the_world_without_rangefinders_keeps_everything_else(shipped):
+    scenario = shipped("paper_h_escape", "robot.motor_gain=[0.8, 1.0]", "robot.wheel_friction=0.4")
+    full, bare = build_model(scenario), build_model(scenario, rangefinders=False)
+    assert bare.nsensor == 1 and bare.sensor(BUMP_SENSOR).type == mujoco.mjtSensor.mjSENS_CONTACT
+    assert (full.nsite, full.ngeom, full.nbody, full.nu) == (bare.nsite, bare.ngeom, bare.nbody, bare.nu)
+    for name in (
+        "geom_size",
+        "geom_pos",
+        "geom_friction",
+        "site_pos",
+        "site_quat",
+        "body_mass",
+        "actuator_gear",
+    ):
+        np.testing.assert_array_equal(getattr(full, name), getattr(bare, name))
+
+
+CLUTTER = """
+format = 1
+name = "clutter"
+[world]
+size = [6.0, 5.0]
+[[world.obstacles]]
+kind = "box"
+center = [3.0, 1.2]
+size = [0.6, 0.3]
+yaw_deg = 30
+[[world.obstacles]]
+kind = "cylinder"
+center = [2.0, 3.6]
+radius = 0.3
+[[world.obstacles]]
+kind = "u"
+center = [4.6, 3.0]
+width = 1.4
+depth = 1.0
+yaw_deg = 200
+[[world.obstacles]]
+kind = "wall"
+from = [1.0, 0.5]
+to = [1.6, 2.0]
+[robot]
+start = [1.2, 2.6]
+goal = [5.0, 1.0]
+[sensors]
+rays_per_sonar = 5
+beam_deg = 30.0
+range_max = 2.5
+"""
+
+
+def test_the_sonar_casts_exactly_what_the_rangefinders_read(scenario_from):
+    # Two copies of the world driven alike: one with rangefinders evaluated at every step
+    # (MuJoCo's sensor stage), one without, whose sonar casts its rays only when asked.
+    scenario = scenario_from(CLUTTER)
+    reference, stepped = build_model(scenario), build_model(scenario, rangefinders=False)
+    ref_data, data = mujoco.MjData(reference), mujoco.MjData(stepped)
+    sensors = scenario.sensors
+    rays = sensors.count * sensors.rays_per_sonar
+    first = reference.sensor_adr[reference.sensor(ROBOT_PREFIX + "sonar0_ray0").id]
+    sonar = SonarRays(build_model(scenario), reference.sensor(ROBOT_PREFIX + "sonar0_ray0").id, rays, data)
+    faults = {"noise_std": 0.03, "dropout": 0.1, "crosstalk": 0.05, "dead": (3,)}
+    rings = [
+        SonarRing(sensors.count, sensors.rays_per_sonar, 2.5, np.random.default_rng(5), **faults)
+        for _ in "ab"
+    ]
+    rng = np.random.default_rng(0)
+    echoes = 0
+    for step in range(3000):
+        if step % 25 == 0:
+            data.ctrl[:] = ref_data.ctrl[:] = rng.uniform(-0.3, 0.3, 2)
+        mujoco.mj_step(reference, ref_data)
+        mujoco.mj_step(stepped, data)
+        if step % 7 == 0:
+            expected = ref_data.sensordata[first : first + rays]
+            cast = sonar.cast()
+            np.testing.assert_array_equal(cast, expected)
+            np.testing.assert_array_equal(rings[0].read(cast), rings[1].read(expected))
+            echoes += int(((expected >= 0) & (expected < 2.5)).sum())
+    assert echoes > 1000  # the rays did meet obstacles
 
 
 def test_robot_fits_its_reported_disc():

@@ -7,15 +7,17 @@ import json
 import os
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import mujoco
-
+import vplane_mj
 from vplane_mj.errors import VPlaneError
 from vplane_mj.families import FAMILIES
 from vplane_mj.interrupts import Interrupted, signals_raise_interrupted
 from vplane_mj.outputs import output_directory, prepare_out_dir, write_atomically, write_json
 from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
-from vplane_mj.scenario import Scenario, builtin_scenarios, load_scenario
+
+if TYPE_CHECKING:
+    from vplane_mj.scenario import Scenario
 
 DEFAULT_OUT = Path("logs")
 EXIT_REACHED, EXIT_NOT_REACHED, EXIT_INVALID = 0, 1, 2
@@ -27,6 +29,7 @@ def main(argv: list[str] | None = None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # argparse: usage errors exit 2, --help exits 0
         return int(exc.code or 0)
+    _choose_gl_backend(args)
     stdout, sys.stdout = sys.stdout, _PipeSafeOutput(sys.stdout)
     try:
         return args.handler(args)
@@ -39,6 +42,14 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         sys.stdout.flush()
         sys.stdout = stdout
+
+
+def _choose_gl_backend(args: argparse.Namespace) -> None:
+    """A command that draws nothing does not load an OpenGL backend (it takes a while), unless
+    the user chose one: MuJoCo picks its backend when first imported, which is after this."""
+    draws = getattr(args, "draws", True) and not getattr(args, "no_render", False)
+    if not draws and not vplane_mj.GL_CHOSEN_BY_USER and "mujoco" not in sys.modules:
+        os.environ["MUJOCO_GL"] = "disable"
 
 
 class _PipeSafeOutput:
@@ -109,7 +120,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     sweep.add_argument("--scheduler", metavar="ADDRESS", help="run on this Dask scheduler ([dask] extra)")
     sweep.add_argument("--out", type=Path, help=f"output directory (default {DEFAULT_OUT}/)")
-    sweep.set_defaults(handler=_bench)
+    sweep.set_defaults(handler=_bench, draws=False)
 
     gen = commands.add_parser("generate", help="write seeded scenario files of a family")
     gen.add_argument(
@@ -118,20 +129,20 @@ def _parser() -> argparse.ArgumentParser:
     gen.add_argument("--count", type=int, default=10)
     gen.add_argument("--seed", type=int, default=0)
     gen.add_argument("--out", type=Path, required=True, metavar="DIR")
-    gen.set_defaults(handler=_generate)
+    gen.set_defaults(handler=_generate, draws=False)
 
     check = commands.add_parser("check", help="validate scenarios only")
     check.add_argument("scenarios", nargs="+", metavar="SCENARIO")
-    check.set_defaults(handler=_check)
+    check.set_defaults(handler=_check, draws=False)
 
     export = commands.add_parser("mjcf", help="write the compiled world as one MJCF file")
     export.add_argument("scenario", metavar="SCENARIO")
     export.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.xml")
-    export.set_defaults(handler=_mjcf)
+    export.set_defaults(handler=_mjcf, draws=False)
 
     summary = commands.add_parser("summary", help="recompute a run's summary from its MCAP log")
     summary.add_argument("log", type=Path, metavar="LOG.mcap")
-    summary.set_defaults(handler=_summary)
+    summary.set_defaults(handler=_summary, draws=False)
 
     render = commands.add_parser("render", help="render a run's top-down PNG from its MCAP log")
     render.add_argument("log", type=Path, metavar="LOG.mcap")
@@ -141,7 +152,7 @@ def _parser() -> argparse.ArgumentParser:
     plot = commands.add_parser("plot", help="plot a run (map, potential field, time series) from its log")
     plot.add_argument("log", type=Path, metavar="LOG.mcap")
     plot.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.png")
-    plot.set_defaults(handler=_plot)
+    plot.set_defaults(handler=_plot, draws=False)
 
     video = commands.add_parser("video", help="replay a run from its MCAP log as a top-down video")
     video.add_argument("log", type=Path, metavar="LOG.mcap")
@@ -152,7 +163,7 @@ def _parser() -> argparse.ArgumentParser:
     video.set_defaults(handler=_video)
 
     listing = commands.add_parser("list", help="built-in scenarios and planners")
-    listing.set_defaults(handler=_list)
+    listing.set_defaults(handler=_list, draws=False)
     return parser
 
 
@@ -166,8 +177,7 @@ def _overrides(args: argparse.Namespace) -> list[str]:
 
 
 def _run(args: argparse.Namespace) -> int:
-    # Imported here so that `check` and `list` stay quick.
-    from vplane_mj.render import render_top_view, write_png
+    from vplane_mj.scenario import load_scenario
     from vplane_mj.sim import run_scenario
 
     scenario = load_scenario(args.scenario, _overrides(args))
@@ -194,6 +204,8 @@ def _run(args: argparse.Namespace) -> int:
     written = [_finish_log(log, mcap_path, result.summary)] if log else []
     written.append(write_json(base.with_suffix(".json"), result.summary))
     if not args.no_render:
+        from vplane_mj.render import render_top_view, write_png
+
         image = render_top_view(scenario, result.track())
         written.append(write_atomically(base.with_suffix(".png"), lambda tmp: write_png(image, tmp)))
     if args.video:
@@ -283,6 +295,8 @@ def _generate(args: argparse.Namespace) -> int:
 
 
 def _check(args: argparse.Namespace) -> int:
+    from vplane_mj.scenario import load_scenario
+
     status = 0
     for ref in args.scenarios:
         try:
@@ -296,6 +310,9 @@ def _check(args: argparse.Namespace) -> int:
 
 
 def _mjcf(args: argparse.Namespace) -> int:
+    import mujoco
+
+    from vplane_mj.scenario import load_scenario
     from vplane_mj.world import standalone_xml
 
     scenario = load_scenario(args.scenario)
@@ -372,6 +389,8 @@ def _check_parent(target: Path) -> None:
 
 
 def _list(args: argparse.Namespace) -> int:
+    from vplane_mj.scenario import builtin_scenarios
+
     print("Built-in scenarios:")
     for name, description in builtin_scenarios():
         print(f"  {name:<20} {description}")

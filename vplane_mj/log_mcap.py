@@ -265,7 +265,7 @@ class McapLog:
         self._closed = False
 
         self._context = foxglove.Context()
-        options = MCAPWriteOptions(compression=MCAPCompression.Zstd)
+        options = MCAPWriteOptions(compression=MCAPCompression.Zstd, compression_threads=0)
         self._writer = foxglove.open_mcap(
             self.path, allow_overwrite=allow_overwrite, context=self._context, writer_options=options
         )

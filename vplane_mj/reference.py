@@ -49,15 +49,17 @@ needed more than 8 GiB).
 
 from __future__ import annotations
 
-import functools
+import hashlib
 import itertools
+import json
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import dijkstra
 
+from vplane_mj import shapes
+from vplane_mj.cache import cached
 from vplane_mj.shapes import Footprints, Rect, scene_footprints
 
 _EPS = 1e-9
@@ -311,6 +313,9 @@ def shortest_path(
     Segments are checked every cell_m / 2; the grid's cells are cell_m, or coarser when the
     arena would need more than MAX_GRID_CELLS of them.
     """
+    from scipy.sparse import coo_matrix  # here: a cached reference path needs no scipy
+    from scipy.sparse.csgraph import dijkstra
+
     world, robot = scenario.world, scenario.robot
     width, height = world.size
     thr = robot_radius_m + clearance_m
@@ -384,15 +389,62 @@ def shortest_path(
     return ReferencePath(_polyline_length(path), path)
 
 
-@functools.lru_cache(maxsize=64)
-def _cached_length(toml_text: str, robot_radius_m: float, clearance_m: float) -> float | None:
-    from vplane_mj.scenario import parse_scenario  # lazy: scenario.py imports mujoco-side modules
+def _source_digest() -> str:
+    """SHA-256 of the code that computes a reference path: a change to it is a new cache key."""
+    digest = hashlib.sha256()
+    for module in (__file__, shapes.__file__):
+        digest.update(Path(module).read_bytes())
+    return digest.hexdigest()
 
-    ref = shortest_path(parse_scenario(toml_text, "<reference>"), robot_radius_m, clearance_m=clearance_m)
-    return None if ref is None else ref.length_m
+
+def world_key(scenario, robot_radius_m: float, clearance_m: float = 0.0) -> dict:
+    """Everything the reference path depends on: the arena, its obstacles as footprint pieces,
+    start, goal, robot radius and clearance, and the code that computes it (not the planner,
+    its parameters, the sensors, the seed or the goal tolerance, which is subtracted
+    afterwards)."""
+    world = scenario.world
+    pieces = [
+        ["disc", *piece.center, piece.radius]
+        if isinstance(piece, shapes.Disc)
+        else ["rect", *piece.center, *piece.half, piece.yaw]
+        for piece in scene_footprints(world.obstacles, world.size if world.border else None).pieces
+    ]
+    return {
+        "code": _SOURCE_DIGEST,
+        "size": list(world.size),
+        "pieces": pieces,
+        "start": list(scenario.robot.start),
+        "goal": list(scenario.robot.goal),
+        "robot_radius_m": float(robot_radius_m),
+        "clearance_m": float(clearance_m),
+    }
+
+
+_LENGTHS: dict[str, float | None] = {}
+"""Reference lengths by world key, in memory (the most recent MEMORY_WORLDS)."""
+MEMORY_WORLDS = 256
 
 
 def shortest_path_length(scenario, robot_radius_m: float, clearance_m: float = 0.0) -> float | None:
-    """The reference path length (m) for the robot's disc plus `clearance_m`, or None; cached by
-    the scenario's TOML text, the radius and the clearance."""
-    return _cached_length(scenario.to_toml(), float(robot_radius_m), float(clearance_m))
+    """The reference path length (m) to the goal point for the robot's disc plus `clearance_m`,
+    or None when there is no path.
+
+    Computed once per world (`world_key`) and kept in memory and in the on-disk cache
+    (`vplane_mj.cache`), so every planner, seed and worker of a sweep, and later sweeps,
+    share it.
+    """
+    key = world_key(scenario, robot_radius_m, clearance_m)
+    text = json.dumps(key, sort_keys=True)
+    if text not in _LENGTHS:
+
+        def compute() -> float | None:
+            ref = shortest_path(scenario, robot_radius_m, clearance_m=clearance_m)
+            return None if ref is None else ref.length_m
+
+        if len(_LENGTHS) >= MEMORY_WORLDS:
+            del _LENGTHS[next(iter(_LENGTHS))]
+        _LENGTHS[text] = cached("reference", key, compute)
+    return _LENGTHS[text]
+
+
+_SOURCE_DIGEST = _source_digest()

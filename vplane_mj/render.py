@@ -12,7 +12,6 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import matplotlib.image
 import mujoco
 import numpy as np
 
@@ -76,6 +75,8 @@ def render_top_view(scenario, track: Track) -> np.ndarray:
 
 def write_png(image: np.ndarray, path: Path) -> None:
     """Save an RGB image as PNG."""
+    import matplotlib.image  # here: a run that writes no render does not load matplotlib
+
     matplotlib.image.imsave(path, image, format="png")
 
 

@@ -24,7 +24,7 @@ from vplane_mj.reference import shortest_path_length
 from vplane_mj.render import Track
 from vplane_mj.robot import BASE_BODY, WHEEL_JOINTS, WHEEL_MOTORS, robot_geometry
 from vplane_mj.scenario import Scenario
-from vplane_mj.sonar import SonarRing
+from vplane_mj.sonar import SonarRays, SonarRing
 from vplane_mj.world import BUMP_SENSOR, OBSTACLES_BODY, ROBOT_PREFIX, SonarLayout, build_model
 
 SUMMARY_FORMAT = 1
@@ -37,7 +37,7 @@ ODOMETRY_STREAM = 1
 BELIEF_PATIENCE_S = 3.0
 """Simulated time the odometry may hold the robot at the goal while it truly is not, before
 the run ends as `stuck` (the planner then drives to where it believes the goal is)."""
-FATAL_WARNINGS = {
+FATAL_WARNINGS: dict[mujoco.mjtWarning, str] = {
     mujoco.mjtWarning.mjWARN_BADQACC: "bad acceleration (the simulation became unstable)",
     mujoco.mjtWarning.mjWARN_BADQVEL: "bad velocity (the simulation became unstable)",
     mujoco.mjtWarning.mjWARN_BADQPOS: "bad position (the simulation became unstable)",
@@ -143,6 +143,7 @@ class _Clearance:
     def __init__(self, footprints: shapes.Footprints):
         self._footprints = footprints
         self._pending: list[np.ndarray] = []
+        self._pending_count = 0
         self.minimum = math.inf
         self._total = 0.0
         self._count = 0
@@ -153,7 +154,8 @@ class _Clearance:
 
     def add(self, positions: np.ndarray) -> None:
         self._pending.append(positions)
-        if sum(len(p) for p in self._pending) >= CLEARANCE_BATCH:
+        self._pending_count += len(positions)
+        if self._pending_count >= CLEARANCE_BATCH:
             self.flush()
 
     def flush(self) -> None:
@@ -163,6 +165,7 @@ class _Clearance:
             self._total += float(distances.sum())
             self._count += len(distances)
         self._pending.clear()
+        self._pending_count = 0
 
 
 class _Drive:
@@ -204,13 +207,9 @@ class _Drive:
         """The wheels' encoder angles (rad), left and right."""
         return float(self.data.qpos[self.wheel_qpos[0]]), float(self.data.qpos[self.wheel_qpos[1]])
 
-    def command(self, force: np.ndarray, yaw: float) -> tuple[float, float]:
-        """(v, omega) that heading control derives from a planner's force at heading `yaw` (rad)."""
-        return heading_command(float(force[0]), float(force[1]), yaw, self.gains)
-
     def run_tick(self, command: tuple[float, float], after_step) -> np.ndarray:
         """Drive one control tick; return base_link's xy after every motor period (chunks, 2)."""
-        targets = wheel_targets(
+        target_left, target_right = wheel_targets(
             *command,
             self.geometry["track_m"],
             self.geometry["wheel_radius_m"],
@@ -218,15 +217,17 @@ class _Drive:
         )
         (left_pi, right_pi), (left_dof, right_dof) = self.wheels, self.wheel_dofs
         left_motor, right_motor = self.motors
-        qvel, ctrl, xpos = self.data.qvel, self.data.ctrl, self.xpos
+        model, data, steps, dt = self.model, self.data, self.motor_steps, self.motor_dt
+        qvel, ctrl, xpos, torques = data.qvel, data.ctrl, self.xpos, self.torques
         trace = np.empty((self.chunks_per_tick, 2))
         for chunk in range(self.chunks_per_tick):
-            left = left_pi.torque(targets[0], qvel[left_dof], self.motor_dt)
-            right = right_pi.torque(targets[1], qvel[right_dof], self.motor_dt)
-            ctrl[left_motor], ctrl[right_motor] = left, right
-            self.torques.append((left, right))
-            mujoco.mj_step(self.model, self.data, nstep=self.motor_steps)
-            trace[chunk] = xpos[0], xpos[1]
+            left = left_pi.torque(target_left, float(qvel[left_dof]), dt)
+            right = right_pi.torque(target_right, float(qvel[right_dof]), dt)
+            ctrl[left_motor] = left
+            ctrl[right_motor] = right
+            torques.append((left, right))
+            mujoco.mj_step(model, data, steps)
+            trace[chunk] = xpos[:2]
             after_step()
         self.steps += self.motor_steps * self.chunks_per_tick
         return trace
@@ -234,7 +235,7 @@ class _Drive:
 
 def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> RunResult:
     """Simulate one scenario to the goal, the time limit, or the planner giving up."""
-    model = build_model(scenario)
+    model = build_model(scenario, rangefinders=False)
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     drive = _Drive(model, data, scenario.run.control_hz)
@@ -250,9 +251,14 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         crosstalk=sensors.crosstalk,
         dead=sensors.dead,
     )
+    sonar_model = build_model(scenario, rangefinders=True)
+    rays = SonarRays(
+        sonar_model,
+        sonar_model.sensor(ROBOT_PREFIX + "sonar0_ray0").id,
+        sensors.count * sensors.rays_per_sonar,
+        data,
+    )
     localiser = _Localiser(drive, scenario)
-    first_ray = model.sensor_adr[model.sensor(ROBOT_PREFIX + "sonar0_ray0").id]
-    rays = data.sensordata[first_ray : first_ray + sensors.count * sensors.rays_per_sonar]
     radius = drive.geometry["radius_m"]
     planner = make_planner(scenario.planner, scenario.planner_params, radius)
     clearance = _Clearance(
@@ -262,11 +268,15 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
     )
     collisions = _CollisionCounter(model, data)
     goal = np.asarray(scenario.robot.goal, float)
+    goal_x, goal_y = float(goal[0]), float(goal[1])
     tolerance = scenario.robot.goal_tolerance
+    time_limit = scenario.run.time_limit_s - 1e-9
     sonar_period = 1.0 / sensors.rate_hz
     beam = math.radians(sensors.beam_deg)
     next_sonar = 0.0
     ranges = np.full(sensors.count, np.nan)
+    warnings = data.warning.number  # counts per warning kind, a view into mjData
+    fatal = [int(kind) for kind in FATAL_WARNINGS]
 
     times: list[float] = []
     positions: list[np.ndarray] = []
@@ -296,22 +306,22 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
     position = drive.xpos[:2].copy()
     clearance.add(position[None, :])
     while True:
-        message = _fatal_warning(data)
-        if message is None and not np.all(np.isfinite(data.qpos)):
+        message = _fatal_warning(data) if any(warnings[kind] for kind in fatal) else None
+        if message is None and not np.isfinite(data.qpos).all():
             message = f"the simulation diverged (non-finite state) at t = {data.time:.3f} s"
         if message is not None:
             outcome = "error"
             note(message)
             break
-        if math.hypot(goal[0] - position[0], goal[1] - position[1]) <= tolerance:
+        if math.hypot(goal_x - position[0], goal_y - position[1]) <= tolerance:
             outcome, time_to_goal = "reached", data.time
             note("goal reached")
             break
-        if data.time >= scenario.run.time_limit_s - 1e-9:
+        if data.time >= time_limit:
             note("time limit reached")
             break
-        if data.time >= next_sonar - 1e-9:  # a new sonar scan is due
-            ranges = sonar.read(rays)
+        if data.time >= next_sonar - 1e-9:  # the sonar pings: cast its rays now
+            ranges = sonar.read(rays.cast())
             while next_sonar <= data.time + 1e-9:
                 next_sonar += sonar_period
         yaw = drive.yaw()
@@ -330,7 +340,8 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
             Observation(data.time, believed_xy, believed_yaw, goal, tolerance, layout.bearings, ranges, beam)
         )
         planner_cpu.append(time.perf_counter() - cpu_start)
-        if not np.all(np.isfinite(decision.force)):
+        force_x, force_y = float(decision.force[0]), float(decision.force[1])
+        if not (math.isfinite(force_x) and math.isfinite(force_y)):
             outcome = "error"
             message = f"planner {scenario.planner!r} gave a non-finite force at t = {data.time:.3f} s"
             note(message)
@@ -339,8 +350,9 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         escapes += decision.escape_completed
         for text in decision.events:
             note(text)
-        _collect_virtual(decision, objectives, planes)
-        command = drive.command(decision.force, believed_yaw)
+        if decision.objective is not None or decision.planes:
+            _collect_virtual(decision, objectives, planes)
+        command = heading_command(force_x, force_y, believed_yaw, drive.gains)
         times.append(data.time)
         positions.append(position)
         modes.append(decision.mode)
@@ -354,8 +366,9 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
             break
         trace = drive.run_tick(command, check_contacts)
         clearance.add(trace)
-        path_length += math.hypot(*(trace[0] - position))
-        path_length += float(np.sum(np.hypot(*np.diff(trace, axis=0).T)))
+        first, rest = _travelled(position, trace)
+        path_length += first
+        path_length += rest
         position = trace[-1].copy()
     wall_time = time.perf_counter() - start_wall
     clearance.flush()
@@ -409,6 +422,13 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
         objectives=objectives,
         planes=planes,
     )
+
+
+def _travelled(start: np.ndarray, trace: np.ndarray) -> tuple[float, float]:
+    """Lengths (m) of the step from `start` to the first point of `trace` (N, 2) and of the rest."""
+    steps = trace[1:] - trace[:-1]
+    first = math.hypot(trace[0, 0] - start[0], trace[0, 1] - start[1])
+    return first, float(np.hypot(steps[:, 0], steps[:, 1]).sum())
 
 
 class _Localiser:

@@ -1,10 +1,43 @@
-"""Sonar readings from MuJoCo rangefinder rays: one range per sonar, NaN when there is no echo."""
+"""Sonar readings: the ring's rays cast in MuJoCo when the sonar pings, one range per sonar.
+
+`SonarRays` evaluates the ring's MuJoCo rangefinders on demand, so the rays are cast only
+at the sonar's rate, not at every physics step; `SonarRing` turns the raw ray readings
+into ranges (shortest echo, faults), NaN when there is no echo.
+"""
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 
 from vplane_mj.robot import SONAR_MOUNT_RADIUS_M
+
+
+class SonarRays:
+    """The rangefinders of the sonar ring, evaluated on the robot's current kinematics.
+
+    The run steps a model without rangefinders (MuJoCo would cast every ray at every
+    physics step). At a ping, the poses of every geom and site in `source`, as the last
+    physics step computed them, are copied into `model` (the same world with the
+    rangefinders) and MuJoCo's position-stage sensors run there once: the readings are
+    exactly those the rangefinders would have given in that step (m from the ray sites,
+    -1 for no hit, `range_max` at the cutoff).
+    """
+
+    def __init__(self, model: mujoco.MjModel, first_sensor: int, rays: int, source: mujoco.MjData):
+        self.model = model
+        self.data = mujoco.MjData(model)
+        adr = model.sensor_adr[first_sensor]
+        self.readings = self.data.sensordata[adr : adr + rays]
+        poses = ("geom_xpos", "geom_xmat", "site_xpos", "site_xmat")
+        self._copies = [(getattr(self.data, name), getattr(source, name)) for name in poses]
+
+    def cast(self) -> np.ndarray:
+        """The rays' readings (rays,) from the kinematics of `source` (a view, valid until the next cast)."""
+        for mine, theirs in self._copies:
+            np.copyto(mine, theirs)
+        mujoco.mj_sensorPos(self.model, self.data)
+        return self.readings
 
 
 class SonarRing:
@@ -41,9 +74,9 @@ class SonarRing:
     def read(self, rays: np.ndarray) -> np.ndarray:
         """Ranges (m, from the robot's centre) of each sonar; `rays` is (count * rays_per_sonar,)."""
         per_sonar = np.asarray(rays, float).reshape(self.count, self.rays_per_sonar)
-        echo = (per_sonar >= 0.0) & (per_sonar < self.range_max)
-        shortest = np.where(echo, per_sonar, np.inf).min(axis=1)
-        ranges = np.where(np.isfinite(shortest), shortest + SONAR_MOUNT_RADIUS_M, np.nan)
+        # Misses (-1) never win; a cutoff reading (range_max) wins only when no ray echoed.
+        shortest = np.where(per_sonar >= 0.0, per_sonar, np.inf).min(axis=1)
+        ranges = np.where(shortest < self.range_max, shortest + SONAR_MOUNT_RADIUS_M, np.nan)
         if self.noise_std > 0.0:
             ranges = ranges + self.rng.normal(0.0, self.noise_std, self.count)
             ranges = np.maximum(ranges, SONAR_MOUNT_RADIUS_M)
@@ -54,5 +87,6 @@ class SonarRing:
             farthest = np.where(np.isnan(ranges), self.range_max + SONAR_MOUNT_RADIUS_M, ranges)
             spurious = self.rng.uniform(SONAR_MOUNT_RADIUS_M, farthest)
             ranges = np.where(heard, spurious, ranges)
-        ranges[self.dead] = np.nan
+        if len(self.dead):
+            ranges[self.dead] = np.nan
         return ranges

@@ -1,8 +1,9 @@
-"""Build the MuJoCo world of a scenario with dm_control.mjcf: arena, border, obstacles, robot, sonar.
+"""Build the MuJoCo world of a scenario with MjSpec: arena, border, obstacles, robot, sonar.
 
 Element names are predictable: obstacle geoms are `obstacle<i>_<part>` (parts per kind
 in PART_NAMES) and border walls `border_<side>`, all in the static body `obstacles`;
-sonar rays are `robot/sonar<k>_ray<j>`, in order, so their readings are contiguous.
+sonar ray sites are `robot/sonar<k>_ray<j>`, in order, so their poses are contiguous,
+and so are the readings of the rangefinders of the same names.
 """
 
 from __future__ import annotations
@@ -12,7 +13,6 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-from dm_control import mjcf
 
 from vplane_mj import shapes
 from vplane_mj.resources import model_path
@@ -42,6 +42,8 @@ PART_NAMES: dict[type, tuple[str, ...]] = {
 BORDER_SIDES = ("west", "east", "south", "north")
 RENDER_PIXELS = 800
 """Longest side (px) of the offscreen buffer that the top camera renders into."""
+SONAR_SITE_SIZE_M = 0.004
+SONAR_SITE_RGBA = (0.1, 0.7, 0.2, 0.6)
 
 
 @dataclass(frozen=True)
@@ -62,12 +64,17 @@ class SonarLayout:
         return cls(bearings=bearings, ray_offsets=offsets)
 
 
-def build_mjcf(scenario: Scenario) -> mjcf.RootElement:
-    """The scenario's whole world as an mjcf tree (not yet compiled)."""
-    arena = mjcf.from_path(str(model_path("arena.xml")))
+def build_spec(scenario: Scenario, rangefinders: bool = True) -> mujoco.MjSpec:
+    """The scenario's whole world as an MjSpec (not yet compiled).
+
+    With `rangefinders`, every sonar ray site carries a MuJoCo rangefinder (the exported
+    world). The run loop builds the world without them: MuJoCo would cast every ray at
+    every physics step, while the sonar pings only at its rate (`vplane_mj.sonar`).
+    """
+    arena = mujoco.MjSpec.from_file(str(model_path("arena.xml")))
     arena.option.timestep = scenario.run.physics_dt_s
     _size_camera(arena, scenario.world.size)
-    statics = arena.worldbody.add("body", name=OBSTACLES_BODY)
+    statics = arena.worldbody.add_body(name=OBSTACLES_BODY)
     if scenario.world.border:
         for side, rect in zip(BORDER_SIDES, shapes.border_footprint(scenario.world.size), strict=True):
             _add_piece(statics, f"border_{side}", rect, "border")
@@ -75,116 +82,111 @@ def build_mjcf(scenario: Scenario) -> mjcf.RootElement:
         parts = PART_NAMES[type(obstacle)]
         for part, piece in zip(parts, obstacle.footprint(), strict=True):
             _add_piece(statics, f"obstacle{index}_{part}", piece, "obstacle")
-
-    robot = mjcf.from_path(str(model_path("robot.xml")))
-    robot.model = ROBOT_PREFIX.rstrip("/")
-    _add_sonar_ring(robot, scenario.sensors)
-    _apply_actuation_faults(robot, scenario.robot)
-    frame = arena.attach(robot)
-    frame.add("freejoint")
-    x, y = scenario.robot.start
-    frame.pos = (x, y, 0.0)
-    yaw = scenario.robot.start_yaw
-    frame.quat = (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
     # Counts robot-obstacle contacts inside MuJoCo, so the run loop reads one number per check.
-    arena.sensor.add(
-        "contact",
+    arena.add_sensor(
         name=BUMP_SENSOR,
-        subtree1=ROBOT_PREFIX + BASE_BODY,
-        body2=OBSTACLES_BODY,
-        data="found",
-        reduce="mindist",
+        type=mujoco.mjtSensor.mjSENS_CONTACT,
+        objtype=mujoco.mjtObj.mjOBJ_XBODY,  # the subtree of base_link
+        objname=ROBOT_PREFIX + BASE_BODY,
+        reftype=mujoco.mjtObj.mjOBJ_BODY,
+        refname=OBSTACLES_BODY,
+        intprm=[1, 1, 1],  # data "found", reduce "mindist", one contact
     )
+
+    robot = mujoco.MjSpec.from_file(str(model_path("robot.xml")))
+    _add_sonar_ring(robot, scenario.sensors, rangefinders)
+    _apply_actuation_faults(robot, scenario.robot)
+    x, y = scenario.robot.start
+    yaw = scenario.robot.start_yaw
+    mount = arena.worldbody.add_body(
+        name=ROBOT_PREFIX, pos=[x, y, 0.0], quat=[math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]
+    )
+    mount.add_freejoint(name=ROBOT_PREFIX)
+    arena.attach(robot, prefix=ROBOT_PREFIX, frame=mount.add_frame())
     return arena
 
 
-def compile_model(root: mjcf.RootElement) -> mujoco.MjModel:
-    """Compile an mjcf tree with MuJoCo directly (dm_control's Physics does not support MuJoCo 4)."""
-    return mujoco.MjModel.from_xml_string(root.to_xml_string(), root.get_assets())
-
-
-def build_model(scenario: Scenario) -> mujoco.MjModel:
-    """The compiled MuJoCo model of a scenario."""
-    return compile_model(build_mjcf(scenario))
+def build_model(scenario: Scenario, rangefinders: bool = True) -> mujoco.MjModel:
+    """The compiled MuJoCo model of a scenario (see `build_spec` for `rangefinders`)."""
+    return build_spec(scenario, rangefinders).compile()
 
 
 def standalone_xml(scenario: Scenario) -> str:
-    """One self-contained MJCF document of the world (assets are built-in textures only)."""
-    return build_mjcf(scenario).to_xml_string()
+    """One self-contained MJCF document of the world, rangefinders included (assets are
+    built-in textures only; numbers at MuJoCo's XML precision of 6 significant digits)."""
+    return build_spec(scenario).to_xml()
 
 
-def _size_camera(arena: mjcf.RootElement, size: tuple[float, float]) -> None:
+def _size_camera(arena: mujoco.MjSpec, size: tuple[float, float]) -> None:
     """Centre the orthographic top camera on the arena and fit the arena plus its border."""
     w, h = size
     margin = 2 * shapes.BORDER_THICKNESS_M + 0.1
-    camera = arena.find("camera", "top")
-    camera.pos = (w / 2, h / 2, 20.0)
+    camera = arena.camera("top")
+    camera.pos = [w / 2, h / 2, 20.0]
     camera.fovy = h + margin  # orthographic: the vertical extent in metres
     scale = RENDER_PIXELS / max(w + margin, h + margin)
-    buffer = getattr(arena.visual, "global")  # `global` is a Python keyword
-    buffer.offwidth = max(64, round((w + margin) * scale))
-    buffer.offheight = max(64, round((h + margin) * scale))
+    arena.visual.global_.offwidth = max(64, round((w + margin) * scale))
+    arena.visual.global_.offheight = max(64, round((h + margin) * scale))
 
 
-def _add_piece(body: mjcf.Element, name: str, piece: shapes.Piece, material: str) -> None:
+def _add_piece(body: mujoco.MjsBody, name: str, piece: shapes.Piece, material: str) -> None:
     """One footprint piece as a vertical geom standing on the floor."""
     half_z = OBSTACLE_HEIGHT_M / 2
     if isinstance(piece, shapes.Disc):
-        body.add(
-            "geom",
+        body.add_geom(
             name=name,
-            type="cylinder",
-            size=(piece.radius, half_z),
-            pos=(*piece.center, half_z),
+            type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+            size=[piece.radius, half_z, 0.0],
+            pos=[*piece.center, half_z],
             material=material,
         )
         return
-    body.add(
-        "geom",
+    geom = body.add_geom(
         name=name,
-        type="box",
-        size=(*piece.half, half_z),
-        pos=(*piece.center, half_z),
-        euler=(0.0, 0.0, piece.yaw),
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[*piece.half, half_z],
+        pos=[*piece.center, half_z],
         material=material,
     )
+    geom.alt.type = mujoco.mjtOrientation.mjORIENTATION_EULER
+    geom.alt.euler = [0.0, 0.0, piece.yaw]
 
 
-def _add_sonar_ring(robot: mjcf.RootElement, spec: SensorSpec) -> None:
-    """Sonar k emulates a beam of `beam_deg` with `rays_per_sonar` rangefinder rays.
+def _add_sonar_ring(robot: mujoco.MjSpec, spec: SensorSpec, rangefinders: bool) -> None:
+    """Sonar k emulates a beam of `beam_deg` with `rays_per_sonar` rays.
 
     All rays of one sonar start at the same site position on the ring; each ray is a
-    site whose +z axis points along the ray. Rangefinders update every 1/rate_hz s.
+    site whose +z axis points along the ray. With `rangefinders`, each site carries a
+    rangefinder cut off at the range limit, with the sonar's period as its interval.
     """
     layout = SonarLayout.from_spec(spec)
-    base = robot.find("body", BASE_BODY)
+    base = robot.body(BASE_BODY)
     for k, bearing in enumerate(layout.bearings):
-        pos = (
+        pos = [
             SONAR_MOUNT_RADIUS_M * math.cos(bearing),
             SONAR_MOUNT_RADIUS_M * math.sin(bearing),
             SONAR_MOUNT_HEIGHT_M,
-        )
+        ]
         for j, offset in enumerate(layout.ray_offsets):
             angle = bearing + offset
             name = f"sonar{k}_ray{j}"
-            base.add(
-                "site",
-                name=name,
-                pos=pos,
-                size=(0.004,),
-                rgba=(0.1, 0.7, 0.2, 0.6),
-                zaxis=(math.cos(angle), math.sin(angle), 0.0),
-            )
-            robot.sensor.add(
-                "rangefinder",
-                name=name,
-                site=name,
-                cutoff=spec.range_max,
-                interval=(1.0 / spec.rate_hz, 0.0),
-            )
+            site = base.add_site(name=name, pos=pos, rgba=list(SONAR_SITE_RGBA))
+            site.size[0] = SONAR_SITE_SIZE_M
+            site.alt.type = mujoco.mjtOrientation.mjORIENTATION_ZAXIS
+            site.alt.zaxis = [math.cos(angle), math.sin(angle), 0.0]
+            if rangefinders:
+                robot.add_sensor(
+                    name=name,
+                    type=mujoco.mjtSensor.mjSENS_RANGEFINDER,
+                    objtype=mujoco.mjtObj.mjOBJ_SITE,
+                    objname=name,
+                    cutoff=spec.range_max,
+                    interval=[1.0 / spec.rate_hz, 0.0],
+                    intprm=[1, 0, 0],  # data "dist"
+                )
 
 
-def _apply_actuation_faults(robot: mjcf.RootElement, spec: RobotSpec) -> None:
+def _apply_actuation_faults(robot: mujoco.MjSpec, spec: RobotSpec) -> None:
     """Wheel slip and motor faults as model properties, so an exported world keeps them.
 
     The wheels' sliding friction becomes `wheel_friction` (the wheel geoms take priority
@@ -192,22 +194,23 @@ def _apply_actuation_faults(robot: mjcf.RootElement, spec: RobotSpec) -> None:
     and bias b becomes an affine actuator of gear g: torque = g * clamp(ctrl + b / g),
     i.e. g times the commanded torque plus b, saturating at g times the torque limit.
     """
-    wheel = robot.find("default", "wheel").geom
-    wheel.friction = (spec.wheel_friction, *wheel.friction[1:])
+    for geom in robot.geoms:
+        if geom.classname.name == "wheel":
+            geom.friction[0] = spec.wheel_friction
     limit = robot_geometry()["torque_limit_nm"]
     for motor_name, joint, gain, bias in zip(
         WHEEL_MOTORS, WHEEL_JOINTS, spec.motor_gain, spec.motor_bias_nm, strict=True
     ):
         if gain == 1.0 and bias == 0.0:
             continue
-        robot.find("actuator", motor_name).remove()
-        robot.actuator.add(
-            "general",
+        robot.delete(robot.actuator(motor_name))
+        robot.add_actuator(
             name=motor_name,
-            joint=joint,
-            gear=(gain,),
-            ctrlrange=(-limit, limit),
-            forcerange=(-limit, limit),
-            biastype="affine",
-            biasprm=(bias / gain, 0.0, 0.0),
+            trntype=mujoco.mjtTrn.mjTRN_JOINT,
+            target=joint,
+            gear=[gain, 0.0, 0.0, 0.0, 0.0, 0.0],
+            ctrlrange=[-limit, limit],
+            forcerange=[-limit, limit],
+            biastype=mujoco.mjtBias.mjBIAS_AFFINE,
+            biasprm=[bias / gain] + [0.0] * 9,
         )

@@ -93,7 +93,7 @@ class Bug2Planner:
         goal_angle = math.atan2(*(obs.goal - obs.position)[::-1])
         relative = np.abs(_wrap(obs.yaw + obs.bearings - goal_angle))
         ahead = (relative <= AHEAD_HALF_ANGLE + obs.beam_width / 2) & np.isfinite(obs.ranges)
-        return float(np.min(obs.ranges[ahead])) if np.any(ahead) else math.inf
+        return float(obs.ranges[ahead].min()) if ahead.any() else math.inf
 
     # ------------------------------------------------------------------ modes
 
@@ -128,7 +128,7 @@ class Bug2Planner:
         # wall across a narrow passage does not capture the follower.
         usable = (-self.side * rel > -math.radians(50.0)) & (-self.side * rel < math.radians(160.0))
         usable &= np.isfinite(obs.ranges)
-        if not np.any(usable) or float(np.min(obs.ranges[usable])) > p["lost_wall_m"]:
+        if not usable.any() or float(obs.ranges[usable].min()) > p["lost_wall_m"]:
             # Lost the wall: curve toward its side to find it again.
             turn = _rotate(heading, -self.side * math.radians(60.0))
             return {"search": turn * p["follow_speed"]}

@@ -47,7 +47,7 @@ def repulsive_force(position: np.ndarray, points: np.ndarray, gain: float, influ
     """
     rel, f = _offsets(position, points)
     near = f <= influence
-    if not np.any(near):
+    if not near.any():
         return np.zeros(2)
     f, rel = f[near], rel[near]
     magnitude = gain * (1.0 / f - 1.0 / influence) / (f * f)

@@ -87,32 +87,49 @@ class Window:
 
     def free_cell_near(self, point: np.ndarray, radius_m: float) -> tuple[int, int] | None:
         """The free cell nearest a point (m) within `radius_m`, None when there is none."""
-        distance = np.hypot(*np.moveaxis(self.centres() - point, -1, 0))
-        distance[~self.free | (distance > radius_m)] = np.inf
-        best = np.unravel_index(int(np.argmin(distance)), distance.shape)
-        return (int(best[0]), int(best[1])) if np.isfinite(distance[best]) else None
+        block, distance = self._disc(point, radius_m)
+        distance[~np.isfinite(self.cost[block]) | (distance > radius_m)] = np.inf
+        if not distance.size or not np.isfinite(distance.min()):
+            return None
+        i, j = np.unravel_index(int(np.argmin(distance)), distance.shape)
+        return int(i + block[0].start), int(j + block[1].start)
 
     def centre(self, cell: tuple[int, int]) -> np.ndarray:
         """The world point (m) at a cell's centre."""
         return self.corner + (np.asarray(cell, float) + 0.5) * self.cell_m
 
     def centres(self) -> np.ndarray:
-        """Every cell's centre (m), shaped like `free` plus a last axis of 2."""
+        """Every cell's centre (m), shaped like `cost` plus a last axis of 2."""
         i, j = np.meshgrid(np.arange(self.cost.shape[0]), np.arange(self.cost.shape[1]), indexing="ij")
         return self.corner + (np.stack([i, j], axis=-1) + 0.5) * self.cell_m
 
     def clear_disc(self, point: np.ndarray, radius_m: float) -> None:
         """Make passable the blocked cells whose centre lies within `radius_m` of a point (m)."""
-        near = np.hypot(*np.moveaxis(self.centres() - point, -1, 0)) <= radius_m
+        block, distance = self._disc(point, radius_m)
+        near = distance <= radius_m
         cell = self.cell_of(point)
         if cell is not None:
-            near[cell] = True
-        self.cost[near & ~np.isfinite(self.cost)] = INFLATED_STEP_COST
+            near[cell[0] - block[0].start, cell[1] - block[1].start] = True
+        cost = self.cost[block]  # a view
+        cost[near & ~np.isfinite(cost)] = INFLATED_STEP_COST
 
     def charge_disc(self, point: np.ndarray, radius_m: float, extra: float) -> None:
         """Add `extra` to the step cost of the cells whose centre lies within `radius_m` of a
         point (m)."""
-        self.cost[np.hypot(*np.moveaxis(self.centres() - point, -1, 0)) <= radius_m] += extra
+        block, distance = self._disc(point, radius_m)
+        self.cost[block][distance <= radius_m] += extra
+
+    def _disc(self, point: np.ndarray, radius_m: float) -> tuple[tuple[slice, slice], np.ndarray]:
+        """The block of cells around a point (m) that holds the disc of `radius_m`, and the
+        distance (m) from the point to each of their centres."""
+        low = np.floor((np.asarray(point, float) - radius_m - self.corner) / self.cell_m).astype(int)
+        high = np.floor((np.asarray(point, float) + radius_m - self.corner) / self.cell_m).astype(int) + 1
+        low = np.clip(low, 0, self.cost.shape)
+        high = np.clip(high, low, self.cost.shape)
+        block = (slice(int(low[0]), int(high[0])), slice(int(low[1]), int(high[1])))
+        x = self.corner[0] + (np.arange(low[0], high[0]) + 0.5) * self.cell_m - point[0]
+        y = self.corner[1] + (np.arange(low[1], high[1]) + 0.5) * self.cell_m - point[1]
+        return block, np.hypot(x[:, None], y[None, :])
 
     def block_segment(self, a: np.ndarray, b: np.ndarray) -> None:
         """Mark blocked the cells a segment (m) passes through, thickened so no diagonal step

@@ -33,27 +33,28 @@ def polar_histogram(
     enlarge_m: float,
 ) -> np.ndarray:
     """Obstacle density per sector (n_sectors,) around `origin` from map cells (N, 2)."""
-    h = np.zeros(n_sectors)
     if len(cells) == 0:
-        return h
+        return np.zeros(n_sectors)
     rel = np.asarray(cells, float) - origin
     d = np.hypot(rel[:, 0], rel[:, 1])
     inside = d < window_m
     if not inside.any():
-        return h
-    rel, d, c = rel[inside], d[inside], np.asarray(certainty, float)[inside]
+        return np.zeros(n_sectors)
+    rel, d, c = rel[inside], d[inside], np.asarray(certainty)[inside]
     sector = 2 * math.pi / n_sectors
-    bearing = np.arctan2(rel[:, 1], rel[:, 0]) % (2 * math.pi)
+    bearing = np.arctan2(rel[:, 1], rel[:, 0])
+    bearing = np.where(bearing < 0.0, bearing + 2 * math.pi, bearing)  # [0, 2 pi), as % would
     half = np.arcsin(np.minimum(1.0, enlarge_m / np.maximum(d, 1e-6)))
     magnitude = c * c * (window_m - d)
     # Each cell adds its magnitude to the run of sectors [first, last] (indices may wrap):
-    # a difference array over two laps of the circle, folded back onto one.
+    # a difference array over two laps of the circle (every start, then every end, each in
+    # cell order), folded back onto one.
     first = np.floor((bearing - half) / sector).astype(int) + n_sectors
     last = np.floor((bearing + half) / sector).astype(int) + n_sectors
-    last = np.minimum(last, first + n_sectors - 1)
-    steps = np.zeros(3 * n_sectors + 1)
-    np.add.at(steps, first, magnitude)
-    np.add.at(steps, last + 1, -magnitude)
+    last = np.minimum(last, first + (n_sectors - 1))
+    steps = np.bincount(
+        np.concatenate((first, last + 1)), np.concatenate((magnitude, -magnitude)), 3 * n_sectors + 1
+    )
     laps = np.cumsum(steps)[: 3 * n_sectors].reshape(3, n_sectors)
     return laps.sum(axis=0)
 

@@ -12,6 +12,7 @@ is one detection.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import deque
 from dataclasses import dataclass
@@ -26,6 +27,9 @@ class MinimumState:
     trapped: bool
     new: bool
     trapped_for_s: float
+
+
+_FREE = MinimumState(False, False, 0.0)
 
 
 class LocalMinimumDetector:
@@ -55,21 +59,21 @@ class LocalMinimumDetector:
         self._samples.append((time_s, x, y, speed))
         while self._samples[0][0] < time_s - self.window_s - 1e-9:
             self._samples.popleft()
-        position = np.array([x, y])
 
         if self._trap_position is not None:
-            if near_goal or np.hypot(*(position - self._trap_position)) > 2 * self.displacement_m:
+            trap_x, trap_y = self._trap_position
+            if near_goal or np.hypot(x - trap_x, y - trap_y) > 2 * self.displacement_m:
                 self._trap_position = None
             else:
                 return MinimumState(True, False, time_s - self._trap_time)
 
         if near_goal or time_s < self.startup_s or not self._window_full(time_s):
-            return MinimumState(False, False, 0.0)
+            return _FREE
         if self._slow_throughout() or self._displacement() <= self.displacement_m:
-            self._trap_position = position
+            self._trap_position = np.array([x, y])
             self._trap_time = time_s
             return MinimumState(True, True, 0.0)
-        return MinimumState(False, False, 0.0)
+        return _FREE
 
     def _window_full(self, time_s: float) -> bool:
         return time_s - self._samples[0][0] >= self.window_s - 1e-9
@@ -85,6 +89,7 @@ class LocalMinimumDetector:
 
         A window of one sample (window_s of about zero) has no step: it is not slow.
         """
-        samples = iter(self._samples)
-        next(samples)  # the oldest sample's speed belongs to the step before the window
-        return max((s[3] for s in samples), default=math.inf) <= self.speed_mps
+        if len(self._samples) < 2:
+            return False
+        # The oldest sample's speed belongs to the step before the window.
+        return all(s[3] <= self.speed_mps for s in itertools.islice(self._samples, 1, None))

@@ -26,14 +26,27 @@ class Observation:
     beam_width: float
 
     def echo_points(self) -> np.ndarray:
-        """World-frame points (N, 2) of the sonar echoes; no-echo readings are dropped."""
-        hit = np.isfinite(self.ranges)
-        angles = self.yaw + self.bearings[hit]
-        r = self.ranges[hit]
-        return self.position + np.column_stack((r * np.cos(angles), r * np.sin(angles)))
+        """World-frame points (N, 2) of the sonar echoes; no-echo readings are dropped.
+
+        Computed once per observation and shared by every caller, so it is read-only.
+        """
+        points = self.__dict__.get("_echo_points")
+        if points is None:
+            hit = np.isfinite(self.ranges)
+            angles = self.yaw + self.bearings[hit]
+            r = self.ranges[hit]
+            points = self.position + np.array((r * np.cos(angles), r * np.sin(angles))).T
+            points.flags.writeable = False
+            self.__dict__["_echo_points"] = points  # a frozen dataclass: cache outside its fields
+        return points
 
     def distance_to_goal(self) -> float:
-        return float(np.hypot(*(self.goal - self.position)))
+        """Distance (m) from the position to the goal."""
+        distance = self.__dict__.get("_distance_to_goal")
+        if distance is None:
+            distance = float(np.hypot(self.goal[0] - self.position[0], self.goal[1] - self.position[1]))
+            self.__dict__["_distance_to_goal"] = distance
+        return distance
 
 
 @dataclass

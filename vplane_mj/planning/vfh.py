@@ -58,9 +58,9 @@ class VfhPlanner:
     def step(self, obs: Observation) -> Decision:
         p = self.params
         self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
-        cells, certainty = self.map.cells(p["map_threshold"])
         enlarge = self.radius + p["clearance_m"]
         window = min(p["window_m"], obs.distance_to_goal() + enlarge)  # nothing beyond the goal blocks it
+        cells, certainty = self.map.cells(p["map_threshold"], obs.position, window)
         h = histogram.polar_histogram(obs.position, cells, certainty, self.n_sectors, window, enlarge)
         to_goal = obs.goal - obs.position
         goal_bearing = math.atan2(to_goal[1], to_goal[0])

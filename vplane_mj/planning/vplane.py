@@ -109,7 +109,8 @@ class VPlanePlanner:
         self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
         self.echoes.append(obs.echo_points())
         decision = Decision(force=np.zeros(2), mode="normal")
-        self._retire_planes(obs, decision)
+        if self.planes:
+            self._retire_planes(obs, decision)
 
         near_goal = obs.distance_to_goal() <= obs.goal_tolerance
         state = self.detector.update(obs.time_s, obs.position, near_goal)
@@ -242,9 +243,10 @@ class VPlanePlanner:
     def _update_avoidance(self, obs: Observation, decision: Decision) -> None:
         """Enter, keep or leave the avoiding mode (steering past a concave obstacle's edge)."""
         p = self.params
-        cells, certainty = self.map.cells(p["map_threshold"])
+        # Only cells within the histogram's window count: those of the square around the robot.
+        cells, certainty = self.map.cells(p["map_threshold"], obs.position, p["window_m"])
         goal_bearing = math.atan2(*(obs.goal - obs.position)[::-1])
-        if len(cells) == 0:
+        if len(cells) == 0 and not self.map.any_cells(p["map_threshold"]):
             self.avoid_waypoint = None
             return
         h = histogram.polar_histogram(
@@ -291,7 +293,7 @@ class VPlanePlanner:
     def _concave_edge_waypoint(self, obs: Observation) -> np.ndarray | None:
         """A point just past the nearer edge of a concave obstacle ahead, or None."""
         p = self.params
-        cells, labels, _ = self.map.clusters(p["map_threshold"], self._link_m())
+        cells, _ = self.map.cells(p["map_threshold"])
         heading = unit(obs.goal - obs.position)
         rel = cells - obs.position
         forward = rel @ heading
@@ -301,6 +303,7 @@ class VPlanePlanner:
         if not ahead.any():
             return None
         nearest = np.flatnonzero(ahead)[np.argmin(forward[ahead])]
+        _, labels, _ = self.map.clusters(p["map_threshold"], self._link_m())  # the same cells, in order
         cluster = cells[labels == labels[nearest]]
         i1, i2, span = angular_extremes(obs.position, cluster)
         if span >= math.pi:  # it surrounds the robot: that is a trap, not an obstacle ahead

@@ -6,6 +6,7 @@ away from the trap), never with fixed x/y comparisons, so it holds for any orien
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -33,11 +34,11 @@ class VirtualPlane:
     normal: np.ndarray
     slide: float
 
-    @property
+    @functools.cached_property
     def tangent(self) -> np.ndarray:
         return unit(self.e2 - self.e1)
 
-    @property
+    @functools.cached_property
     def length(self) -> float:
         return float(np.hypot(*(self.e2 - self.e1)))
 
@@ -142,9 +143,8 @@ def plane_force(
     toward the end with the shorter way to the goal, so a head-on approach cannot stall.
     """
     along, out = plane.frame_coordinates(robot)
-    n_points = max(2, math.ceil(plane.length / step) + 1)
-    positions = np.linspace(0.0, plane.length, n_points)
-    weight = plane.length / (n_points - 1)
+    positions = _plane_points(plane.length, step)
+    weight = plane.length / (len(positions) - 1)
     normal_distance = max(out, MIN_DISTANCE_M)
     f = np.hypot(along - positions, normal_distance)
     near = f <= influence
@@ -154,3 +154,11 @@ def plane_force(
     magnitude = gain * (1.0 / f - 1.0 / influence) / (f * f) * weight
     outward = float(np.sum(magnitude * normal_distance / f))
     return outward * plane.normal + slide_gain * outward * plane.slide * plane.tangent
+
+
+@functools.lru_cache(maxsize=64)
+def _plane_points(length: float, step: float) -> np.ndarray:
+    """Positions (m from e1) of the points p_i: at most `step` apart, both ends included."""
+    points = np.linspace(0.0, length, max(2, math.ceil(length / step) + 1))
+    points.flags.writeable = False
+    return points

@@ -66,7 +66,7 @@ def _with_default(param: Param, default: float) -> Param:
 PARAMS: dict[str, Param] = {
     **VPLANE_PARAMS,
     "map_cell_m": _with_default(VPLANE_PARAMS["map_cell_m"], 0.05),
-    "map_size_m": _with_default(VPLANE_PARAMS["map_size_m"], 16.0),
+    "map_size_m": _with_default(VPLANE_PARAMS["map_size_m"], 12.0),
     "map_hit": Param(1, "", "certainty an echo adds to each cell of its arc", ge=1, le=15, integer=True),
     "map_miss": Param(
         2, "", "certainty a reading removes from the cells it shows free", ge=0, le=15, integer=True
@@ -114,6 +114,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             hit=round(p["map_hit"]),
             miss=round(p["map_miss"]),
             hit_range_m=p["map_hit_range_m"],
+            track_seen=True,
             silent_free_m=SILENT_FREE_M,
         )
         self.escape_way: list[np.ndarray] = []  # waypoints (m) to the virtual objective
@@ -441,8 +442,8 @@ class VPlanePlusPlanner(VPlanePlanner):
         """
         p = self.params
         waypoint = self._next_waypoint(obs.position, self.follow_way, obs.goal)
-        if obs.time_s < self.next_replan_s and self.follow_way:
-            if not self._way_is_blocked(obs.position, self.follow_way):
+        if obs.time_s < self.next_replan_s:
+            if not self.follow_way or not self._way_is_blocked(obs.position, self.follow_way):
                 return waypoint
             decision.events.append("the way ahead is blocked on the map: searched again")
         self.next_replan_s = obs.time_s + p["replan_period_s"]
@@ -565,13 +566,12 @@ class VPlanePlusPlanner(VPlanePlanner):
         if not way:
             return end
         reach = self.params["waypoint_m"]
-        distances = [float(np.hypot(*(point - position))) for point in way]
+        distances = np.hypot(*(np.array(way) - position).T)
         nearest = int(np.argmin(distances))
         del way[:nearest]  # the robot has passed these
-        best = way[0]
-        for point in way[1:]:
-            if np.hypot(*(point - position)) > reach:
-                break
-            if self.sight is None or self.sight.line_of_sight(position, point):
-                best = point
-        return best
+        beyond = np.flatnonzero(distances[nearest + 1 :] > reach)
+        within = 1 + (int(beyond[0]) if len(beyond) else len(way) - 1)  # the leading run within reach
+        for k in range(within - 1, 0, -1):  # the farthest first
+            if self.sight is None or self.sight.line_of_sight(position, way[k]):
+                return way[k]
+        return way[0]
