@@ -98,7 +98,9 @@ def test_a_non_finite_planner_force_ends_the_run_as_error(shipped, monkeypatch):
     assert summary["sim_time_s"] == pytest.approx(1.0)
 
 
-def test_an_unstable_simulation_ends_as_error_with_mujocos_warning(shipped, monkeypatch):
+def test_an_unstable_simulation_ends_as_error_with_mujocos_warning(shipped, monkeypatch, tmp_path):
+    monkeypatch.chdir(tmp_path)  # MuJoCo writes its warning to MUJOCO_LOG.TXT in the working directory
+
     def unstable(scenario, **options):
         model = build_model(scenario, **options)
         model.dof_damping[:] = -1e6  # negative damping: the state blows up within a step
