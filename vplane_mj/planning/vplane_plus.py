@@ -66,7 +66,7 @@ def _with_default(param: Param, default: float) -> Param:
 PARAMS: dict[str, Param] = {
     **VPLANE_PARAMS,
     "map_cell_m": _with_default(VPLANE_PARAMS["map_cell_m"], 0.05),
-    "map_size_m": _with_default(VPLANE_PARAMS["map_size_m"], 12.0),
+    "map_size_m": _with_default(VPLANE_PARAMS["map_size_m"], 16.0),
     "map_hit": Param(1, "", "certainty an echo adds to each cell of its arc", ge=1, le=15, integer=True),
     "map_miss": Param(
         2, "", "certainty a reading removes from the cells it shows free", ge=0, le=15, integer=True
