@@ -66,7 +66,7 @@ def test_goes_to_goal_in_the_open_and_follows_near_a_wall():
     assert far.mode == "go_to_goal" and not far.events
     assert far.force[0] > 0.9 and abs(far.force[1]) < 1e-9
     near = plan.step(observe(wall, (2.6, 3.0), 0.0, (5.0, 3.0), 1.0))
-    assert near.mode == "following" and near.events and "hit" in near.events[0]
+    assert near.mode == "following" and near.events and "hit" in near.events[0].text
     assert plan.hit_distance == pytest.approx(2.4)
     # Turning left with the wall on the right: the force points up along the wall.
     assert near.force[1] > 0.5 and near.force[1] > abs(near.force[0])
@@ -86,7 +86,7 @@ def test_gives_up_on_a_goal_enclosed_by_walls():
     walls = shapes.scene_footprints(ENCLOSURE)
     _, decisions = drive(walls, (1.0, 3.0), (4.0, 3.0), 120.0)
     last = decisions[-1][1]
-    assert last.gave_up and any("loop" in e for e in last.events)
+    assert last.gave_up and any("loop" in e.text for e in last.events)
     assert "following" in [d.mode for _, d in decisions]
     assert decisions[-1][0][0] < 3.4  # still outside the enclosure
 
@@ -95,7 +95,7 @@ def test_gives_up_after_max_follow_s():
     walls = shapes.scene_footprints(ENCLOSURE)
     _, decisions = drive(walls, (1.0, 3.0), (4.0, 3.0), 60.0, planner(max_follow_s=5.0))
     last = decisions[-1][1]
-    assert last.gave_up and any("following for" in e for e in last.events)
+    assert last.gave_up and any("following for" in e.text for e in last.events)
 
 
 @pytest.mark.parametrize("name", ["paper_c_escape", "paper_c_avoid"])

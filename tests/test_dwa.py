@@ -160,7 +160,7 @@ def test_with_no_admissible_arc_it_brakes():
     for tick in range(4):  # standing still: the map learns the pocket
         dwa_planner.step(observe(POCKET, tick * PERIOD, (0.0, 0.0), 0.0))
     decision = dwa_planner.step(observe(POCKET, 4 * PERIOD, (0.025, 0.0), 0.0))  # now at 0.5 m/s
-    assert decision.mode == "blocked" and decision.events == ["no admissible arc: braking"]
+    assert decision.mode == "blocked" and [e.text for e in decision.events] == ["no admissible arc: braking"]
     assert command(decision, 0.0) == pytest.approx((0.3, 0.0))  # 0.5 - a dt: as hard as it may
 
 

@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from vplane_mj import shapes
+from vplane_mj.planning.events import EventKind
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Observation
 from vplane_mj.synthetic import BEAM, BEARINGS, scan
@@ -58,7 +59,7 @@ def test_trapped_robot_escapes_through_the_mouth_for_any_orientation(angle):
     decisions = hold(planner, footprints, inside, angle, goal, 0.0, 7.0)
     detected = [d for d in decisions if d.local_minimum]
     assert len(detected) == 1
-    assert any(e.startswith("escape started") for e in detected[0].events)
+    assert any(e.kind == EventKind.ESCAPE_STARTED for e in detected[0].events)
     assert decisions[-1].mode == "escaping"
     objective = to_local(planner.temp_goal, rot)
     assert objective[0] < -0.6 - RADIUS  # beyond the mouth (local x = -0.6), outside the trap

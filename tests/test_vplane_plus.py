@@ -8,6 +8,7 @@ import pytest
 
 from vplane_mj import shapes
 from vplane_mj.planning import gridsearch
+from vplane_mj.planning.events import EventKind
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Observation
 from vplane_mj.planning.vplane_geometry import make_plane
@@ -90,7 +91,7 @@ def test_a_plane_never_spans_a_gap_the_robot_fits_through():
     planner = make_planner("vplane_plus", {}, RADIUS)
     start_s = drive(planner, footprints, [(2.0, 5.0), (5.2, 5.0)], scenario.robot.goal)
     decisions = hold(planner, footprints, (5.2, 5.0), scenario.robot.goal, 8.0, start_s=start_s)
-    assert any(e.startswith("escape started") for d in decisions for e in d.events)
+    assert any(e.kind == EventKind.ESCAPE_STARTED for d in decisions for e in d.events)
     plane = planner.pending_plane
     assert plane is not None
     span = np.linspace(plane.e1, plane.e2, 50)
@@ -123,7 +124,7 @@ size = [0.1, 1.8]
     # A trapped robot turns on the spot: scans from new headings are folded into the map.
     decisions = hold(planner, footprints, (5.0, 5.0), scenario.robot.goal, 40.0, turn_rad_per_s=1.0)
     assert any(d.gave_up for d in decisions)
-    assert any("gave up: the map has held no way" in e for d in decisions for e in d.events)
+    assert any("gave up: the map has held no way" in e.text for d in decisions for e in d.events)
 
 
 def test_a_plane_that_closes_the_only_way_is_retired():
@@ -138,7 +139,7 @@ def test_a_plane_that_closes_the_only_way_is_retired():
     )
     planner.planes.append(mouth)
     decisions = hold(planner, footprints, (5.2, 5.0), goal, 8.0, start_s=start_s)
-    events = [e for d in decisions for e in d.events]
+    events = [e.text for d in decisions for e in d.events]
     assert "virtual plane retired: it closed the only known way to the goal" in events
     assert mouth not in planner.planes
 

@@ -348,8 +348,8 @@ def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> Ru
             break
         local_minima += decision.local_minimum
         escapes += decision.escape_completed
-        for text in decision.events:
-            note(text)
+        for event in decision.events:
+            note(event.text)
         if decision.objective is not None or decision.planes:
             _collect_virtual(decision, objectives, planes)
         command = heading_command(force_x, force_y, believed_yaw, drive.gains)

@@ -12,6 +12,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from vplane_mj.planning import fields
+from vplane_mj.planning.events import Event, EventKind
 from vplane_mj.planning.minima import LocalMinimumDetector
 from vplane_mj.planning.params import Param, PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
@@ -91,9 +92,11 @@ def report_trap(
     state = detector.update(obs.time_s, obs.position, near_goal)
     if state.new:
         decision.local_minimum = True
-        decision.events.append("local minimum detected")
+        decision.events.append(Event(EventKind.LOCAL_MINIMUM, "local minimum detected"))
     if state.trapped:
         decision.mode = "trapped"
         if state.trapped_for_s >= patience_s:
             decision.gave_up = True
-            decision.events.append(f"gave up: trapped for {state.trapped_for_s:.1f} s")
+            decision.events.append(
+                Event(EventKind.GAVE_UP, f"gave up: trapped for {state.trapped_for_s:.1f} s")
+            )

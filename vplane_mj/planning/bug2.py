@@ -17,6 +17,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.params import Param, PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.planning.vplane_geometry import unit
@@ -167,7 +168,13 @@ class Bug2Planner:
             self.left_hit_area = False
             self.side = self._choose_side(obs)
             turn = "left" if self.side > 0 else "right"
-            events.append(f"hit at ({position[0]:.2f}, {position[1]:.2f}): following, turning {turn}")
+            events.append(
+                Event(
+                    EventKind.FOLLOWING_STARTED,
+                    f"hit at ({position[0]:.2f}, {position[1]:.2f}): following, turning {turn}",
+                    {"point": point(position)},
+                )
+            )
         elif self.mode == "following":
             from_hit = float(np.hypot(*(position - self.hit_point)))
             if from_hit > 2.0 * p["loop_radius_m"]:
@@ -177,13 +184,28 @@ class Bug2Planner:
             clear = ahead > p["hit_distance_m"] + 0.15
             if on_mline and closer and clear:
                 self.mode = "go_to_goal"
-                events.append(f"leave at ({position[0]:.2f}, {position[1]:.2f}): back on the m-line")
+                events.append(
+                    Event(
+                        EventKind.WALL_LEFT,
+                        f"leave at ({position[0]:.2f}, {position[1]:.2f}): back on the m-line",
+                        {"point": point(position)},
+                    )
+                )
             elif self.left_hit_area and from_hit <= p["loop_radius_m"]:
                 self.gave_up = True
-                events.append("gave up: back at the hit point after a loop, the goal is unreachable")
+                events.append(
+                    Event(
+                        EventKind.GAVE_UP,
+                        "gave up: back at the hit point after a loop, the goal is unreachable",
+                    )
+                )
             elif obs.time_s - self.follow_start_s >= p["max_follow_s"]:
                 self.gave_up = True
-                events.append(f"gave up: following for {obs.time_s - self.follow_start_s:.1f} s")
+                events.append(
+                    Event(
+                        EventKind.GAVE_UP, f"gave up: following for {obs.time_s - self.follow_start_s:.1f} s"
+                    )
+                )
 
         if self.gave_up:
             return Decision(force=np.zeros(2), mode="gave_up", events=events, gave_up=True)

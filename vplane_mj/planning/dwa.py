@@ -39,6 +39,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from vplane_mj.planning.apf import MINIMUM_PARAMS, detector_from, report_trap
+from vplane_mj.planning.events import Event, EventKind
 from vplane_mj.planning.localmap import LocalMap
 from vplane_mj.planning.params import LOCAL_MAP_PARAMS, Param, PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
@@ -172,13 +173,13 @@ class DwaPlanner:
             i, j = np.unravel_index(np.argmax(np.where(admissible, score, -np.inf)), score.shape)
             command = float(speeds[i]), float(turns[j])
             if self.blocked:
-                decision.events.append("an admissible arc again")
+                decision.events.append(Event(EventKind.UNBLOCKED, "an admissible arc again"))
             self.blocked = False
         else:  # brake as hard as the window allows, without turning when it can
             command = float(speeds[0]), min(max(0.0, float(turns[0])), float(turns[-1]))
             decision.mode = "blocked"
             if not self.blocked:
-                decision.events.append("no admissible arc: braking")
+                decision.events.append(Event(EventKind.BLOCKED, "no admissible arc: braking"))
             self.blocked = True
         decision.force = force_for_command(*command, obs.yaw)
         decision.components = {"command": decision.force}

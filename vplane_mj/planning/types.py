@@ -6,6 +6,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from vplane_mj.planning.events import Event
+
 
 @dataclass(frozen=True)
 class Observation:
@@ -54,7 +56,7 @@ class Decision:
     """A planner's answer: the total force (world frame) to follow, and what it is doing.
 
     `components` names the parts of the force (attractive, repulsive, ...) for the log;
-    `events` are short human-readable notes of what happened this tick;
+    `events` are what happened this tick (kind, text and numbers);
     `local_minimum` and `escape_completed` mark a detection and a finished escape;
     `objective` is the virtual new objective while one exists (world frame, m) and
     `planes` the virtual planes in force, each as its two end points.
@@ -63,7 +65,7 @@ class Decision:
     force: np.ndarray
     mode: str
     components: dict[str, np.ndarray] = field(default_factory=dict)
-    events: list[str] = field(default_factory=list)
+    events: list[Event] = field(default_factory=list)
     local_minimum: bool = False
     escape_completed: bool = False
     gave_up: bool = False

@@ -15,6 +15,7 @@ import numpy as np
 
 from vplane_mj.planning import fields
 from vplane_mj.planning.apf import DETECTOR_PARAMS, FIELD_PARAMS, detector_from, firas_components
+from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.params import Param, PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
 
@@ -52,16 +53,27 @@ class VobsPlanner:
             decision.local_minimum = True
             if self.placed >= p["max_virtual"]:
                 decision.gave_up = True
-                decision.events.append(f"gave up after {self.placed} virtual obstacles")
+                decision.events.append(Event(EventKind.LOCAL_MINIMUM, "local minimum detected"))
+                decision.events.append(
+                    Event(EventKind.GAVE_UP, f"gave up after {self.placed} virtual obstacles")
+                )
             else:
                 self.placed += 1
                 self.virtual.append((obs.time_s, obs.position.copy()))
                 self.detector.reset()
                 x, y = obs.position
-                decision.events.append(f"local minimum detected: virtual obstacle at ({x:.2f}, {y:.2f})")
+                decision.events.append(
+                    Event(
+                        EventKind.LOCAL_MINIMUM,
+                        f"local minimum detected: virtual obstacle at ({x:.2f}, {y:.2f})",
+                        {"point": point(obs.position)},
+                    )
+                )
         expired = [v for v in self.virtual if obs.time_s - v[0] > p["vobs_lifetime_s"]]
         if expired:
-            decision.events.append(f"{len(expired)} virtual obstacle(s) cleared")
+            decision.events.append(
+                Event(EventKind.VIRTUAL_OBSTACLES_CLEARED, f"{len(expired)} virtual obstacle(s) cleared")
+            )
             self.virtual = [v for v in self.virtual if v not in expired]
         points = np.array([position for _, position in self.virtual]).reshape(-1, 2)
         components["virtual"] = fields.repulsive_force(

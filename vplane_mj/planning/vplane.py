@@ -31,6 +31,7 @@ import numpy as np
 
 from vplane_mj.planning import fields, histogram
 from vplane_mj.planning.apf import DETECTOR_PARAMS, FIELD_PARAMS, detector_from, firas_components
+from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.localmap import LocalMap, angular_extremes
 from vplane_mj.planning.params import SONAR_MAP_PARAMS, Param, PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
@@ -84,6 +85,25 @@ INFO = PlannerInfo(
 )
 
 
+def escape_started(e1: np.ndarray, e2: np.ndarray, objective: np.ndarray) -> Event:
+    """The event of an escape that starts toward `objective`, from the trap's extreme points."""
+    return Event(
+        EventKind.ESCAPE_STARTED,
+        f"escape started: e1=({e1[0]:.2f}, {e1[1]:.2f}) e2=({e2[0]:.2f}, {e2[1]:.2f}) "
+        f"objective=({objective[0]:.2f}, {objective[1]:.2f})",
+        {"e1": point(e1), "e2": point(e2), "objective": point(objective)},
+    )
+
+
+def plane_created(plane: VirtualPlane) -> Event:
+    """The event of an escape finished with a new virtual plane."""
+    return Event(
+        EventKind.ESCAPE_FINISHED,
+        "objective reached: virtual plane created, target re-activated",
+        {"e1": point(plane.e1), "e2": point(plane.e2)},
+    )
+
+
 class VPlanePlanner:
     """Algorithm 3 with its flags: `temp_goal` (escaping) and the list L of virtual planes."""
 
@@ -116,11 +136,11 @@ class VPlanePlanner:
         state = self.detector.update(obs.time_s, obs.position, near_goal)
         if state.new:
             decision.local_minimum = True
-            decision.events.append("local minimum detected")
+            decision.events.append(Event(EventKind.LOCAL_MINIMUM, "local minimum detected"))
             if not self._start_escape(obs, decision):
                 return decision
         elif self.temp_goal is not None and obs.time_s - self.escape_started_s > p["escape_timeout_s"]:
-            decision.events.append("escape timed out")
+            decision.events.append(Event(EventKind.ESCAPE_TIMED_OUT, "escape timed out"))
             if not self._start_escape(obs, decision):
                 return decision
 
@@ -153,11 +173,13 @@ class VPlanePlanner:
         self.avoid_waypoint = None
         if self.escapes_tried >= self.params["max_escapes"]:
             decision.gave_up = True
-            decision.events.append(f"gave up after {self.escapes_tried} escapes")
+            decision.events.append(Event(EventKind.GAVE_UP, f"gave up after {self.escapes_tried} escapes"))
             return False
         trap = self._trap_cluster(obs.position, obs.goal)
         if trap is None:
-            decision.events.append("local minimum without mapped obstacles: no escape possible")
+            decision.events.append(
+                Event(EventKind.GAVE_UP, "local minimum without mapped obstacles: no escape possible")
+            )
             decision.gave_up = True
             return False
         i1, i2, _ = angular_extremes(obs.position, trap)
@@ -169,10 +191,7 @@ class VPlanePlanner:
         self.escape_started_s = obs.time_s
         self.escapes_tried += 1
         self.detector.reset()
-        decision.events.append(
-            f"escape started: e1=({e1[0]:.2f}, {e1[1]:.2f}) e2=({e2[0]:.2f}, {e2[1]:.2f}) "
-            f"objective=({self.temp_goal[0]:.2f}, {self.temp_goal[1]:.2f})"
-        )
+        decision.events.append(escape_started(e1, e2, self.temp_goal))
         return True
 
     def _finish_escape(self, decision: Decision) -> None:
@@ -182,10 +201,10 @@ class VPlanePlanner:
         self.pending_plane = None
         if len(self.planes) > self.params["max_planes"]:
             self.planes.pop(0)
-            decision.events.append("oldest virtual plane retired")
+            decision.events.append(Event(EventKind.PLANE_RETIRED, "oldest virtual plane retired"))
         self.detector.reset()
         decision.escape_completed = True
-        decision.events.append("objective reached: virtual plane created, target re-activated")
+        decision.events.append(plane_created(self.planes[-1]))
 
     def _trap_cluster(self, position: np.ndarray, goal: np.ndarray) -> np.ndarray | None:
         """Echo points of the obstacle that traps the robot: the cluster nearest toward the goal.
@@ -234,7 +253,9 @@ class VPlanePlanner:
         for plane in self.planes:
             nearest_to_goal = min(np.hypot(*(plane.e1 - obs.goal)), np.hypot(*(plane.e2 - obs.goal)))
             if to_goal < nearest_to_goal - self.radius:
-                decision.events.append("virtual plane retired: the trap is behind")
+                decision.events.append(
+                    Event(EventKind.PLANE_RETIRED, "virtual plane retired: the trap is behind")
+                )
             else:
                 kept.append(plane)
         self.planes = kept
@@ -256,13 +277,15 @@ class VPlanePlanner:
         goal_free = not blocked[histogram.sector_of(goal_bearing, self.n_sectors)]
         if goal_free:
             if self.avoid_waypoint is not None:
-                decision.events.append("avoidance finished: the way to the goal is free")
+                decision.events.append(
+                    Event(EventKind.AVOIDANCE_FINISHED, "avoidance finished: the way to the goal is free")
+                )
             self.avoid_waypoint = None
             return
         if self.avoid_waypoint is not None:
             if np.hypot(*(obs.position - self.avoid_waypoint)) < 2 * self.radius:
                 self.avoid_waypoint = None
-                decision.events.append("avoidance finished: edge passed")
+                decision.events.append(Event(EventKind.AVOIDANCE_FINISHED, "avoidance finished: edge passed"))
             return
         if obs.time_s < self.next_concavity_check_s:
             return
@@ -271,7 +294,11 @@ class VPlanePlanner:
         if waypoint is not None and self._passage_is_wide(blocked, waypoint - obs.position):
             self.avoid_waypoint = waypoint
             decision.events.append(
-                f"concave obstacle ahead: passing its edge via ({waypoint[0]:.2f}, {waypoint[1]:.2f})"
+                Event(
+                    EventKind.AVOIDANCE_STARTED,
+                    f"concave obstacle ahead: passing its edge via ({waypoint[0]:.2f}, {waypoint[1]:.2f})",
+                    {"waypoint": point(waypoint)},
+                )
             )
 
     def _passage_is_wide(self, blocked: np.ndarray, direction: np.ndarray) -> bool:

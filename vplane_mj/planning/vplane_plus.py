@@ -34,11 +34,12 @@ from scipy import ndimage
 
 from vplane_mj.planning import fields, gridsearch
 from vplane_mj.planning.apf import firas_components
+from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.localmap import LocalMap, angular_extremes
 from vplane_mj.planning.params import Param, PlannerInfo
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.planning.vplane import PARAMS as VPLANE_PARAMS
-from vplane_mj.planning.vplane import VPlanePlanner
+from vplane_mj.planning.vplane import VPlanePlanner, escape_started, plane_created
 from vplane_mj.planning.vplane_geometry import VirtualPlane, make_plane, unit, virtual_objective
 
 CLOSE_ECHO_MARGIN_M = 0.1
@@ -57,6 +58,15 @@ OBJECTIVE_ROOM_M = 0.05
 """A virtual objective lies at least this much beyond the robot's disc from every mapped obstacle."""
 TRAP_REACH_M = 2.5
 """Obstacle cells farther than this from the robot are not part of the trap it is in."""
+
+
+def plane_refused(e1: np.ndarray, e2: np.ndarray, why: str) -> Event:
+    """The event of a virtual plane e1-e2 not created, and why."""
+    return Event(
+        EventKind.PLANE_REFUSED,
+        f"no virtual plane: e1=({e1[0]:.2f}, {e1[1]:.2f}) e2=({e2[0]:.2f}, {e2[1]:.2f}) {why}",
+        {"e1": point(e1), "e2": point(e2)},
+    )
 
 
 def _with_default(param: Param, default: float) -> Param:
@@ -139,19 +149,25 @@ class VPlanePlusPlanner(VPlanePlanner):
         state = self.detector.update(obs.time_s, obs.position, near_goal)
         if state.new:
             decision.local_minimum = True
-            decision.events.append("local minimum detected")
+            decision.events.append(Event(EventKind.LOCAL_MINIMUM, "local minimum detected"))
             if self.following:
                 # Held up on the way: the map missed something there. Charge for passing that
                 # place again, and look for a way at once.
                 stuck_at = self._next_waypoint(obs.position, self.follow_way, obs.goal)
                 self.stalls.append(stuck_at)
-                decision.events.append(f"held up on the way near ({stuck_at[0]:.2f}, {stuck_at[1]:.2f})")
+                decision.events.append(
+                    Event(
+                        EventKind.HELD_UP,
+                        f"held up on the way near ({stuck_at[0]:.2f}, {stuck_at[1]:.2f})",
+                        {"point": point(stuck_at)},
+                    )
+                )
                 self.next_replan_s = obs.time_s
                 self.detector.reset()
             else:
                 self._start_escape(obs, decision)
         elif self.temp_goal is not None and obs.time_s - self.escape_started_s > p["escape_timeout_s"]:
-            decision.events.append("escape timed out")
+            decision.events.append(Event(EventKind.ESCAPE_TIMED_OUT, "escape timed out"))
             self._start_escape(obs, decision)
 
         if self.temp_goal is not None and np.hypot(*(obs.position - self.temp_goal)) <= p["vno_tolerance_m"]:
@@ -297,15 +313,11 @@ class VPlanePlusPlanner(VPlanePlanner):
         clearance = self.radius + self.params["escape_margin_m"]
         window = self._window(obs.position, obs.goal, self.planes, margin=self.params["search_margin_m"])
         if self._spans_a_gap(plane, others):
-            decision.events.append(
-                f"no virtual plane: e1=({e1[0]:.2f}, {e1[1]:.2f}) e2=({e2[0]:.2f}, {e2[1]:.2f}) "
-                "would span a gap between obstacles"
-            )
+            decision.events.append(plane_refused(e1, e2, "would span a gap between obstacles"))
             plane = None
         elif self._find_way(obs.position, obs.goal, [*self.planes, plane]):
             decision.events.append(
-                f"no virtual plane: e1=({e1[0]:.2f}, {e1[1]:.2f}) e2=({e2[0]:.2f}, {e2[1]:.2f}) "
-                "would close no trap (the map shows another way out)"
+                plane_refused(e1, e2, "would close no trap (the map shows another way out)")
             )
             plane = None
         frame = plane or make_plane(e1, e2, cells, obs.position, obs.goal)
@@ -317,10 +329,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         self.temp_goal, self.escape_way, self.pending_plane = objective, way, plane
         self.escape_started_s = obs.time_s
         self.escapes_tried += 1
-        decision.events.append(
-            f"escape started: e1=({e1[0]:.2f}, {e1[1]:.2f}) e2=({e2[0]:.2f}, {e2[1]:.2f}) "
-            f"objective=({objective[0]:.2f}, {objective[1]:.2f})"
-        )
+        decision.events.append(escape_started(e1, e2, objective))
         return True
 
     def _finish_escape(self, obs: Observation, decision: Decision) -> None:
@@ -330,19 +339,24 @@ class VPlanePlusPlanner(VPlanePlanner):
         self.detector.reset()
         decision.escape_completed = True
         if plane is None:
-            decision.events.append("objective reached: target re-activated (no virtual plane)")
+            decision.events.append(
+                Event(EventKind.ESCAPE_FINISHED, "objective reached: target re-activated (no virtual plane)")
+            )
             return
         if self._find_way(obs.position, obs.goal, [*self.planes, plane]) is None:
             decision.events.append(
-                "objective reached: target re-activated; no virtual plane, it would cut the only known "
-                "way to the goal"
+                Event(
+                    EventKind.ESCAPE_FINISHED,
+                    "objective reached: target re-activated; no virtual plane, it would cut the only known "
+                    "way to the goal",
+                )
             )
             return
         self.planes.append(plane)
         if len(self.planes) > self.params["max_planes"]:
             self.planes.pop(0)
-            decision.events.append("oldest virtual plane retired")
-        decision.events.append("objective reached: virtual plane created, target re-activated")
+            decision.events.append(Event(EventKind.PLANE_RETIRED, "oldest virtual plane retired"))
+        decision.events.append(plane_created(plane))
 
     def _trap_obstacle(self, position: np.ndarray, goal: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         """Cell centres of the one obstacle that traps the robot, and of every other obstacle
@@ -432,7 +446,9 @@ class VPlanePlusPlanner(VPlanePlanner):
     def _start_following(self, obs: Observation, decision: Decision, why: str) -> None:
         self.following = True
         self.next_replan_s = obs.time_s
-        decision.events.append(f"following the map's way to the goal ({why})")
+        decision.events.append(
+            Event(EventKind.FOLLOWING_STARTED, f"following the map's way to the goal ({why})")
+        )
 
     def _follow_target(self, obs: Observation, decision: Decision) -> np.ndarray:
         """The waypoint on the map's way to the goal; replanned every `replan_period_s`.
@@ -445,22 +461,27 @@ class VPlanePlusPlanner(VPlanePlanner):
         if obs.time_s < self.next_replan_s:
             if not self.follow_way or not self._way_is_blocked(obs.position, self.follow_way):
                 return waypoint
-            decision.events.append("the way ahead is blocked on the map: searched again")
+            decision.events.append(
+                Event(EventKind.WAY_CHANGED, "the way ahead is blocked on the map: searched again")
+            )
         self.next_replan_s = obs.time_s + p["replan_period_s"]
         way = self._way_to_goal(obs, decision)
         if way is None:
             self.follow_way = []
             if self.no_way_since is None:
                 self.no_way_since = obs.time_s
-                decision.events.append("the map holds no way to the goal")
+                decision.events.append(Event(EventKind.WAY_CHANGED, "the map holds no way to the goal"))
             elif obs.time_s - self.no_way_since >= p["no_way_patience_s"]:
                 decision.gave_up = True
                 decision.events.append(
-                    f"gave up: the map has held no way to the goal for {p['no_way_patience_s']:g} s"
+                    Event(
+                        EventKind.GAVE_UP,
+                        f"gave up: the map has held no way to the goal for {p['no_way_patience_s']:g} s",
+                    )
                 )
             return obs.goal
         if self.no_way_since is not None:
-            decision.events.append("the map shows a way to the goal again")
+            decision.events.append(Event(EventKind.WAY_CHANGED, "the map shows a way to the goal again"))
         self.no_way_since = None
         kept = self.sight.path_cost(np.array([obs.position, *self.follow_way])) if self.follow_way else np.inf
         if kept > KEEP_WAY_RATIO * self.sight.path_cost(np.array([obs.position, *way])):
@@ -474,7 +495,11 @@ class VPlanePlusPlanner(VPlanePlanner):
         way = self._find_way(obs.position, obs.goal, self.planes)
         while way is None and self.planes:
             self.planes.pop()
-            decision.events.append("virtual plane retired: it closed the only known way to the goal")
+            decision.events.append(
+                Event(
+                    EventKind.PLANE_RETIRED, "virtual plane retired: it closed the only known way to the goal"
+                )
+            )
             way = self._find_way(obs.position, obs.goal, self.planes)
         return way or self._find_way(obs.position, obs.goal, self.planes, relaxed=True)
 

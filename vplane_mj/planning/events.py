@@ -1,0 +1,71 @@
+"""What happens during a run, as data: an event's kind, its human-readable text and its numbers.
+
+Planners report their decisions as events (a local minimum, an escape, a plane created or
+retired, ...); the run loop adds its own (a collision, the goal reached, the time limit, an
+error). The log stores each with its kind and data, so a run's summary can be recomputed
+from the log without reading the text (`vplane_mj.replay`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import StrEnum
+
+
+class EventKind(StrEnum):
+    """Every kind of event; the value is what the log stores."""
+
+    RUN_STARTED = "run_started"
+    LOCAL_MINIMUM = "local_minimum"
+    """The local-minimum detector fired (counted in the summary's `local_minima`)."""
+    ESCAPE_STARTED = "escape_started"
+    """A virtual new objective was placed; data: `objective` (x, y) and `e1`, `e2` when known."""
+    ESCAPE_TIMED_OUT = "escape_timed_out"
+    ESCAPE_FINISHED = "escape_finished"
+    """The virtual objective was reached and the target re-activated (counted in `escapes`)."""
+    PLANE_CREATED = "plane_created"
+    """A virtual plane was added; data: `e1`, `e2`."""
+    PLANE_REFUSED = "plane_refused"
+    """A virtual plane was considered and not created (the text says why)."""
+    PLANE_RETIRED = "plane_retired"
+    AVOIDANCE_STARTED = "avoidance_started"
+    """Histogram avoidance steers past an obstacle's edge; data: `waypoint`."""
+    AVOIDANCE_FINISHED = "avoidance_finished"
+    FOLLOWING_STARTED = "following_started"
+    """A fallback that follows a way (the map's, or a wall's) took over."""
+    WAY_CHANGED = "way_changed"
+    """The way being followed was found blocked, held up, lost or found again."""
+    HELD_UP = "held_up"
+    """Following a way, the robot was held up; data: `point`."""
+    WALL_LEFT = "wall_left"
+    VIRTUAL_OBSTACLE_PLACED = "virtual_obstacle_placed"
+    VIRTUAL_OBSTACLES_CLEARED = "virtual_obstacles_cleared"
+    BLOCKED = "blocked"
+    UNBLOCKED = "unblocked"
+    GAVE_UP = "gave_up"
+    """The planner gave up: the run ends as `stuck`."""
+    COLLISION = "collision"
+    """A new contact episode between the robot and an obstacle; data: `point`."""
+    GOAL_REACHED = "goal_reached"
+    TIME_LIMIT = "time_limit"
+    BELIEVED_ARRIVED = "believed_arrived"
+    """Odometry has held the robot at a goal it has not reached: the run ends as `stuck`."""
+    ERROR = "error"
+    """A MuJoCo warning, a non-finite state or force: the run ends as `error`."""
+
+
+@dataclass(frozen=True)
+class Event:
+    """One event: its kind, a short text for people, and its numbers (points as (x, y) in m)."""
+
+    kind: EventKind
+    text: str
+    data: dict[str, object] = field(default_factory=dict)
+
+    def __str__(self) -> str:
+        return self.text
+
+
+def point(xy) -> tuple[float, float]:
+    """A point for an event's data: (x, y) as plain floats, rounded to the millimetre."""
+    return (round(float(xy[0]), 3), round(float(xy[1]), 3))
