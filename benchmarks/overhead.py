@@ -59,7 +59,7 @@ def logged_run(scenario, log_dir: Path) -> tuple[float, int]:
     start = time.process_time()
     log = McapLog(path, scenario, robot_radius_m(), bearings, scenario.sensors.range_max, {})
     result = run_scenario(scenario, observers=(log,))
-    log.close(result.summary)
+    log.close(result.summary.to_dict())
     return time.process_time() - start, path.stat().st_size
 
 
@@ -84,10 +84,10 @@ def measure(ref: str, planner: str, repeat: int, log_dir: Path | None) -> dict:
         result = run_scenario(scenario)
         times["run"].append(time.process_time() - start - setup)
         summary = result.summary
-        times["run wall"].append(summary["wall_time_s"])
-        times["floor"].append(replay_time(floor, result.torques, summary["steps"]))
-        times["floor wall"].append(replay_time(floor, result.torques, summary["steps"], time.perf_counter))
-        times["built"].append(replay_time(built, result.torques, summary["steps"]))
+        times["run wall"].append(summary.wall_time_s)
+        times["floor"].append(replay_time(floor, result.torques, summary.steps))
+        times["floor wall"].append(replay_time(floor, result.torques, summary.steps, time.perf_counter))
+        times["built"].append(replay_time(built, result.torques, summary.steps))
         if log_dir is not None:
             cpu, log_bytes = logged_run(scenario, log_dir)
             times["log"].append(cpu - setup)
@@ -95,16 +95,16 @@ def measure(ref: str, planner: str, repeat: int, log_dir: Path | None) -> dict:
     return {
         "scenario": scenario.name,
         "planner": planner,
-        "outcome": summary["outcome"],
-        "steps": summary["steps"],
+        "outcome": summary.outcome,
+        "steps": summary.steps,
         "run": median["run"] / median["floor"],
         "log": median["log"] / median["floor"] if "log" in median else None,
         "built": median["built"] / median["floor"],
         "run_vs_built": median["run"] / median["built"],
         "run_wall": median["run wall"] / median["floor wall"],
-        "floor_us": 1e6 * median["floor"] / summary["steps"],
-        "planner_ms": summary["planner_cpu_ms_mean"],
-        "log_mb_per_min": log_bytes / 1e6 / (summary["sim_time_s"] / 60.0),
+        "floor_us": 1e6 * median["floor"] / summary.steps,
+        "planner_ms": summary.planner_cpu_ms_mean,
+        "log_mb_per_min": log_bytes / 1e6 / (summary.sim_time_s / 60.0),
     }
 
 

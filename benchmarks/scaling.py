@@ -76,7 +76,7 @@ def cost(document: str) -> tuple[float, float, float]:
     start = time.process_time()
     result = run_scenario(scenario)
     run = time.process_time() - start
-    steps = result.summary["steps"]
+    steps = result.summary.steps
     floor, built = build_model(scenario), build_model(scenario)
     floor.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_SENSOR
     return (

@@ -35,7 +35,7 @@ def logged_run(scenario, path: Path) -> float:
     bearings = SonarLayout.from_spec(scenario.sensors).bearings
     log = McapLog(path, scenario, robot_radius_m(), bearings, scenario.sensors.range_max, {})
     result = run_scenario(scenario, observers=(log,))
-    log.close(result.summary)
+    log.close(result.summary.to_dict())
     return time.perf_counter() - started
 
 

@@ -17,7 +17,7 @@ from vplane_mj.bench import JOURNAL, family_of, parse_seeds, read_journal
 from vplane_mj.cli import main
 from vplane_mj.errors import VPlaneError
 from vplane_mj.scenario import load_scenario
-from vplane_mj.sim import TIMING_KEYS
+from vplane_mj.summary import TIMING_KEYS
 
 OUTPUTS = ("bench.csv", "bench.json", "bench.png", "bench-scenarios.png", "bench.html")
 ARGS = ["bench", "open_field", "paper_c_escape", "--planners", "apf,vplane", "--seeds", "0-1", "--jobs", "2"]

@@ -101,18 +101,18 @@ def test_gives_up_after_max_follow_s():
 @pytest.mark.parametrize("name", ["paper_c_escape", "paper_c_avoid"])
 def test_escapes_the_c_trap_where_apf_is_stuck(name):
     apf = run_scenario(load_scenario(name, ["planner.name=apf"])).summary
-    assert not apf["reached"]
+    assert not apf.reached
     result = run_scenario(load_scenario(name, ["planner.name=bug2"]))
     summary = result.summary
-    assert summary["reached"] and summary["collisions"] == 0
-    assert summary["min_clearance_m"] > 0.05
+    assert summary.reached and summary.collisions == 0
+    assert summary.min_clearance_m > 0.05
     assert "following" in result.modes
 
 
 def test_open_field_is_a_straight_line():
     summary = run_scenario(load_scenario("open_field", ["planner.name=bug2"])).summary
-    assert summary["reached"] and summary["collisions"] == 0
-    assert summary["path_length_m"] <= 1.1 * math.hypot(4.0, 4.0)
+    assert summary.reached and summary.collisions == 0
+    assert summary.path_length_m <= 1.1 * math.hypot(4.0, 4.0)
 
 
 def test_gives_up_in_physics_on_an_enclosed_goal(scenario_from):
@@ -126,4 +126,4 @@ def test_gives_up_in_physics_on_an_enclosed_goal(scenario_from):
         '[planner]\nname = "bug2"\n[run]\ntime_limit_s = 90\n'
     )
     summary = run_scenario(scenario_from(text)).summary
-    assert summary["outcome"] == "stuck" and summary["collisions"] == 0
+    assert summary.outcome == "stuck" and summary.collisions == 0

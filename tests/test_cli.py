@@ -14,7 +14,7 @@ import pytest
 
 from vplane_mj.cache import CACHE_ENV
 from vplane_mj.cli import main
-from vplane_mj.log_mcap import read_log
+from vplane_mj.log_read import read_log
 
 BAD_SCENARIO = """
 format = 1

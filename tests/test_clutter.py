@@ -1,7 +1,6 @@
 """Closed-loop runs in generated BARN-like worlds (fixed seeds): where the paper's rules place the
 virtual objective, and the clutter extension `vplane_plus`."""
 
-import re
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
@@ -9,13 +8,13 @@ import pytest
 
 from vplane_mj import shapes
 from vplane_mj.families import generate
+from vplane_mj.planning.events import EventKind
 from vplane_mj.reference import shortest_path, shortest_path_length
 from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim import run_scenario
 
 RADIUS = robot_radius_m()
-OBJECTIVE = re.compile(r"escape started: .* objective=\((-?[\d.]+), (-?[\d.]+)\)")
 
 
 class Escapes:
@@ -28,9 +27,9 @@ class Escapes:
     def on_tick(self, tick):
         self.position = tick.position.copy()
 
-    def on_event(self, time_s, text):
-        if match := OBJECTIVE.match(text):
-            self.placed.append((self.position, np.array([float(match[1]), float(match[2])])))
+    def on_event(self, time_s, event):
+        if event.kind == EventKind.ESCAPE_STARTED:
+            self.placed.append((self.position, np.array(event.data["objective"])))
 
 
 def misplaced(toml: str, robot: np.ndarray, objective: np.ndarray) -> str | None:
@@ -56,7 +55,7 @@ def _run(job):
         parse_scenario(toml, "world.toml", [f"planner.name={planner}"]), (watcher,)
     ).summary
     problems = [why for robot, objective in watcher.placed if (why := misplaced(toml, robot, objective))]
-    return planner, summary["success"], len(watcher.placed), problems
+    return planner, summary.success, len(watcher.placed), problems
 
 
 @pytest.fixture(scope="module")

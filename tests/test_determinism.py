@@ -10,7 +10,8 @@ import pytest
 
 from vplane_mj.cli import main
 from vplane_mj.scenario import load_scenario
-from vplane_mj.sim import TIMING_KEYS, run_scenario
+from vplane_mj.sim import run_scenario
+from vplane_mj.summary import TIMING_KEYS
 
 EVERY_FAULT = [
     "sensors.noise_std=0.02",
@@ -45,7 +46,7 @@ def test_two_processes_and_this_one_give_identical_runs(tmp_path):
     second.mkdir()
     a, b = _run_in_new_process(first, "1"), _run_in_new_process(second, "2")
     here = run_scenario(load_scenario("paper_h_escape", [*EVERY_FAULT, "run.seed=3"])).summary
-    here = json.loads(json.dumps(here))  # the JSON form the files hold
+    here = json.loads(json.dumps(here.to_dict()))  # the JSON form the files hold
     assert _without_timing(a) == _without_timing(b) == _without_timing(here)
     assert a["odometry_error_m"] > 0  # the faults were on
 
@@ -53,7 +54,7 @@ def test_two_processes_and_this_one_give_identical_runs(tmp_path):
 def test_another_seed_gives_another_trajectory():
     def digest(seed):
         scenario = load_scenario("single_box", [*EVERY_FAULT, f"run.seed={seed}", "run.time_limit_s=5"])
-        return run_scenario(scenario).summary["trajectory_sha256"]
+        return run_scenario(scenario).summary.trajectory_sha256
 
     assert digest(0) == digest(0) != digest(1)
 

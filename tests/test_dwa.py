@@ -166,12 +166,12 @@ def test_with_no_admissible_arc_it_brakes():
 
 def test_it_reaches_the_goal_past_a_box_without_collision(shipped):
     summary = run_scenario(shipped("single_box", "planner.name=dwa")).summary
-    assert summary["success"] and summary["collisions"] == 0
-    assert summary["path_ratio"] < 1.15 and summary["min_clearance_m"] > 0.05
+    assert summary.success and summary.collisions == 0
+    assert summary.path_ratio < 1.15 and summary.min_clearance_m > 0.05
 
 
 def test_it_crosses_a_barn_world_without_collision():
     case = random_barn("barn_dwa", np.random.default_rng(8))  # 47 boxes; the straight line is blocked
     summary = run_scenario(parse_scenario(case.toml(), "barn_dwa.toml", ["planner.name=dwa"])).summary
-    assert summary["success"] and summary["collisions"] == 0
-    assert 1.05 < summary["path_ratio"] < 1.6
+    assert summary.success and summary.collisions == 0
+    assert 1.05 < summary.path_ratio < 1.6

@@ -104,7 +104,7 @@ def test_slipping_wheels_fool_the_odometry(shipped):
         scenario = shipped(
             "single_box", 'sensors.pose="odometry"', f"robot.wheel_friction={friction}", "run.time_limit_s=8"
         )
-        return sim.run_scenario(scenario).summary["odometry_error_m"]
+        return sim.run_scenario(scenario).summary.odometry_error_m
 
     grippy, slippery = odometry_error(1.0), odometry_error(0.05)
     assert grippy < 0.05
@@ -114,19 +114,19 @@ def test_slipping_wheels_fool_the_odometry(shipped):
 @pytest.mark.parametrize("name", ["paper_c_escape", "paper_h_escape"])
 def test_vplane_escapes_the_paper_traps_with_every_sensor_and_actuation_fault(shipped, name):
     summary = sim.run_scenario(shipped(name, *SENSOR_AND_ACTUATION_FAULTS)).summary
-    assert summary["outcome"] == "reached" and summary["success"], summary
-    assert summary["escapes"] >= 1 and summary["path_ratio"] < 2.5
+    assert summary.outcome == "reached" and summary.success, summary
+    assert summary.escapes >= 1 and summary.path_ratio < 2.5
 
 
 def test_vplane_escapes_on_odometry_alone_with_every_fault_on(shipped):
     summary = sim.run_scenario(shipped("paper_h_escape", *SENSOR_AND_ACTUATION_FAULTS, *ODOMETRY)).summary
-    assert summary["outcome"] == "reached" and summary["success"], summary
-    assert 0.0 < summary["odometry_error_m"] < 0.15
+    assert summary.outcome == "reached" and summary.success, summary
+    assert 0.0 < summary.odometry_error_m < 0.15
 
 
 def test_a_robot_lost_by_its_odometry_stops_as_stuck_with_the_reason(shipped):
     scenario = shipped("open_field", 'sensors.pose="odometry"', "sensors.odometry_noise=0.3")
     summary = sim.run_scenario(scenario).summary
-    assert summary["outcome"] == "stuck"
-    assert "odometry has put the robot at the goal" in summary["message"]
-    assert summary["final_distance_to_goal_m"] > 0.15 and summary["sim_time_s"] < 60
+    assert summary.outcome == "stuck"
+    assert "odometry has put the robot at the goal" in summary.message
+    assert summary.final_distance_to_goal_m > 0.15 and summary.sim_time_s < 60

@@ -33,6 +33,7 @@ from vplane_mj.reference import shortest_path
 from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim import run_scenario
+from vplane_mj.summary import RunSummary
 
 FUZZ = settings(
     deadline=None,
@@ -729,10 +730,10 @@ def scenario_text(size, obstacles: list[dict], start, goal, time_limit_s: float,
     return tomli_w.dumps(doc)
 
 
-def assert_finished(summary: dict, outcomes=OUTCOMES) -> None:
+def assert_finished(summary: RunSummary, outcomes=OUTCOMES) -> None:
     """The run ended normally, with one of `outcomes`."""
-    assert summary["outcome"] in outcomes, (summary["outcome"], summary.get("message"))
-    assert summary["sim_time_s"] > 0 and math.isfinite(summary["path_length_m"])
+    assert summary.outcome in outcomes, (summary.outcome, summary.message)
+    assert summary.sim_time_s > 0 and math.isfinite(summary.path_length_m)
 
 
 def test_a_thousand_obstacles_run_and_have_a_reference_path():
@@ -753,7 +754,7 @@ def test_a_thousand_obstacles_run_and_have_a_reference_path():
     assert_finished(summary, {"timeout"})
     # Through the lattice's 0.8 m aisles the way is at least the straight line, and not much more.
     straight = math.dist((0.5, 0.5), (41.0, 26.0))
-    assert straight - 0.15 <= summary["optimal_length_m"] <= 1.1 * straight
+    assert straight - 0.15 <= summary.optimal_length_m <= 1.1 * straight
 
 
 def test_a_100_m_arena_runs_and_its_reference_path_stays_small():
@@ -778,7 +779,7 @@ def test_a_100_m_arena_runs_and_its_reference_path_stays_small():
     print(f"\n100 m arena reference path: {seconds:.2f} s CPU, peak {peak / 2**20:.0f} MiB")
     summary = run_scenario(scenario).summary
     assert_finished(summary, {"timeout"})
-    assert summary["optimal_length_m"] == pytest.approx(reference.length_m - scenario.robot.goal_tolerance)
+    assert summary.optimal_length_m == pytest.approx(reference.length_m - scenario.robot.goal_tolerance)
 
 
 @pytest.mark.parametrize("planner", sorted(registry.PLANNERS))
@@ -792,7 +793,7 @@ def test_a_gap_narrower_than_the_robot_is_never_passed(planner):
     text = scenario_text((4.0, 4.0), obstacles, (2.0, 0.8), (2.0, 3.2), 10.0, "narrow_gap")
     result = run_scenario(parse_scenario(text, "narrow_gap.toml", [f"planner.name={planner}"]))
     assert_finished(result.summary, {"timeout", "stuck"})
-    assert result.summary["optimal_length_m"] is None  # no way through for the reference either
+    assert result.summary.optimal_length_m is None  # no way through for the reference either
     assert result.final_pose[1] < 2.0
 
 
@@ -810,8 +811,8 @@ def test_a_goal_two_decimetres_from_a_wall_is_reached_without_collision(obstacle
     scenario = parse_scenario(text, "goal_by_wall.toml")
     assert scenario.planner == registry.DEFAULT_PLANNER
     summary = run_scenario(scenario).summary
-    assert summary["outcome"] == "reached", summary.get("message")
-    assert summary["collisions"] == 0 and summary["success"]
+    assert summary.outcome == "reached", summary.message
+    assert summary.collisions == 0 and summary.success
 
 
 # --------------------------------------------------------------------------- 3. output directories

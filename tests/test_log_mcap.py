@@ -21,18 +21,17 @@ from mcap.records import Chunk
 from mcap.stream_reader import StreamReader
 
 from vplane_mj.log_mcap import (
-    ARROW_M_PER_UNIT,
-    ARROW_MAX_M,
+    EVENTS_JSON_SCHEMA,
     FLUSH_PERIOD_S,
     METADATA_NAME,
     METRICS_JSON_SCHEMA,
-    PATH_ID,
     PATH_TOLERANCE_M,
     McapLog,
-    iter_messages,
-    read_log,
     time_ns,
 )
+from vplane_mj.log_read import iter_messages, read_log
+from vplane_mj.log_scene import ARROW_M_PER_UNIT, ARROW_MAX_M, PATH_ID
+from vplane_mj.planning.events import Event, EventKind
 from vplane_mj.polyline import distances_to_segment
 from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import load_scenario, parse_scenario
@@ -64,7 +63,7 @@ class Recorder:
         self.ranges.append(np.array(tick.ranges, dtype=float))
         self.forces.append(np.array(tick.decision.force, dtype=float))
 
-    def on_event(self, time_s, text):
+    def on_event(self, time_s, event):
         pass
 
 
@@ -80,7 +79,7 @@ def run(tmp_path_factory):
     log = make_log(path, scenario, {"command": "pytest"})
     recorder = Recorder()
     result = run_scenario(scenario, observers=(log, recorder))
-    log.close(result.summary)
+    log.close(result.summary.to_dict())
     return {
         "scenario": scenario,
         "path": path,
@@ -113,7 +112,7 @@ def test_one_pose_per_tick_in_simulated_nanoseconds(run):
     assert contents.times_ns.dtype == np.int64
     assert np.all(np.diff(contents.times_ns) > 0)
     assert contents.times_ns.tolist()[:-1] == [round(t * 1e9) for t in result.times]
-    assert contents.times_ns[-1] == round(result.summary["sim_time_s"] * 1e9)
+    assert contents.times_ns[-1] == round(result.summary.sim_time_s * 1e9)
     np.testing.assert_array_equal(contents.positions[:-1], result.positions)
     assert contents.positions[-1] == pytest.approx(result.track().final_pose[:2])
     assert np.all(np.isfinite(contents.yaws))
@@ -196,23 +195,27 @@ def test_metadata_holds_the_resolved_scenario_and_versions(run):
         assert info[key]
     assert info["command"] == "pytest"
     summary = run["contents"].summary
-    assert summary == json.loads(json.dumps(run["result"].summary))
+    assert summary == json.loads(json.dumps(run["result"].summary.to_dict()))
 
 
-def test_events_and_their_levels(run):
+def test_events_as_text_and_as_data(run):
     events = run["contents"].events
-    texts = [text for _, _, text in events]
-    assert events[0] == (0.0, "INFO", "run started: paper_c_escape, planner vplane, seed 0")
-    assert "local minimum detected" in texts
-    assert all(level == "INFO" for _, level, _ in events)
-    detected = next(t for t, _, text in events if text == "local minimum detected")
-    assert 2.0 < detected < TIME_LIMIT_S
-    assert run["contents"].topics["/events"][1] == len(events)
+    assert (events[0].time_s, events[0].kind) == (0.0, EventKind.RUN_STARTED)
+    assert events[0].text == "run started: paper_c_escape, planner vplane, seed 0"
+    detected = next(e for e in events if e.kind is EventKind.LOCAL_MINIMUM)
+    assert 2.0 < detected.time_s < TIME_LIMIT_S and detected.text == "local minimum detected"
+    started = next(e for e in events if e.kind is EventKind.ESCAPE_STARTED)
+    assert set(started.data) == {"e1", "e2", "objective"}  # the points, as numbers
+    logs = list(iter_messages(run["path"], ("/events",)))
+    assert [(m.log_time_ns, m.message.name, m.message.message) for m in logs] == [
+        (time_ns(e.time_s), str(e.kind), e.text) for e in events
+    ]
+    assert all(m.message.level == 2 for m in logs)  # INFO: no collision, nobody gave up
 
 
 def test_virtual_objective_deleted_after_the_escape(run):
     events = run["contents"].events
-    finished = next(t for t, _, text in events if text.startswith("objective reached"))
+    finished = next(e.time_s for e in events if e.kind is EventKind.ESCAPE_FINISHED)
     updates = list(iter_messages(run["path"], ("/virtual",)))
     times = [u.log_time_ns for u in updates]
     assert times == sorted(set(times))  # logged only when something changed
@@ -246,7 +249,7 @@ def test_an_odometry_run_logs_the_believed_pose_and_its_error(tmp_path):
     scenario = load_scenario("single_box", overrides)
     log = make_log(tmp_path / "odometry.mcap", scenario)
     result = run_scenario(scenario, observers=(log,))
-    log.close(result.summary)
+    log.close(result.summary.to_dict())
     beliefs = [m.message for m in iter_messages(tmp_path / "odometry.mcap", ("/robot/odometry",))]
     metrics = [m.message for m in iter_messages(tmp_path / "odometry.mcap", ("/metrics",))]
     assert len(beliefs) == len(result.times)
@@ -335,25 +338,29 @@ def test_every_channel_has_a_foxglove_schema_or_a_plain_json_schema(run):
     """Viewers refuse a JSON schema whose types are not plain (e.g. ["number", "null"])."""
     with open(run["path"], "rb") as stream:
         summary = make_reader(stream).get_summary()
+    json_topics = {"/metrics": METRICS_JSON_SCHEMA, "/run/events": EVENTS_JSON_SCHEMA}
     for channel in summary.channels.values():
         schema = summary.schemas[channel.schema_id]
-        if channel.topic == "/metrics":
+        if channel.topic in json_topics:
             assert (channel.message_encoding, schema.encoding) == ("json", "jsonschema")
             continue
         assert channel.message_encoding == schema.encoding == "protobuf", channel.topic
         assert schema.name == EXPECTED_SCHEMAS[channel.topic]
-    (metrics,) = [c for c in summary.channels.values() if c.topic == "/metrics"]
-    document = json.loads(summary.schemas[metrics.schema_id].data)
-    assert document == METRICS_JSON_SCHEMA and document["type"] == "object"
-    assert {spec["type"] for spec in document["properties"].values()} == {"number", "string"}
-    records = [m.message for m in iter_messages(run["path"], ("/metrics",))]
-    for record in records:
-        assert set(document["required"]) <= set(record) <= set(document["properties"])
-        for key, value in record.items():
-            if document["properties"][key]["type"] == "number":
-                assert type(value) in (int, float) and math.isfinite(value), (key, value)
-            else:
-                assert isinstance(value, str)
+    plain = {"number": (int, float), "string": (str,), "array": (list,)}
+    for topic, expected in json_topics.items():
+        (channel,) = [c for c in summary.channels.values() if c.topic == topic]
+        document = json.loads(summary.schemas[channel.schema_id].data)
+        assert document == expected and document["type"] == "object"
+        assert {spec["type"] for spec in document["properties"].values()} <= set(plain)
+        records = [m.message for m in iter_messages(run["path"], (topic,))]
+        assert records, topic
+        for record in records:
+            assert set(document["required"]) <= set(record) <= set(document["properties"])
+            for key, value in record.items():
+                spec = document["properties"][key]
+                assert isinstance(value, plain[spec["type"]]), (topic, key, value)
+                numbers = value if spec["type"] == "array" else [value] if spec["type"] == "number" else []
+                assert all(type(v) in (int, float) and math.isfinite(v) for v in numbers), (key, value)
 
 
 def test_truncated_file_keeps_its_complete_chunks(run, tmp_path):
@@ -383,7 +390,7 @@ _CHILD = textwrap.dedent(
     class Slow:  # keep the run going until it is killed
         def on_tick(self, tick):
             time.sleep(0.004)
-        def on_event(self, time_s, text):
+        def on_event(self, time_s, event):
             pass
 
     scenario = load_scenario("paper_c_escape", ["run.time_limit_s=300"])
@@ -424,19 +431,20 @@ def test_warning_levels_close_is_idempotent_and_ticks_after_close_are_ignored(tm
     scenario = load_scenario("paper_c_escape")
     path = tmp_path / "events.mcap"
     log = make_log(path, scenario)
-    log.on_event(0.5, "collision at (1.00, 2.00)")
-    log.on_event(1.0, "gave up after 3 escapes")
-    log.on_event(1.5, "escape started")
+    log.on_event(0.5, Event(EventKind.COLLISION, "collision at (1.00, 2.00)", {"point": (1.0, 2.0)}))
+    log.on_event(1.0, Event(EventKind.GAVE_UP, "gave up after 3 escapes"))
+    log.on_event(1.5, Event(EventKind.ESCAPE_STARTED, "escape started", {"objective": (3.0, 4.0)}))
     log.close({"outcome": "stuck", "value": np.float64(1.5), "gap": [math.nan, np.int64(2)]})
     log.close()
-    log.on_event(2.0, "ignored")
+    log.on_event(2.0, Event(EventKind.TIME_LIMIT, "ignored"))
     contents = read_log(path)
-    assert contents.events == [
-        (0.0, "INFO", "run started: paper_c_escape, planner vplane, seed 0"),
-        (0.5, "WARNING", "collision at (1.00, 2.00)"),
-        (1.0, "WARNING", "gave up after 3 escapes"),
-        (1.5, "INFO", "escape started"),
+    assert [(e.time_s, e.kind, e.text, e.data) for e in contents.events] == [
+        (0.5, EventKind.COLLISION, "collision at (1.00, 2.00)", {"point": (1.0, 2.0)}),
+        (1.0, EventKind.GAVE_UP, "gave up after 3 escapes", {}),
+        (1.5, EventKind.ESCAPE_STARTED, "escape started", {"objective": (3.0, 4.0)}),
     ]
+    levels = [m.message.level for m in iter_messages(path, ("/events",))]
+    assert levels == [3, 3, 2]  # WARNING, WARNING, INFO
     assert contents.summary == {"outcome": "stuck", "value": 1.5, "gap": [None, 2]}
     assert len(contents.times_ns) == 0 and contents.complete
 
@@ -466,9 +474,9 @@ def test_cylinders_no_border_and_a_planner_without_virtual_parts(scenario_from, 
     path = tmp_path / "apf.mcap"
     log = make_log(path, scenario)
     result = run_scenario(scenario, observers=(log,))
-    log.close(result.summary)
+    log.close(result.summary.to_dict())
     contents = read_log(path)
-    assert set(EXPECTED_SCHEMAS) | {"/metrics"} == set(contents.topics)
+    assert set(EXPECTED_SCHEMAS) | {"/metrics", "/run/events"} == set(contents.topics)
     assert contents.topics["/virtual"][1] == 1  # the empty update at time 0 only
     (world,) = iter_messages(path, ("/world",))
     entities = {entity.id: entity for entity in world.message.entities}

@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 from vplane_mj import shapes
 from vplane_mj.families import cup_case, rotated, trap_suite
+from vplane_mj.planning.events import EventKind
 from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim import run_scenario
 
@@ -24,8 +25,8 @@ class Events:
     def on_tick(self, tick):
         pass
 
-    def on_event(self, time_s, text):
-        self.events.append((time_s, text))
+    def on_event(self, time_s, event):
+        self.events.append((time_s, event))
 
 
 def inside_trap(scenario, positions):
@@ -40,17 +41,17 @@ def test_vplane_reaches_the_goal_in_the_paper_scenarios(shipped, name, planner):
     scenario = shipped(name, f"planner.name={planner}")
     summary = run_scenario(scenario).summary
     straight = math.dist(scenario.robot.start, scenario.robot.goal)
-    assert summary["outcome"] == "reached" and summary["success"], summary
-    assert summary["collisions"] == 0
-    assert straight - 0.2 < summary["path_length_m"] < 2.0 * straight
-    assert summary["min_clearance_m"] > 0.05
+    assert summary.outcome == "reached" and summary.success, summary
+    assert summary.collisions == 0
+    assert straight - 0.2 < summary.path_length_m < 2.0 * straight
+    assert summary.min_clearance_m > 0.05
 
 
 @pytest.mark.parametrize("name", ["paper_c_avoid", "paper_h_avoid"])
 def test_histogram_avoidance_passes_the_cup_without_entering(shipped, name):
     scenario = shipped(name)
     result = run_scenario(scenario)
-    assert result.summary["reached"] and result.summary["local_minima"] == 0
+    assert result.summary.reached and result.summary.local_minima == 0
     assert not inside_trap(scenario, result.positions).any()
     assert "avoiding" in result.modes
 
@@ -60,8 +61,8 @@ def test_after_the_escape_the_robot_never_reenters_the_trap(shipped, name):
     scenario = shipped(name)
     watcher = Events()
     result = run_scenario(scenario, observers=(watcher,))
-    assert result.summary["reached"] and result.summary["escapes"] >= 1
-    escaped_at = min(t for t, text in watcher.events if text.startswith("objective reached"))
+    assert result.summary.reached and result.summary.escapes >= 1
+    escaped_at = min(t for t, e in watcher.events if e.kind == EventKind.ESCAPE_FINISHED)
     before = result.times < escaped_at
     assert inside_trap(scenario, result.positions[before]).any()  # it was trapped
     assert not inside_trap(scenario, result.positions[~before]).any()  # and never went back
@@ -70,7 +71,7 @@ def test_after_the_escape_the_robot_never_reenters_the_trap(shipped, name):
 def _run_case(job):
     toml, name, planner = job
     summary = run_scenario(parse_scenario(toml, name, [f"planner.name={planner}"])).summary
-    return name, planner, summary["success"], summary["time_to_goal_s"], summary["path_length_m"]
+    return name, planner, summary.success, summary.time_to_goal_s, summary.path_length_m
 
 
 def test_trap_suite_vplane_succeeds_where_apf_is_trapped():
@@ -96,6 +97,6 @@ def test_a_rotated_trap_gives_the_same_outcome(angle):
     case = cup_case("u_front", 0.0)
     base = run_scenario(parse_scenario(case.toml(), "base.toml")).summary
     turned = run_scenario(parse_scenario(rotated(case, angle).toml(), "rotated.toml")).summary
-    assert base["success"] and turned["success"]
-    assert turned["escapes"] == base["escapes"]
-    assert turned["path_length_m"] == pytest.approx(base["path_length_m"], rel=0.2)
+    assert base.success and turned.success
+    assert turned.escapes == base.escapes
+    assert turned.path_length_m == pytest.approx(base.path_length_m, rel=0.2)

@@ -93,9 +93,9 @@ class _BrokenPlanner:
 def test_a_non_finite_planner_force_ends_the_run_as_error(shipped, monkeypatch):
     monkeypatch.setattr(sim, "make_planner", lambda *args: _BrokenPlanner())
     summary = sim.run_scenario(shipped("open_field")).summary
-    assert summary["outcome"] == "error" and not summary["reached"]
-    assert "non-finite force at t = 1.000 s" in summary["message"]
-    assert summary["sim_time_s"] == pytest.approx(1.0)
+    assert summary.outcome == "error" and not summary.reached
+    assert "non-finite force at t = 1.000 s" in summary.message
+    assert summary.sim_time_s == pytest.approx(1.0)
 
 
 def test_an_unstable_simulation_ends_as_error_with_mujocos_warning(shipped, monkeypatch, tmp_path):
@@ -108,7 +108,7 @@ def test_an_unstable_simulation_ends_as_error_with_mujocos_warning(shipped, monk
 
     monkeypatch.setattr(sim, "build_model", unstable)
     summary = sim.run_scenario(shipped("open_field")).summary
-    assert summary["outcome"] == "error"
-    assert summary["message"].startswith("MuJoCo warning at t = ")
-    assert "unstable" in summary["message"]
-    assert summary["sim_time_s"] < 0.1  # detected at the first control tick, not after the time limit
+    assert summary.outcome == "error"
+    assert summary.message.startswith("MuJoCo warning at t = ")
+    assert "unstable" in summary.message
+    assert summary.sim_time_s < 0.1  # detected at the first control tick, not after the time limit

@@ -18,8 +18,8 @@ from vplane_mj.sim import run_scenario
 )
 def test_peer_planner_succeeds(shipped, planner, scenario):
     summary = run_scenario(shipped(scenario, f"planner.name={planner}")).summary
-    assert summary["success"], summary["outcome"]
-    assert summary["path_ratio"] < 1.6
+    assert summary.success, summary.outcome
+    assert summary.path_ratio < 1.6
 
 
 @pytest.mark.parametrize(
@@ -32,8 +32,8 @@ def test_peer_planner_succeeds(shipped, planner, scenario):
 )
 def test_peer_planner_known_failures(shipped, planner, scenario, outcome):
     summary = run_scenario(shipped(scenario, f"planner.name={planner}", "run.time_limit_s=120")).summary
-    assert not summary["reached"] and summary["outcome"] == outcome
-    assert summary["local_minima"] >= 1
+    assert not summary.reached and summary.outcome == outcome
+    assert summary.local_minima >= 1
 
 
 def test_every_planner_is_documented_with_a_citation_and_parameters():

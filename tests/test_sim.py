@@ -5,7 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj.sim import TIMING_KEYS, barn_score, run_scenario
+from vplane_mj.metrics import barn_score
+from vplane_mj.sim import run_scenario
+from vplane_mj.summary import TIMING_KEYS
 
 OPEN = """
 format = 1
@@ -57,10 +59,10 @@ class Recorder:
 
 def test_robot_drives_straight_along_an_aligned_force(scenario_from):
     result = run_scenario(scenario_from(OPEN.format(yaw=0.0)))
-    assert result.summary["reached"]
+    assert result.summary.reached
     assert np.max(np.abs(result.positions[:, 1] - 1.5)) < 0.01
     # cruise speed is the controller's 0.5 m/s limit: 4 m in well under 12 s
-    assert result.summary["time_to_goal_s"] < 12.0
+    assert result.summary.time_to_goal_s < 12.0
 
 
 def test_robot_turns_in_place_toward_a_force_behind_it(scenario_from):
@@ -70,7 +72,7 @@ def test_robot_turns_in_place_toward_a_force_behind_it(scenario_from):
     turned = next(t for t in recorder.ticks if abs(t.yaw) <= math.radians(90))
     assert 0.3 < turned.time_s < 1.5  # 90 degrees at up to 2.5 rad/s
     assert np.hypot(*(turned.position - [1.0, 1.5])) < 0.03  # it turned on the spot
-    assert result.summary["reached"]
+    assert result.summary.reached
 
 
 @pytest.mark.parametrize("name", ["open_field", "single_box"])
@@ -78,20 +80,20 @@ def test_apf_reaches_the_goal_without_collision(shipped, name):
     scenario = shipped(name, "planner.name=apf")
     summary = run_scenario(scenario).summary
     straight = math.dist(scenario.robot.start, scenario.robot.goal) - scenario.robot.goal_tolerance
-    assert summary["outcome"] == "reached" and summary["success"]
-    assert summary["collisions"] == 0
-    assert straight - 0.01 <= summary["path_length_m"] <= 1.2 * straight
-    assert summary["min_clearance_m"] > 0.0
-    assert summary.keys() >= SUMMARY_KEYS
+    assert summary.outcome == "reached" and summary.success
+    assert summary.collisions == 0
+    assert straight - 0.01 <= summary.path_length_m <= 1.2 * straight
+    assert summary.min_clearance_m > 0.0
+    assert summary.to_dict().keys() >= SUMMARY_KEYS
 
 
 @pytest.mark.parametrize("name", ["paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape"])
 def test_apf_is_trapped_in_the_paper_scenarios(shipped, name):
     summary = run_scenario(shipped(name, "planner.name=apf")).summary
-    assert not summary["reached"]
-    assert summary["outcome"] == "stuck"
-    assert summary["local_minima"] >= 1
-    assert summary["final_distance_to_goal_m"] > 3.0
+    assert not summary.reached
+    assert summary.outcome == "stuck"
+    assert summary.local_minima >= 1
+    assert summary.final_distance_to_goal_m > 3.0
 
 
 def test_collisions_are_counted_as_separate_episodes(shipped):
@@ -99,43 +101,41 @@ def test_collisions_are_counted_as_separate_episodes(shipped):
     summary = run_scenario(
         shipped("single_box", "planner.name=apf", "planner.repulse_gain=0", "run.time_limit_s=20")
     ).summary
-    assert summary["collisions"] >= 1
-    assert not summary["success"]
-    assert summary["min_clearance_m"] < 0.0
+    assert summary.collisions >= 1
+    assert not summary.success
+    assert summary.min_clearance_m < 0.0
 
 
 def test_clearance_is_measured_against_the_contract_geometry(scenario_from):
     summary = run_scenario(scenario_from(OPEN.format(yaw=0.0))).summary
     # Driving along y = 1.5 in a 3 m high arena: the borders are 1.5 m from the centre.
     # The start is 1 m from the west border; the robot never gets closer than that.
-    assert summary["min_clearance_m"] == pytest.approx(1.0 - summary["robot_radius_m"], abs=1e-6)
+    assert summary.min_clearance_m == pytest.approx(1.0 - summary.robot_radius_m, abs=1e-6)
 
 
 def test_same_seed_gives_identical_summaries(shipped):
     scenario = shipped("paper_c_escape", "sensors.noise_std=0.02", "sensors.dropout=0.1")
     first = run_scenario(scenario)
     second = run_scenario(scenario)
-    for key in TIMING_KEYS:
-        first.summary.pop(key)
-        second.summary.pop(key)
-    assert first.summary == second.summary
+    assert first.summary.without_timing() == second.summary.without_timing()
+    assert TIMING_KEYS[0] in first.summary.to_dict()
     np.testing.assert_array_equal(first.positions, second.positions)
 
 
 def test_time_limit_ends_the_run(shipped):
     summary = run_scenario(shipped("open_field", "run.time_limit_s=2")).summary
-    assert summary["outcome"] == "timeout" and not summary["reached"]
-    assert summary["sim_time_s"] == pytest.approx(2.0, abs=0.06)
-    assert summary["time_to_goal_s"] is None
+    assert summary.outcome == "timeout" and not summary.reached
+    assert summary.sim_time_s == pytest.approx(2.0, abs=0.06)
+    assert summary.time_to_goal_s is None
 
 
 def test_motion_quality_metrics(shipped):
     straight = run_scenario(shipped("open_field", "planner.name=apf")).summary
     detour = run_scenario(shipped("paper_c_escape")).summary
-    assert straight["smoothness_rad_per_m"] < 0.05 and straight["oscillation_per_m"] < 1.0
-    assert detour["smoothness_rad_per_m"] > 5 * straight["smoothness_rad_per_m"]
-    assert detour["mean_clearance_m"] > detour["min_clearance_m"] > 0
-    assert 0 < detour["planner_cpu_ms_mean"] <= detour["planner_cpu_ms_max"]
+    assert straight.smoothness_rad_per_m < 0.05 and straight.oscillation_per_m < 1.0
+    assert detour.smoothness_rad_per_m > 5 * straight.smoothness_rad_per_m
+    assert detour.mean_clearance_m > detour.min_clearance_m > 0
+    assert 0 < detour.planner_cpu_ms_mean <= detour.planner_cpu_ms_max
 
 
 def test_barn_score_clips_the_time_between_two_and_eight_optimal_times():
@@ -149,10 +149,10 @@ def test_barn_score_clips_the_time_between_two_and_eight_optimal_times():
 
 def test_the_summary_scores_a_run_against_its_reference_path(shipped):
     reached = run_scenario(shipped("paper_c_escape")).summary
-    optimal_time = reached["optimal_length_m"] / 0.5
-    assert reached["success"]
-    expected = optimal_time / min(max(reached["time_to_goal_s"], 2 * optimal_time), 8 * optimal_time)
-    assert reached["score"] == pytest.approx(expected)
-    assert 0.125 <= reached["score"] <= 0.5
+    optimal_time = reached.optimal_length_m / 0.5
+    assert reached.success
+    expected = optimal_time / min(max(reached.time_to_goal_s, 2 * optimal_time), 8 * optimal_time)
+    assert reached.score == pytest.approx(expected)
+    assert 0.125 <= reached.score <= 0.5
     trapped = run_scenario(shipped("paper_c_escape", "planner.name=apf")).summary
-    assert trapped["score"] == 0.0
+    assert trapped.score == 0.0

@@ -8,7 +8,8 @@ import pytest
 from PIL import Image
 
 from vplane_mj.cli import main
-from vplane_mj.log_mcap import read_log
+from vplane_mj.log_read import read_log
+from vplane_mj.planning.events import EventKind
 from vplane_mj.timeline import timeline_from_log
 
 TIME_LIMIT_S = 6.0  # vplane detects the trap at 5.45 s: the escape starts on screen
@@ -94,7 +95,7 @@ def test_the_timeline_of_a_log(logged):
     assert len(timeline.times_s) == len(timeline.echoes) == len(timeline.forces) == ticks
     assert timeline.index_at(-1.0) == 0 and timeline.index_at(1e9) == ticks - 1
     assert timeline.times_s[timeline.index_at(2.0)] <= 2.0 < timeline.times_s[timeline.index_at(2.0) + 1]
-    escape = next(t for t, _, text in timeline.events if text.startswith("escape started"))
+    escape = next(e.time_s for e in timeline.events if e.kind is EventKind.ESCAPE_STARTED)
     for k, t in enumerate(timeline.times_s):
         # the objective exists from the escape on (until the final state); echoes lie within range
         assert (timeline.objectives[k] is not None) == (escape <= t < timeline.times_s[-1]), t

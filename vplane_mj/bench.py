@@ -116,7 +116,7 @@ def run_job(job: Job) -> dict:
     for x, y in (*result.positions, result.final_pose[:2]):
         path.add(x, y)
     track = [[round(x, 3), round(y, 3)] for x, y in path.polyline()]
-    return {"key": job.key, **result.summary, PATH_KEY: track}
+    return {"key": job.key, **result.summary.to_dict(), PATH_KEY: track}
 
 
 def read_journal(path: Path) -> dict[str, dict]:

@@ -18,6 +18,7 @@ from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
 
 if TYPE_CHECKING:
     from vplane_mj.scenario import Scenario
+    from vplane_mj.summary import RunSummary
 
 DEFAULT_OUT = Path("logs")
 EXIT_REACHED, EXIT_NOT_REACHED, EXIT_INVALID = 0, 1, 2
@@ -201,8 +202,9 @@ def _run(args: argparse.Namespace) -> int:
             log.close()
             log.path.unlink(missing_ok=True)
         raise
-    written = [_finish_log(log, mcap_path, result.summary)] if log else []
-    written.append(write_json(base.with_suffix(".json"), result.summary))
+    summary = result.summary
+    written = [_finish_log(log, mcap_path, summary.to_dict())] if log else []
+    written.append(write_json(base.with_suffix(".json"), summary.to_dict()))
     if not args.no_render:
         from vplane_mj.render import render_top_view, write_png
 
@@ -212,17 +214,17 @@ def _run(args: argparse.Namespace) -> int:
         from vplane_mj.video import write_video
 
         written.append(write_video(mcap_path, base.with_suffix(".mp4")))
-    print(_summary_line(scenario, result.summary))
+    print(_summary_line(scenario, summary))
     for path in written:
         print(f"wrote {path}")
-    return EXIT_REACHED if result.summary["reached"] else EXIT_NOT_REACHED
+    return EXIT_REACHED if summary.reached else EXIT_NOT_REACHED
 
 
 def _open_log(scenario: Scenario, target: Path):
     """An MCAP log written under a temporary name beside `target` (renamed when finished).
 
     A process killed outright leaves that `.partial` file: its flushed part (all but
-    about the last simulated second) is readable with `vplane_mj.log_mcap.read_log`.
+    about the last simulated second) is readable with `vplane_mj.log_read.read_log`.
     """
     from vplane_mj.log_mcap import McapLog
     from vplane_mj.robot import robot_radius_m
@@ -240,13 +242,13 @@ def _finish_log(log, target: Path, summary: dict | None) -> Path:
     return target
 
 
-def _summary_line(scenario: Scenario, s: dict) -> str:
-    clearance = "n/a" if s["min_clearance_m"] is None else f"{s['min_clearance_m']:.3f} m"
+def _summary_line(scenario: Scenario, s: RunSummary) -> str:
+    clearance = "n/a" if s.min_clearance_m is None else f"{s.min_clearance_m:.3f} m"
     return (
-        f"{scenario.name} [{s['planner']}, seed {s['seed']}]: {s['outcome']} after "
-        f"{s['sim_time_s']:.2f} s simulated, path {s['path_length_m']:.2f} m, "
-        f"collisions {s['collisions']}, min clearance {clearance}, "
-        f"local minima {s['local_minima']}, escapes {s['escapes']}, wall {s['wall_time_s']:.2f} s"
+        f"{scenario.name} [{s.planner}, seed {s.seed}]: {s.outcome} after "
+        f"{s.sim_time_s:.2f} s simulated, path {s.path_length_m:.2f} m, "
+        f"collisions {s.collisions}, min clearance {clearance}, "
+        f"local minima {s.local_minima}, escapes {s.escapes}, wall {s.wall_time_s:.2f} s"
     )
 
 

@@ -16,9 +16,11 @@ from matplotlib.collections import LineCollection
 from matplotlib.patches import Circle, Polygon
 
 from vplane_mj import shapes
-from vplane_mj.log_mcap import METADATA_NAME, LogContents, iter_messages
+from vplane_mj.log_mcap import METADATA_NAME
+from vplane_mj.log_read import LogContents, iter_messages
 from vplane_mj.planning import fields
 from vplane_mj.planning.apf import FIELD_PARAMS
+from vplane_mj.planning.events import EventKind
 from vplane_mj.planning.registry import planner_info
 from vplane_mj.render import MODE_RGBA, OTHER_MODE_RGBA, Track
 from vplane_mj.scenario import Scenario
@@ -65,7 +67,7 @@ def _draw_map(axes, contents: LogContents, scenario: Scenario, track: Track) -> 
     axes.plot(*scenario.robot.start, "o", color="green", ms=9, label="start")
     axes.add_patch(Circle(scenario.robot.goal, scenario.robot.goal_tolerance, color="gold", label="goal"))
     times = contents.times_ns / 1e9
-    minima = [t for t, _, text in contents.events if text.startswith("local minimum")]
+    minima = [e.time_s for e in contents.events if e.kind is EventKind.LOCAL_MINIMUM]
     for k, t in enumerate(minima):
         where = points[min(np.searchsorted(times, t), len(points) - 1)]
         axes.plot(*where, "X", color="black", ms=10, label="local minimum" if k == 0 else None)
@@ -101,7 +103,7 @@ def _draw_field(axes, contents: LogContents, scenario: Scenario) -> None:
     resolved = planner_info(scenario.planner).resolve(json.loads(info.get("planner_params", "{}")))
     params = {key: resolved.get(key, param.default) for key, param in FIELD_PARAMS.items()}
     times = contents.times_ns / 1e9
-    minima = [t for t, _, text in contents.events if text.startswith("local minimum")]
+    minima = [e.time_s for e in contents.events if e.kind is EventKind.LOCAL_MINIMUM]
     if minima:
         centre = contents.positions[min(np.searchsorted(times, minima[0]), len(times) - 1)]
         title = f"APF force at the local minimum, t = {minima[0]:.1f} s"

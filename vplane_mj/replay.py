@@ -1,26 +1,35 @@
-"""A run recomputed from its MCAP log alone: the scenario, the summary and the render's track."""
+"""A run recomputed from its MCAP log alone: the scenario, the summary and the render's track.
+
+The outcome and the counts come from the kinds of the logged events (`/run/events`), the
+path and clearance from the poses: no event text is parsed.
+"""
 
 from __future__ import annotations
 
 import math
-import re
 from pathlib import Path
 
 import numpy as np
 
 from vplane_mj import shapes
 from vplane_mj.errors import VPlaneError
-from vplane_mj.log_mcap import METADATA_NAME, LogContents, iter_messages, read_log
+from vplane_mj.log_mcap import METADATA_NAME
+from vplane_mj.log_read import LogContents, iter_messages, read_log
+from vplane_mj.planning.events import EventKind
 from vplane_mj.render import Track
 from vplane_mj.scenario import Scenario, parse_scenario
+from vplane_mj.summary import Outcome
 
-_POINT = r"\(([-0-9.]+), ([-0-9.]+)\)"
-_OUTCOME_EVENTS = (
-    ("goal reached", "reached"),
-    ("gave up", "stuck"),
-    ("time limit reached", "timeout"),
-    ("the simulation diverged", "error"),
-)
+ENDINGS: dict[EventKind, Outcome] = {
+    EventKind.GOAL_REACHED: Outcome.REACHED,
+    EventKind.TIME_LIMIT: Outcome.TIMEOUT,
+    EventKind.GAVE_UP: Outcome.STUCK,
+    EventKind.BELIEVED_ARRIVED: Outcome.STUCK,
+    EventKind.ERROR: Outcome.ERROR,
+}
+"""The event that ends a run, by kind, and the outcome it means (the run's last such event)."""
+INTERRUPTED = "interrupted"
+"""The recomputed outcome of a log that holds no ending (the run was stopped or killed)."""
 COMPARED_KEYS = (
     "outcome",
     "reached",
@@ -32,6 +41,7 @@ COMPARED_KEYS = (
     "min_clearance_m",
     "local_minima",
     "escapes",
+    "message",
 )
 """The summary keys that a log reproduces."""
 
@@ -49,6 +59,8 @@ def load_log(path: Path) -> tuple[LogContents, Scenario]:
         raise VPlaneError(f"{path}: no vplane-mj metadata (was it written by vplane-mj run?)")
     if len(contents.times_ns) == 0:
         raise VPlaneError(f"{path}: the log holds no robot pose")
+    if not contents.events:
+        raise VPlaneError(f"{path}: no /run/events (written by an older vplane-mj?)")
     return contents, parse_scenario(info["scenario_toml"], f"{path} (metadata)")
 
 
@@ -60,33 +72,33 @@ def summarize(contents: LogContents, scenario: Scenario) -> dict:
     """
     info = contents.metadata[METADATA_NAME]
     radius = float(info["robot_radius_m"])
-    texts = [(time_s, text) for time_s, _, text in contents.events]
-    outcome = next(
-        (label for prefix, label in _OUTCOME_EVENTS for _, text in texts if text.startswith(prefix)),
-        "timeout" if contents.complete else "interrupted",
-    )
-    reached_at = [t for t, text in texts if text.startswith("goal reached")]
-    collisions = sum(text.startswith("collision at") for _, text in texts)
+    events = contents.events
+    endings = [event for event in events if event.kind in ENDINGS]
+    ending = endings[-1] if endings else None
+    outcome = INTERRUPTED if ending is None else str(ENDINGS[ending.kind])
+    collisions = sum(event.kind is EventKind.COLLISION for event in events)
     steps = np.diff(contents.positions, axis=0)
     footprints = shapes.scene_footprints(
         scenario.world.obstacles, scenario.world.size if scenario.world.border else None
     )
     clearance = float(footprints.distance(contents.positions).min()) if len(footprints) else math.inf
+    reached = outcome == Outcome.REACHED
     return {
         "scenario": scenario.name,
         "planner": scenario.planner,
         "seed": scenario.run.seed,
         "outcome": outcome,
-        "reached": outcome == "reached",
-        "success": outcome == "reached" and collisions == 0,
-        "time_to_goal_s": reached_at[0] if reached_at else None,
+        "reached": reached,
+        "success": reached and collisions == 0,
+        "time_to_goal_s": ending.time_s if reached else None,
         "sim_time_s": contents.times_ns[-1] / 1e9,
         "path_length_m": float(np.sum(np.hypot(steps[:, 0], steps[:, 1]))),
         "collisions": collisions,
         "min_clearance_m": None if math.isinf(clearance) else clearance - radius,
-        "local_minima": sum(text.startswith("local minimum detected") for _, text in texts),
-        "escapes": sum(text.startswith("objective reached") for _, text in texts),
-        "events": [f"{t:8.2f} s  {text}" for t, text in texts],
+        "local_minima": sum(event.kind is EventKind.LOCAL_MINIMUM for event in events),
+        "escapes": sum(event.kind is EventKind.ESCAPE_FINISHED for event in events),
+        "message": "" if ending is None or outcome in (Outcome.REACHED, Outcome.TIMEOUT) else ending.text,
+        "events": [f"{event.time_s:8.2f} s  {event.text}" for event in events],
     }
 
 
@@ -106,14 +118,8 @@ def disagreements(recomputed: dict, stored: dict, tolerance_m: float = 0.01) -> 
 
 def track_from_log(path: Path, contents: LogContents) -> Track:
     """What a render shows, from the log: path, modes, final pose, virtual objects, collisions."""
-    objectives, planes, collisions = [], [], []
-    for _, _, text in contents.events:
-        if text.startswith("escape started"):
-            points = [(float(x), float(y)) for x, y in re.findall(_POINT, text)]
-            if len(points) == 3:  # e1, e2, objective
-                objectives.append(points[2])
-        elif text.startswith("collision at"):
-            collisions.extend((float(x), float(y)) for x, y in re.findall(_POINT, text))
+    objectives = [e.data["objective"] for e in contents.events if e.kind is EventKind.ESCAPE_STARTED]
+    collisions = [e.data["point"] for e in contents.events if e.kind is EventKind.COLLISION]
     planes = []
     for update in iter_messages(path, ("/virtual",)):
         for entity in update.message.entities:

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vplane_mj.log_mcap import LogContents, iter_messages
+from vplane_mj.log_read import LogContents, LoggedEvent, iter_messages
 
 FORCE_NAMES = ("attractive", "repulsive", "virtual", "total")
 """The `/forces` entities, drawn in this order."""
@@ -22,8 +22,8 @@ class Timeline:
     planner mode per tick; `echoes[k]` (M, 2) the sonar echoes of tick k in the world
     frame (m); `forces[k]` force name -> (x, y, dx, dy), the arrow as drawn in the log
     (m, 0.5 m per unit of force, at most 1.5 m); `objectives[k]` the virtual objective
-    (x, y) or None; `planes[k]` the virtual planes ((x1, y1), (x2, y2)); `events` (time_s,
-    level, text) in order.
+    (x, y) or None; `planes[k]` the virtual planes ((x1, y1), (x2, y2)); `events` the logged
+    events in order.
     """
 
     times_s: np.ndarray
@@ -33,7 +33,7 @@ class Timeline:
     forces: list[dict[str, tuple[float, float, float, float]]]
     objectives: list[tuple[float, float] | None]
     planes: list[list[tuple[tuple[float, float], tuple[float, float]]]]
-    events: list[tuple[float, str, str]]
+    events: list[LoggedEvent]
 
     def index_at(self, time_s: float) -> int:
         """The last tick at or before `time_s` (the first tick before the run starts)."""

@@ -307,7 +307,7 @@ class FrameCanvas:
     def _caption(self, time_s: float) -> str:
         """The latest events within the last CAPTION_HOLD_S of video."""
         since = time_s - CAPTION_HOLD_S * self.speed
-        recent = [text for t, _, text in self.timeline.events if since < t <= time_s]
+        recent = [e.text for e in self.timeline.events if since < e.time_s <= time_s]
         return "\n".join(recent[-CAPTION_LINES:])
 
 

@@ -54,13 +54,22 @@ class EventKind(StrEnum):
     """A MuJoCo warning, a non-finite state or force: the run ends as `error`."""
 
 
+EVENT_POINTS = ("point", "e1", "e2", "objective", "waypoint")
+"""The names an event's data may use, each a point (x, y) in metres (world frame)."""
+
+
 @dataclass(frozen=True)
 class Event:
-    """One event: its kind, a short text for people, and its numbers (points as (x, y) in m)."""
+    """One event: its kind, a short text for people, and its named points (x, y) in m."""
 
     kind: EventKind
     text: str
-    data: dict[str, object] = field(default_factory=dict)
+    data: dict[str, tuple[float, float]] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        unknown = set(self.data) - set(EVENT_POINTS)
+        if unknown:
+            raise ValueError(f"event data names {sorted(unknown)}: not among {EVENT_POINTS}")
 
     def __str__(self) -> str:
         return self.text
