@@ -5,6 +5,10 @@ several times; reported are the process's wall time (from launch to exit), the l
 wall time (the summary's `wall_time_s`) and their ratio, medians over the repeats. The
 first run of each scenario fills the reference-path cache and is not counted.
 
+Then the commands that simulate nothing, `vplane-mj check` of the first scenario and
+`vplane-mj list`, against the floor every command pays: Python starting and importing
+numpy. Their processes alternate with the floor's, so a busy machine slows all alike.
+
     python benchmarks/startup.py [SCENARIO ...] [--repeat 5]
 """
 
@@ -44,6 +48,31 @@ def one_run(scenario: str, out: Path) -> tuple[float, float]:
     return wall, summary.wall_time_s
 
 
+def process_wall(arguments: list[str]) -> float:
+    """Wall time (s) of one `python ARGUMENTS` process, from launch to exit."""
+    start = time.perf_counter()
+    subprocess.run([sys.executable, *arguments], check=True, capture_output=True)
+    return time.perf_counter() - start
+
+
+def command_table(scenario: str, repeat: int) -> None:
+    """check and list processes against Python with numpy, medians over `repeat` alternations."""
+    commands = {
+        "python -c 'import numpy'": ["-c", "import numpy"],
+        f"vplane-mj check {scenario}": ["-m", "vplane_mj", "check", scenario],
+        "vplane-mj list": ["-m", "vplane_mj", "list"],
+    }
+    walls: dict[str, list[float]] = {name: [] for name in commands}
+    for _ in range(repeat):
+        for name, arguments in commands.items():
+            walls[name].append(process_wall(arguments))
+    floor = statistics.median(walls["python -c 'import numpy'"])
+    print("\n| command | process wall s | / python with numpy |\n|---|---:|---:|")
+    for name in commands:
+        wall = statistics.median(walls[name])
+        print(f"| `{name}` | {wall:.3f} | {wall / floor:.2f} |")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scenarios", nargs="*", default=list(DEFAULT_SCENARIOS))
@@ -58,6 +87,7 @@ def main(argv: list[str] | None = None) -> int:
             wall, loop = statistics.median(walls), statistics.median(loops)
             print(f"| {scenario} | {wall:.3f} | {loop:.3f} | {wall / loop:.2f} |")
             sys.stdout.flush()
+    command_table(args.scenarios[0], args.repeat)
     return 0
 
 

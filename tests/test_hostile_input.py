@@ -1,8 +1,8 @@
 """Hostile input at the command line (fuzzed scenario files and --set overrides), extreme but
 valid worlds, and output directories that cannot be used.
 
-The fuzzed key paths come from the scenario module's own key tables and the planners' parameter
-tables, so keys added there are fuzzed without changing this file.
+The fuzzed key paths come from the scenario format's own key tables (`vplane_mj.scenario.keys`)
+and the planners' parameter tables, so keys added there are fuzzed without changing this file.
 """
 
 from __future__ import annotations
@@ -25,13 +25,12 @@ import tomli_w
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
-from vplane_mj import scenario as scn
 from vplane_mj.cli import main
 from vplane_mj.planning import registry
 from vplane_mj.planning.params import Param
 from vplane_mj.reference import shortest_path
 from vplane_mj.robot import robot_radius_m
-from vplane_mj.scenario import parse_scenario
+from vplane_mj.scenario import Field, keys, parse_scenario
 from vplane_mj.sim import run_scenario
 from vplane_mj.summary import RunSummary
 
@@ -71,7 +70,7 @@ def base_doc(kind: str | None = None, planner: str = registry.DEFAULT_PLANNER) -
     obstacles = [copy.deepcopy(BOX)]
     if kind is not None:
         second = {"kind": kind}
-        for key, field in scn._OBSTACLE_KINDS[kind].fields.items():
+        for key, field in keys.OBSTACLE_KINDS[kind].fields.items():
             if key in SECOND_OBSTACLE:
                 second[key] = copy.deepcopy(SECOND_OBSTACLE[key])
             elif field.required:
@@ -106,33 +105,33 @@ def key_path(path: tuple) -> str:
     return text
 
 
-KIND_FIELD = scn.Field("str", required=True)
+KIND_FIELD = Field("str", required=True)
 TABLE = "table"
 
 
 def section_fields(section: str) -> dict:
-    """The key table of a section (`_WORLD_FIELDS`, `_SENSOR_FIELDS`, ...); {} for `planner`."""
-    for name in (f"_{section.upper()}_FIELDS", f"_{section.upper().removesuffix('S')}_FIELDS"):
-        if hasattr(scn, name):
-            return getattr(scn, name)
+    """The key table of a section (`WORLD_FIELDS`, `SENSOR_FIELDS`, ...); {} for `planner`."""
+    for name in (f"{section.upper()}_FIELDS", f"{section.upper().removesuffix('S')}_FIELDS"):
+        if hasattr(keys, name):
+            return getattr(keys, name)
     return {}
 
 
 def slots(doc: dict) -> list[tuple[tuple, object]]:
     """Every key path of the scenario format that applies to `doc`, with its Field or Param."""
-    found: list[tuple[tuple, object]] = [((key,), field) for key, field in scn._TOP_FIELDS.items()]
-    found += [((section,), TABLE) for section in scn._SECTIONS]
-    for section in scn._SECTIONS:
+    found: list[tuple[tuple, object]] = [((key,), field) for key, field in keys.TOP_FIELDS.items()]
+    found += [((section,), TABLE) for section in keys.SECTIONS]
+    for section in keys.SECTIONS:
         found += [((section, key), field) for key, field in section_fields(section).items()]
     planner = doc.get("planner", {}).get("name", registry.DEFAULT_PLANNER)
-    found.append((("planner", "name"), scn.Field("str")))
+    found.append((("planner", "name"), Field("str")))
     if planner in registry.PLANNERS:
         found += [(("planner", key), p) for key, p in registry.planner_info(planner).params.items()]
     found.append((("world", "obstacles"), TABLE))
     for index, item in enumerate(doc["world"]["obstacles"]):
         found.append((("world", "obstacles", index), TABLE))
         found.append((("world", "obstacles", index, "kind"), KIND_FIELD))
-        kind = scn._OBSTACLE_KINDS[item["kind"]]
+        kind = keys.OBSTACLE_KINDS[item["kind"]]
         found += [(("world", "obstacles", index, key), field) for key, field in kind.fields.items()]
     return found
 
@@ -232,7 +231,7 @@ def valid_values(spec, path: tuple) -> st.SearchStrategy:
         if spec.integer:
             return st.integers(math.ceil(lo + (spec.gt is not None)), max(math.ceil(lo), math.floor(hi)))
         return _bounded_floats(lo, hi, spec.gt is not None, False)
-    if not isinstance(spec, scn.Field):
+    if not isinstance(spec, Field):
         return st.nothing()
     lower = spec.gt if spec.gt is not None else spec.ge
     upper = spec.lt if spec.lt is not None else spec.le
@@ -260,7 +259,7 @@ def valid_values(spec, path: tuple) -> st.SearchStrategy:
         if path == ("name",):
             return st.from_regex(r"[a-z0-9_]{1,20}", fullmatch=True)
         if path[-1] == "kind":
-            return st.sampled_from(sorted(scn._OBSTACLE_KINDS))
+            return st.sampled_from(sorted(keys.OBSTACLE_KINDS))
         if path == ("planner", "name"):
             return st.sampled_from(sorted(registry.PLANNERS))
         return st.text(max_size=30)
@@ -284,7 +283,7 @@ def extreme_values(spec, path: tuple) -> st.SearchStrategy:
         if spec.integer:
             edges = [int(e) for e in edges if float(e).is_integer()] + [2**62, -(2**62), 2**1000]
         return st.sampled_from(edges)
-    if not isinstance(spec, scn.Field):
+    if not isinstance(spec, Field):
         return st.nothing()
     edges = _edges(spec.gt, spec.ge, spec.lt, spec.le)
     if spec.kind == "number":
@@ -323,7 +322,7 @@ EXPENSIVE = {("run",), ("run", "time_limit_s"), ("run", "physics_dt_s"), ("run",
 @st.composite
 def mutated_docs(draw, for_run: bool) -> tuple[dict, list[str]]:
     """A base scenario after 1-3 mutations, and the key paths the mutations touched."""
-    kinds = [None, *sorted(scn._OBSTACLE_KINDS)]
+    kinds = [None, *sorted(keys.OBSTACLE_KINDS)]
     doc = base_doc(draw(st.sampled_from(kinds)), draw(st.sampled_from(sorted(registry.PLANNERS))))
     touched: list[str] = []
     candidates = [s for s in slots(doc) if not (for_run and s[0][:2] in EXPENSIVE)]

@@ -1,13 +1,21 @@
-"""Facts about the robot model in models/robot.xml that the rest of the code relies on."""
+"""Facts about the robot model in models/robot.xml that the rest of the code relies on.
+
+They are read from the XML itself (`vplane_mj.mjcf_reader`), not from a compiled model, so
+validating a scenario or listing the planners never loads MuJoCo; tests/test_robot.py
+checks them against the model MuJoCo compiles from the same file.
+"""
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
+from dataclasses import dataclass
+from pathlib import Path
 
-import mujoco
 import numpy as np
 
+from vplane_mj.mjcf_reader import MjcfReader, PosedGeom
 from vplane_mj.resources import model_path
 
 BASE_BODY = "base_link"
@@ -17,53 +25,77 @@ SONAR_MOUNT_HEIGHT_M = 0.07
 """Height of the sonar sites above base_link's origin: above the wheels (top at 0.04 m)."""
 SONAR_MOUNT_RADIUS_M = 0.10
 """Distance of the sonar sites from base_link's vertical axis."""
+RIM_SAMPLES = 73
+"""Points per rim circle of a cylinder when measuring the footprint (every 5 degrees)."""
+
+
+@dataclass(frozen=True)
+class RobotFacts:
+    """Wheel radius and track (m), each motor's torque limit (N m), footprint radius (m).
+
+    `radius_m` is the radius of the disc around base_link's centre that contains every
+    geom, rounded to 1e-9 m (the summary's `robot_radius_m`).
+    """
+
+    wheel_radius_m: float
+    track_m: float
+    torque_limit_nm: float
+    radius_m: float
+
+
+def read_robot_facts(path: Path) -> RobotFacts:
+    """The facts of the robot model in the MJCF file `path` (with the wheels and motors above)."""
+    reader = MjcfReader(path)
+    geoms = reader.geoms()
+    wheel = next((geom for geom in geoms if geom.name == WHEEL_JOINTS[0]), None)
+    forcerange = reader.numbers(reader.named("motor", WHEEL_MOTORS[0]), "forcerange")
+    if wheel is None or forcerange is None:
+        raise ValueError(f"{path}: no geom {WHEEL_JOINTS[0]!r} or no forcerange of motor {WHEEL_MOTORS[0]!r}")
+    left, right = (
+        reader.numbers(reader.named("body", name), "pos") or (0.0, 0.0, 0.0) for name in WHEEL_JOINTS
+    )
+    return RobotFacts(
+        wheel_radius_m=float(wheel.size[0]),
+        track_m=float(abs(left[1] - right[1])),
+        torque_limit_nm=float(forcerange[1]),
+        radius_m=round(footprint_radius(geoms, reader.body_position(BASE_BODY)[:2]), 9),
+    )
+
+
+def footprint_radius(geoms: list[PosedGeom], origin: np.ndarray) -> float:
+    """Largest horizontal distance (m) from `origin` (x, y) to any point of any geom.
+
+    Spheres count by their radius, cylinders by their two rim circles, boxes by their corners.
+    """
+    reach = 0.0
+    ring = np.linspace(0.0, 2 * math.pi, RIM_SAMPLES)
+    for geom in geoms:
+        if geom.type == "sphere":
+            reach = max(reach, float(np.hypot(*(geom.pos[:2] - origin))) + geom.size[0])
+            continue
+        if geom.type == "cylinder":
+            radius, half = geom.size[0], geom.size[1]
+            rim = np.column_stack((radius * np.cos(ring), radius * np.sin(ring)))
+            local = np.vstack([np.column_stack((rim, np.full(len(rim), z))) for z in (-half, half)])
+        else:
+            signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+            local = signs * np.asarray(geom.size[:3])
+        points = geom.pos + local @ geom.rot.T
+        reach = max(reach, float(np.max(np.hypot(*(points[:, :2] - origin).T))))
+    return reach
 
 
 @functools.cache
+def robot_facts() -> RobotFacts:
+    """The facts of the shipped robot, models/robot.xml."""
+    return read_robot_facts(model_path("robot.xml"))
+
+
 def robot_geometry() -> dict[str, float]:
-    """Wheel radius and track (m), torque limit (N m) and footprint radius, read from robot.xml."""
-    model = mujoco.MjModel.from_xml_path(str(model_path("robot.xml")))
-    wheel = model.geom("wheel_left")
-    left = model.body("wheel_left").pos
-    right = model.body("wheel_right").pos
-    return {
-        "wheel_radius_m": float(wheel.size[0]),
-        "track_m": float(abs(left[1] - right[1])),
-        "torque_limit_nm": float(model.actuator("wheel_left").forcerange[1]),
-        "radius_m": round(footprint_radius(model), 9),
-    }
+    """The shipped robot's facts by name: wheel_radius_m, track_m, torque_limit_nm, radius_m."""
+    return dataclasses.asdict(robot_facts())
 
 
 def robot_radius_m() -> float:
     """Radius (m) of a disc around base_link's centre that contains every robot geom."""
-    return robot_geometry()["radius_m"]
-
-
-def footprint_radius(model: mujoco.MjModel) -> float:
-    """Largest horizontal distance from the root body's axis to any point of any geom.
-
-    Computed in the robot's default pose from each geom's own shape: spheres by
-    their radius, cylinders by their two rim circles, boxes by their corners.
-    """
-    data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
-    origin = data.xpos[model.body(BASE_BODY).id][:2]
-    reach = 0.0
-    ring = np.linspace(0.0, 2 * math.pi, 73)
-    for g in range(model.ngeom):
-        if model.geom_bodyid[g] == 0:
-            continue
-        pos, rot, size = data.geom_xpos[g], data.geom_xmat[g].reshape(3, 3), model.geom_size[g]
-        gtype = model.geom_type[g]
-        if gtype == mujoco.mjtGeom.mjGEOM_SPHERE:
-            reach = max(reach, float(np.hypot(*(pos[:2] - origin))) + size[0])
-            continue
-        if gtype == mujoco.mjtGeom.mjGEOM_CYLINDER:
-            rim = np.column_stack((size[0] * np.cos(ring), size[0] * np.sin(ring)))
-            local = np.vstack([np.column_stack((rim, np.full(len(rim), z))) for z in (-size[1], size[1])])
-        else:
-            signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-            local = signs * size
-        points = pos + local @ rot.T
-        reach = max(reach, float(np.max(np.hypot(*(points[:, :2] - origin).T))))
-    return reach
+    return robot_facts().radius_m

@@ -22,7 +22,7 @@ from vplane_mj.robot import (
     SONAR_MOUNT_RADIUS_M,
     WHEEL_JOINTS,
     WHEEL_MOTORS,
-    robot_geometry,
+    robot_facts,
 )
 from vplane_mj.scenario import RobotSpec, Scenario, SensorSpec
 
@@ -197,7 +197,7 @@ def _apply_actuation_faults(robot: mujoco.MjSpec, spec: RobotSpec) -> None:
     for geom in robot.geoms:
         if geom.classname.name == "wheel":
             geom.friction[0] = spec.wheel_friction
-    limit = robot_geometry()["torque_limit_nm"]
+    limit = robot_facts().torque_limit_nm
     for motor_name, joint, gain, bias in zip(
         WHEEL_MOTORS, WHEEL_JOINTS, spec.motor_gain, spec.motor_bias_nm, strict=True
     ):

@@ -1,0 +1,156 @@
+"""Every key a scenario file may hold, as data: its type, bounds and where its value goes.
+
+The contract these tables encode is docs/interface.md section 1 (and the README's
+"Scenario files" for the further keys); `fields.py` is the engine that applies them.
+Lengths in metres, times in seconds, angles in degrees in the file (radians once read).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from vplane_mj.scenario.fields import Field, Invalid, join_key
+from vplane_mj.shapes import Box, Cup, Cylinder, HShape, Obstacle, Wall
+
+FORMAT = 1
+"""The only value of `format` this version reads."""
+
+NAME_PATTERN = re.compile(r"[a-z0-9_]+")
+"""What a scenario `name` must match in full (it names output files)."""
+MAX_NAME_LENGTH = 100
+"""The longest `name`: output files are `<name>-<planner>-<seed>.<ext>` (at most 255 bytes)."""
+MAX_ARENA_M = 150.0
+"""The largest side of the arena (m): the top camera that renders runs cannot see wider than 180 m."""
+MAX_NOISE_STD_M = 10.0
+"""The largest sonar noise (m): more is meaningless, and huge readings overflow the sonar map."""
+MIN_OBSTACLE_M, MAX_OBSTACLE_M = 0.001, 1000.0
+"""Obstacle sizes and thicknesses (m) lie in [MIN_OBSTACLE_M, MAX_OBSTACLE_M], coordinates within
++-MAX_OBSTACLE_M: beyond these a size or a thickness can vanish in floating point (MuJoCo rejects
+the geom) and distances overflow."""
+
+SECTIONS = ("world", "robot", "planner", "sensors", "run")
+"""The tables of a scenario file besides its top-level keys."""
+
+TOP_FIELDS = {
+    "format": Field("int", required=True),
+    "name": Field("str", required=True),
+    "description": Field("str"),
+}
+
+WORLD_FIELDS = {
+    "size": Field("point", required=True, gt=0, le=MAX_ARENA_M),
+    "border": Field("bool"),
+}
+
+ROBOT_FIELDS = {
+    "start": Field("point", required=True),
+    "start_yaw_deg": Field("number", attr="start_yaw", convert=math.radians),
+    "goal": Field("point", required=True),
+    "goal_tolerance": Field("number", gt=0),
+    "wheel_friction": Field("number", ge=0.01, le=5),
+    "motor_gain": Field("pair", gt=0, le=2),
+    "motor_bias_nm": Field("pair"),
+}
+
+SENSOR_FIELDS = {
+    "noise_std": Field("number", ge=0, le=MAX_NOISE_STD_M),
+    "dropout": Field("number", ge=0, lt=1),
+    "crosstalk": Field("number", ge=0, lt=1),
+    "dead": Field("ints", ge=0),
+    "pose": Field("str", choices=("truth", "odometry")),
+    "odometry_noise": Field("number", ge=0, le=1),
+    "count": Field("int", ge=4, le=128),
+    "rays_per_sonar": Field("int", ge=1, le=15),
+    "beam_deg": Field("number", gt=0, le=60),
+    "range_max": Field("number", gt=0.2, le=20),
+    "rate_hz": Field("number", gt=0, le=100),
+}
+
+RUN_FIELDS = {
+    "seed": Field("int", ge=0, lt=2**32),
+    "time_limit_s": Field("number", gt=0),
+    "physics_dt_s": Field("number", ge=0.0005, le=0.01),
+    "control_hz": Field("number", ge=1, le=200),  # one control tick is simulated whole
+}
+
+STRING = Field("str")
+"""Any string: an obstacle's `kind`, the planner's `name`."""
+_CENTER = Field("point", required=True, ge=-MAX_OBSTACLE_M, le=MAX_OBSTACLE_M)
+_LENGTH = Field("number", required=True, gt=0, ge=MIN_OBSTACLE_M, le=MAX_OBSTACLE_M)
+_YAW = Field("number", attr="yaw", convert=math.radians)
+_THICKNESS = Field("number", gt=0, ge=MIN_OBSTACLE_M, le=MAX_OBSTACLE_M)
+
+
+def _check_wall(wall: Wall, path: str) -> None:
+    """A wall needs a length: `from` and `to` differ."""
+    if wall.start == wall.end:
+        raise Invalid(join_key(path, "to"), "must differ from `from` (a wall needs a length)")
+
+
+def _check_thin_walls(width: float, along: float, along_key: str, thickness: float, path: str) -> None:
+    """u, c and h shapes: width > 2*thickness and depth/length > thickness."""
+    if not width > 2 * thickness:
+        reason = f"must be greater than 2*thickness ({2 * thickness:g}), got {width!r}"
+        raise Invalid(join_key(path, "width"), reason)
+    if not along > thickness:
+        reason = f"must be greater than thickness ({thickness:g}), got {along!r}"
+        raise Invalid(join_key(path, along_key), reason)
+
+
+def _check_cup(cup: Cup, path: str) -> None:
+    """A cup's arms and back wall must leave room inside."""
+    _check_thin_walls(cup.width, cup.depth, "depth", cup.thickness, path)
+
+
+def _check_h(shape: HShape, path: str) -> None:
+    """An H's posts and crossbar must leave room inside."""
+    _check_thin_walls(shape.width, shape.length, "length", shape.thickness, path)
+
+
+@dataclass(frozen=True)
+class ObstacleKind:
+    """An obstacle kind: its keys besides `kind`, the shape it builds, its extra rule."""
+
+    fields: Mapping[str, Field]
+    shape: Callable[..., Obstacle]
+    check: Callable[[Any, str], None] | None = None
+
+
+_BOX_FIELDS = {
+    "center": _CENTER,
+    "size": Field("point", required=True, gt=0, ge=MIN_OBSTACLE_M, le=MAX_OBSTACLE_M),
+    "yaw_deg": _YAW,
+}
+_WALL_FIELDS = {
+    "from": Field("point", required=True, ge=-MAX_OBSTACLE_M, le=MAX_OBSTACLE_M, attr="start"),
+    "to": Field("point", required=True, ge=-MAX_OBSTACLE_M, le=MAX_OBSTACLE_M, attr="end"),
+    "thickness": _THICKNESS,
+}
+_CYLINDER_FIELDS = {"center": _CENTER, "radius": _LENGTH}
+_CUP_FIELDS = {
+    "center": _CENTER,
+    "width": _LENGTH,
+    "depth": _LENGTH,
+    "yaw_deg": _YAW,
+    "thickness": _THICKNESS,
+}
+_H_FIELDS = {
+    "center": _CENTER,
+    "length": _LENGTH,
+    "width": _LENGTH,
+    "yaw_deg": _YAW,
+    "thickness": _THICKNESS,
+}
+
+OBSTACLE_KINDS: dict[str, ObstacleKind] = {
+    "box": ObstacleKind(_BOX_FIELDS, Box),
+    "wall": ObstacleKind(_WALL_FIELDS, Wall, _check_wall),
+    "cylinder": ObstacleKind(_CYLINDER_FIELDS, Cylinder),
+    "u": ObstacleKind(_CUP_FIELDS, Cup, _check_cup),
+    "c": ObstacleKind(_CUP_FIELDS, Cup, _check_cup),  # "c" is the contract's alias of "u"
+    "h": ObstacleKind(_H_FIELDS, HShape, _check_h),
+}

@@ -1,0 +1,73 @@
+"""TOML text -> a validated Scenario, or a ScenarioError naming the source, key and reason.
+
+The document is parsed, the `--set` overrides are applied, then every section is read
+(`sections.py`) and the start and goal placed (`placement.py`): the rules of
+docs/interface.md section 1, all checked before anything runs.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Sequence
+from types import MappingProxyType
+from typing import Any
+
+from vplane_mj.errors import ScenarioError
+from vplane_mj.scenario.fields import Invalid
+from vplane_mj.scenario.overrides import apply_override
+from vplane_mj.scenario.placement import check_placement
+from vplane_mj.scenario.sections import read_planner, read_robot, read_run, read_sensors, read_top, read_world
+from vplane_mj.scenario.spec import Scenario
+
+
+def _freeze(value: Any) -> Any:
+    """A read-only deep copy of a parsed TOML value: tables as mappingproxies, arrays as tuples."""
+    if isinstance(value, dict):
+        return MappingProxyType({key: _freeze(item) for key, item in value.items()})
+    if isinstance(value, list):
+        return tuple(_freeze(item) for item in value)
+    return value
+
+
+def _build_scenario(doc: dict[str, Any], source: str) -> Scenario:
+    """Validate a parsed document section by section, then the start and goal placement."""
+    top = read_top(doc)
+    world = read_world(doc)
+    robot = read_robot(doc)
+    planner, params = read_planner(doc)
+    scenario = Scenario(
+        name=top["name"],
+        description=top.get("description", ""),
+        source=source,
+        world=world,
+        robot=robot,
+        planner=planner,
+        planner_params=params,
+        sensors=read_sensors(doc),
+        run=read_run(doc),
+        raw=_freeze(doc),
+    )
+    check_placement(world, robot)
+    return scenario
+
+
+def _parse_toml(text: str, source: str) -> dict[str, Any]:
+    """The TOML document, or a ScenarioError quoting tomllib (line and column)."""
+    try:
+        return tomllib.loads(text)
+    except (ValueError, RecursionError) as exc:  # TOMLDecodeError, huge integers, deep nesting
+        raise ScenarioError(source, "", f"invalid TOML: {exc}") from None
+
+
+def parse_scenario(text: str, source: str, overrides: Sequence[str] = ()) -> Scenario:
+    """Parse TOML text, apply `--set KEY=VALUE` overrides, validate: a Scenario or ScenarioError."""
+    doc = _parse_toml(text, source)
+    try:
+        for override in overrides:
+            apply_override(doc, override)
+        return _build_scenario(doc, source)
+    except Invalid as exc:
+        raise ScenarioError(source, exc.key, exc.reason) from None
+    except Exception as exc:  # promised: no input ever escapes as anything but ScenarioError
+        reason = f"cannot be validated (internal error, please report it: {exc!r})"
+        raise ScenarioError(source, "", reason) from exc

@@ -1,0 +1,166 @@
+"""Each table of a scenario file read into its dataclass (docs/interface.md section 1).
+
+Besides each key's own rule (`keys.py`), a section checks what spans keys: the format
+and name, an obstacle's shape, the planner's parameters against its table, a motor bias
+within the torque limit of models/robot.xml, dead sonars within the ring, a control
+period of at least one physics step.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from types import MappingProxyType
+from typing import Any
+
+from vplane_mj.planning import registry
+from vplane_mj.planning.params import Param
+from vplane_mj.robot import robot_facts
+from vplane_mj.scenario.fields import (
+    Invalid,
+    checked,
+    is_finite,
+    is_number,
+    join_key,
+    read_fields,
+    sub_table,
+    type_name,
+)
+from vplane_mj.scenario.keys import (
+    FORMAT,
+    MAX_NAME_LENGTH,
+    NAME_PATTERN,
+    OBSTACLE_KINDS,
+    ROBOT_FIELDS,
+    RUN_FIELDS,
+    SECTIONS,
+    SENSOR_FIELDS,
+    STRING,
+    TOP_FIELDS,
+    WORLD_FIELDS,
+)
+from vplane_mj.scenario.spec import RobotSpec, RunSpec, SensorSpec, WorldSpec
+from vplane_mj.shapes import Obstacle
+
+
+def _check_format(doc: Mapping[str, Any]) -> None:
+    """`format` is present and exactly the integer 1."""
+    if "format" not in doc:
+        raise Invalid("format", f"missing required key (this version reads format = {FORMAT})")
+    value = doc["format"]
+    if type(value) is not int or value != FORMAT:
+        raise Invalid("format", f"must be {FORMAT}, got {value!r}")
+
+
+def read_top(doc: Mapping[str, Any]) -> dict[str, Any]:
+    """format, name and description, and no unknown top-level key."""
+    _check_format(doc)
+    top = read_fields(doc, "", TOP_FIELDS, extra=SECTIONS)
+    if not NAME_PATTERN.fullmatch(top["name"]):
+        raise Invalid("name", f"must match [a-z0-9_]+ (it names output files), got {top['name']!r}")
+    if len(top["name"]) > MAX_NAME_LENGTH:
+        length = len(top["name"])
+        raise Invalid("name", f"must be at most {MAX_NAME_LENGTH} characters (it names files), got {length}")
+    return top
+
+
+def _read_obstacle(item: Any, path: str) -> Obstacle:
+    """One `[[world.obstacles]]` table as a shapes dataclass."""
+    if not isinstance(item, dict):
+        raise Invalid(path, f"must be a table, got {type_name(item)}")
+    if "kind" not in item:
+        raise Invalid(join_key(path, "kind"), "missing required key")
+    kind_name = checked(item["kind"], STRING, join_key(path, "kind"))
+    kind = OBSTACLE_KINDS.get(kind_name)
+    if kind is None:
+        known = ", ".join(OBSTACLE_KINDS)
+        raise Invalid(join_key(path, "kind"), f"unknown obstacle kind {kind_name!r} (known: {known})")
+    shape = kind.shape(**read_fields(item, path, kind.fields, extra=("kind",)))
+    if kind.check:
+        kind.check(shape, path)
+    return shape
+
+
+def _read_obstacles(world: Mapping[str, Any]) -> tuple[Obstacle, ...]:
+    """All `[[world.obstacles]]`, in order."""
+    items = world.get("obstacles", [])
+    if not isinstance(items, list):
+        raise Invalid("world.obstacles", f"must be an array of tables, got {type_name(items)}")
+    return tuple(_read_obstacle(item, f"world.obstacles[{i}]") for i, item in enumerate(items))
+
+
+def read_world(doc: Mapping[str, Any]) -> WorldSpec:
+    """The `[world]` table."""
+    table = sub_table(doc, "world", required=True)
+    values = read_fields(table, "world", WORLD_FIELDS, extra=("obstacles",))
+    return WorldSpec(**values, obstacles=_read_obstacles(table))
+
+
+def _facing(start: tuple[float, float], goal: tuple[float, float]) -> float:
+    """The yaw (rad) that faces from `start` toward `goal`."""
+    return math.atan2(goal[1] - start[1], goal[0] - start[0])
+
+
+def read_robot(doc: Mapping[str, Any]) -> RobotSpec:
+    """The `[robot]` table, start_yaw resolved; a motor bias within the torque limit."""
+    values = read_fields(sub_table(doc, "robot", required=True), "robot", ROBOT_FIELDS)
+    values.setdefault("start_yaw", _facing(values["start"], values["goal"]))
+    limit = robot_facts().torque_limit_nm
+    for index, bias in enumerate(values.get("motor_bias_nm", ())):
+        if abs(bias) > limit:
+            reason = f"item {index}: must be within the motor's torque limit +-{limit:g} N m, got {bias!r}"
+            raise Invalid("robot.motor_bias_nm", reason)
+    return RobotSpec(**values)
+
+
+def _param_reason(param: Param, value: Any) -> str | None:
+    """Param.check, also for integers too large for a float."""
+    if is_number(value) and not is_finite(value):
+        return f"must be finite, got {value!r}"
+    return param.check(value)
+
+
+def read_planner(doc: Mapping[str, Any]) -> tuple[str, Mapping[str, float]]:
+    """The planner's name and the parameters the file gives (checked against its table)."""
+    table = sub_table(doc, "planner")
+    given = "name" in table
+    name = checked(table.get("name", registry.DEFAULT_PLANNER), STRING, "planner.name")
+    if name not in registry.PLANNERS:
+        default = "" if given else " (the default)"
+        known = ", ".join(sorted(registry.PLANNERS))
+        raise Invalid("planner.name", f"unknown planner {name!r}{default}; available: {known}")
+    info = registry.planner_info(name)
+    params = {}
+    for key, value in table.items():
+        if key == "name":
+            continue
+        if key not in info.params:
+            known = ", ".join(info.params)
+            raise Invalid(join_key("planner", key), f"not a parameter of planner {name!r} ({known})")
+        reason = _param_reason(info.params[key], value)
+        if reason:
+            raise Invalid(join_key("planner", key), reason)
+        params[key] = value if info.params[key].integer else float(value)
+    return name, MappingProxyType(params)
+
+
+def read_sensors(doc: Mapping[str, Any]) -> SensorSpec:
+    """The optional `[sensors]` table; dead sonars must exist in the ring."""
+    sensors = SensorSpec(**read_fields(sub_table(doc, "sensors"), "sensors", SENSOR_FIELDS))
+    for index, sonar in enumerate(sub_table(doc, "sensors").get("dead", [])):
+        if sonar >= sensors.count:
+            ring = f"a ring of count = {sensors.count} (0 to {sensors.count - 1})"
+            raise Invalid("sensors.dead", f"item {index}: no sonar {sonar} in {ring}")
+    return sensors
+
+
+def read_run(doc: Mapping[str, Any]) -> RunSpec:
+    """The optional `[run]` table; the control period must span at least one physics step."""
+    run = RunSpec(**read_fields(sub_table(doc, "run"), "run", RUN_FIELDS))
+    if 1.0 / run.control_hz < run.physics_dt_s:
+        reason = (
+            f"the control period 1/control_hz ({1.0 / run.control_hz:g} s) must be at least "
+            f"physics_dt_s ({run.physics_dt_s:g} s)"
+        )
+        raise Invalid("run.control_hz", reason)
+    return run

@@ -1,0 +1,95 @@
+"""A validated scenario as frozen dataclasses (the file format: docs/interface.md section 1).
+
+Units: metres and seconds; degrees in the file, radians here. Obstacles are the shapes of
+`vplane_mj.shapes`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import tomli_w
+
+from vplane_mj.shapes import Obstacle
+
+
+@dataclass(frozen=True)
+class WorldSpec:
+    """The free arena [0, W] x [0, H] (m), whether border walls surround it, the obstacles."""
+
+    size: tuple[float, float]
+    border: bool = True
+    obstacles: tuple[Obstacle, ...] = ()
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """Start and goal (m); start_yaw in radians, resolved (default: facing the goal).
+
+    Actuation faults: `wheel_friction` is the tyres' sliding friction coefficient (lower
+    lets the wheels slip); each motor (left, right) delivers `motor_gain` times the
+    commanded torque plus `motor_bias_nm` (N m).
+    """
+
+    start: tuple[float, float]
+    start_yaw: float
+    goal: tuple[float, float]
+    goal_tolerance: float = 0.15
+    wheel_friction: float = 1.0
+    motor_gain: tuple[float, float] = (1.0, 1.0)
+    motor_bias_nm: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class SensorSpec:
+    """The sonar ring: noise (m), dropout probability, layout, beam (deg), range (m), rate.
+
+    Sensor faults: `crosstalk` is the probability that a reading is a spurious short
+    echo, `dead` the indices of sonars that never echo. `pose` is where the planner's
+    pose comes from: "truth" (the simulator, an ideal localiser) or "odometry" (dead
+    reckoning from the wheel encoders, whose travel has relative noise `odometry_noise`).
+    """
+
+    noise_std: float = 0.0
+    dropout: float = 0.0
+    crosstalk: float = 0.0
+    dead: tuple[int, ...] = ()
+    pose: str = "truth"
+    odometry_noise: float = 0.0
+    count: int = 16
+    rays_per_sonar: int = 3
+    beam_deg: float = 20.0
+    range_max: float = 3.0
+    rate_hz: float = 20.0
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """Random seed, simulated time limit (s), physics step (s) and planner rate (Hz)."""
+
+    seed: int = 0
+    time_limit_s: float = 300.0
+    physics_dt_s: float = 0.002
+    control_hz: float = 20.0
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario. `raw` is the document as read, with overrides applied (read-only)."""
+
+    name: str
+    description: str
+    source: str
+    world: WorldSpec
+    robot: RobotSpec
+    planner: str
+    planner_params: Mapping[str, float]
+    sensors: SensorSpec
+    run: RunSpec
+    raw: Mapping[str, Any]
+
+    def to_toml(self) -> str:
+        """The resolved scenario as TOML text; parsing it back gives an equal Scenario."""
+        return tomli_w.dumps(self.raw)
