@@ -250,7 +250,7 @@ def wait_for_partial_log(tmp_path, process, seconds=60.0):
 
 
 @pytest.mark.parametrize("signum, status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
-def test_interrupted_run_closes_its_log_and_writes_nothing_else(tmp_path, signum, status):
+def test_interrupted_run_closes_its_log_and_writes_nothing_else(tmp_path, capsys, signum, status):
     process = start_long_run(tmp_path)
     wait_for_partial_log(tmp_path, process)
     process.send_signal(signum)
@@ -261,6 +261,10 @@ def test_interrupted_run_closes_its_log_and_writes_nothing_else(tmp_path, signum
     log = read_log(tmp_path / "paper_c_escape-apf-0.mcap")
     assert log.complete and len(log.times_ns) > 20
     assert np.all(np.diff(log.times_ns) > 0)
+    assert main(["summary", str(tmp_path / "paper_c_escape-apf-0.mcap")]) == 0
+    out = capsys.readouterr().out
+    assert json.loads(out[: out.index("\nevents:")])["outcome"] == "interrupted"
+    assert "the log holds no stored summary" in out
 
 
 def test_killed_run_leaves_a_recoverable_partial_log(tmp_path):
