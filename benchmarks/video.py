@@ -18,7 +18,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from vplane_mj.log_mcap import McapLog, read_log
+from vplane_mj.log_mcap import McapLog
+from vplane_mj.log_read import read_log
 from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim import run_scenario

@@ -47,7 +47,7 @@ planner and its parameters, package versions, time base, plus the caller's
 
 Crash safety: the writer is flushed (open chunk finished and written to disk) about
 once per simulated second, so a process killed with SIGKILL loses at most about the
-last second; `read_log` recovers every complete chunk of such a file (see there).
+last second; `vplane_mj.log_read.read_log` recovers every complete chunk of such a file.
 """
 
 from __future__ import annotations
