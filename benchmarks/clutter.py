@@ -10,7 +10,8 @@ so `OUT/bench.jsonl` journals them and the same command run again only does what
 
 Writes `OUT/clutter.csv` (per family and planner: runs, success rate, runs with a collision,
 timeouts, stuck, mean BARN score, median path ratio of the successes) and `OUT/clutter.png`
-(success and mean score per family, one bar per planner), and prints the table as Markdown.
+(success, mean score and median path ratio per planner and family, as annotated heatmaps),
+and prints the table as Markdown.
 
     python benchmarks/clutter.py [--jobs 2] [--barn 100] [--count 10] [--out logs/clutter]
     python benchmarks/clutter.py --barn 4 --count 2 --planners vplane,vplane_plus --out /tmp/clutter
@@ -24,6 +25,8 @@ import io
 import statistics
 import sys
 from pathlib import Path
+
+import numpy as np
 
 from vplane_mj.bench import plan_jobs, run_sweep
 from vplane_mj.errors import VPlaneError
@@ -119,35 +122,35 @@ def markdown(table: list[dict]) -> str:
 
 
 def plot(table: list[dict], path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """Success, mean BARN score and median path ratio per planner (rows) and family (columns)."""
+    from vplane_mj.bench_report import annotated_heatmap, plt
 
     families = list(dict.fromkeys(row["family"] for row in table))
     planners = list(dict.fromkeys(row["planner"] for row in table))
-    figure, axes = plt.subplots(1, 2, figsize=(13, 4.2))
-    width = 0.8 / len(planners)
-    for ax, key, label in (
-        (axes[0], "success_rate", "success rate"),
-        (axes[1], "mean_score", "mean BARN score"),
-    ):
-        for k, planner in enumerate(planners):
-            values = [
-                next(
-                    (row[key] or 0.0 for row in table if row["family"] == f and row["planner"] == planner),
-                    0.0,
-                )
-                for f in families
-            ]
-            ax.bar([i + k * width for i in range(len(families))], values, width, label=planner)
-        ax.set_xticks([i + width * (len(planners) - 1) / 2 for i in range(len(families))], families)
-        ax.set(ylabel=label, title=f"{label} per family")
-    axes[0].set_ylim(0, 1.05)
-    axes[1].set_ylim(0, 0.55)
-    axes[0].legend(fontsize=8, ncol=2)
+    cells = {(row["planner"], row["family"]): row for row in table}
+
+    def grid(key: str) -> np.ndarray:
+        return np.array(
+            [[_number(cells.get((p, f), {}).get(key)) for f in families] for p in planners], dtype=float
+        )
+
+    panels = (
+        ("success_rate", "success (reached, no collision)", lambda v: f"{100 * v:.0f}%", 0.0, 1.0, "RdYlGn"),
+        ("mean_score", "mean BARN score (0 to 0.5)", lambda v: f"{v:.2f}", 0.0, 0.5, "RdYlGn"),
+        ("median_path_ratio", "median path ratio of successes", lambda v: f"{v:.2f}", 1.0, 2.5, "RdYlGn_r"),
+    )
+    figure, axes = plt.subplots(3, 1, figsize=(2 + 0.95 * len(families), 3 * (0.8 + 0.34 * len(planners))))
+    for ax, (key, title, text, low, high, cmap) in zip(axes, panels, strict=True):
+        values = grid(key)
+        texts = np.array([[text(v) if np.isfinite(v) else "-" for v in row] for row in values], dtype=object)
+        annotated_heatmap(ax, values, texts, planners, families, fontsize=8, vmin=low, vmax=high, cmap=cmap)
+        ax.set_title(title, fontsize=10)
     figure.tight_layout()
     write_atomically(path, lambda tmp: figure.savefig(tmp, format="png", dpi=100))
+
+
+def _number(value: float | None) -> float:
+    return float("nan") if value is None else float(value)
 
 
 def main(argv: list[str] | None = None) -> int:

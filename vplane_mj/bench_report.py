@@ -77,24 +77,47 @@ def _cell_text(successes: int, runs: int) -> str:
 
 def _heatmap(axes, grid: SuccessGrid, transpose: bool, fontsize: float) -> None:
     """An annotated success heatmap, red (0%) to green (100%); planners across when transposed."""
-    rates, successes, runs = grid.rates, grid.successes, grid.runs
+    rates = grid.rates
+    texts = np.array(
+        [
+            [_cell_text(successes, runs) for successes, runs in zip(row_successes, row_runs, strict=True)]
+            for row_successes, row_runs in zip(grid.successes, grid.runs, strict=True)
+        ],
+        dtype=object,
+    ).reshape(rates.shape)
     if transpose:
-        rates, successes, runs = rates.T, successes.T, runs.T
-    rows, columns = (grid.columns, grid.planners) if transpose else (grid.planners, grid.columns)
-    axes.imshow(np.ma.masked_invalid(rates), cmap="RdYlGn", vmin=0, vmax=1, aspect="auto")
-    for i in range(len(rows)):
-        for j in range(len(columns)):
-            rate = rates[i, j]
-            colour = "black" if np.isnan(rate) or 0.25 < rate < 0.85 else "white"
-            text = _cell_text(successes[i, j], runs[i, j])
-            axes.text(j, i, text, ha="center", va="center", fontsize=fontsize, color=colour)
+        annotated_heatmap(axes, rates.T, texts.T, grid.columns, grid.planners, fontsize=fontsize)
+    else:
+        annotated_heatmap(axes, rates, texts, grid.planners, grid.columns, fontsize=fontsize, tilt=True)
+
+
+def annotated_heatmap(
+    axes,
+    values: np.ndarray,
+    texts: np.ndarray,
+    row_labels: list[str],
+    column_labels: list[str],
+    fontsize: float = 9,
+    vmin: float = 0.0,
+    vmax: float = 1.0,
+    cmap: str = "RdYlGn",
+    tilt: bool = False,
+) -> None:
+    """A heatmap of `values` (rows, columns; NaN left blank) with each cell's text written on it,
+    white on the dark ends of the colour map; column labels tilted when `tilt`."""
+    axes.imshow(np.ma.masked_invalid(values), cmap=cmap, vmin=vmin, vmax=vmax, aspect="auto")
+    for i in range(len(row_labels)):
+        for j in range(len(column_labels)):
+            level = (values[i, j] - vmin) / (vmax - vmin)
+            colour = "black" if np.isnan(level) or 0.25 < level < 0.85 else "white"
+            axes.text(j, i, texts[i, j], ha="center", va="center", fontsize=fontsize, color=colour)
     axes.set_xticks(
-        range(len(columns)), columns, rotation=0 if transpose else 30, ha="center" if transpose else "right"
+        range(len(column_labels)), column_labels, rotation=30 if tilt else 0, ha="right" if tilt else "center"
     )
-    axes.set_yticks(range(len(rows)), rows, fontsize=fontsize)
+    axes.set_yticks(range(len(row_labels)), row_labels, fontsize=fontsize)
     axes.tick_params(length=0)
-    axes.set_xticks(np.arange(len(columns) + 1) - 0.5, minor=True)
-    axes.set_yticks(np.arange(len(rows) + 1) - 0.5, minor=True)
+    axes.set_xticks(np.arange(len(column_labels) + 1) - 0.5, minor=True)
+    axes.set_yticks(np.arange(len(row_labels) + 1) - 0.5, minor=True)
     axes.grid(which="minor", color="white", linewidth=1.5)
     axes.tick_params(which="minor", length=0)
 
