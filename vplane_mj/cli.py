@@ -397,7 +397,8 @@ def _list(args: argparse.Namespace) -> int:
     for name, description in builtin_scenarios():
         print(f"  {name:<20} {description}")
     print("\nPlanners (parameters: default, unit, meaning):")
-    for name, (info, _) in sorted(PLANNERS.items()):
+    for name in sorted(PLANNERS):
+        info = PLANNERS[name].info()
         default = " (default)" if name == DEFAULT_PLANNER else ""
         print(f"  {name}{default}: {info.summary}")
         print(f"    after: {info.citation}")

@@ -14,13 +14,11 @@ from types import MappingProxyType
 from typing import Any
 
 from vplane_mj.planning import registry
-from vplane_mj.planning.params import Param
+from vplane_mj.planning.params import ParamError
 from vplane_mj.robot import robot_facts
 from vplane_mj.scenario.fields import (
     Invalid,
     checked,
-    is_finite,
-    is_number,
     join_key,
     read_fields,
     sub_table,
@@ -113,15 +111,8 @@ def read_robot(doc: Mapping[str, Any]) -> RobotSpec:
     return RobotSpec(**values)
 
 
-def _param_reason(param: Param, value: Any) -> str | None:
-    """Param.check, also for integers too large for a float."""
-    if is_number(value) and not is_finite(value):
-        return f"must be finite, got {value!r}"
-    return param.check(value)
-
-
 def read_planner(doc: Mapping[str, Any]) -> tuple[str, Mapping[str, float]]:
-    """The planner's name and the parameters the file gives (checked against its table)."""
+    """The planner's name and the parameters the file gives (checked against its dataclass)."""
     table = sub_table(doc, "planner")
     given = "name" in table
     name = checked(table.get("name", registry.DEFAULT_PLANNER), STRING, "planner.name")
@@ -129,18 +120,11 @@ def read_planner(doc: Mapping[str, Any]) -> tuple[str, Mapping[str, float]]:
         default = "" if given else " (the default)"
         known = ", ".join(sorted(registry.PLANNERS))
         raise Invalid("planner.name", f"unknown planner {name!r}{default}; available: {known}")
-    info = registry.planner_info(name)
-    params = {}
-    for key, value in table.items():
-        if key == "name":
-            continue
-        if key not in info.params:
-            known = ", ".join(info.params)
-            raise Invalid(join_key("planner", key), f"not a parameter of planner {name!r} ({known})")
-        reason = _param_reason(info.params[key], value)
-        if reason:
-            raise Invalid(join_key("planner", key), reason)
-        params[key] = value if info.params[key].integer else float(value)
+    overrides = {key: value for key, value in table.items() if key != "name"}
+    try:
+        params = registry.PLANNERS[name].Params.checked(overrides, name)
+    except ParamError as exc:
+        raise Invalid(join_key("planner", exc.key), exc.reason) from None
     return name, MappingProxyType(params)
 
 
