@@ -1,16 +1,25 @@
 """The planners a scenario can name, by name, each a `Planner` class.
 
-A planner's module is imported when the planner is first looked up, not before: a run loads
-only the planner it uses (some need scipy, whose import costs more than a short run's loop).
+Three kinds: the built-in planners; the installed entry points of the group
+`vplane_mj.planners` (`name = "module:Class"`), listed from the installed packages' metadata
+without importing anything until the planner is used; and the classes registered in this
+process (`register_planner`, `load_planner`, or `--planner module:Class` on the command line).
+A module is imported when its planner is first looked up, not before: a run loads only the
+planner it uses (some need scipy, whose import costs more than a short run's loop).
 """
 
 from __future__ import annotations
 
 import importlib
 from collections.abc import Iterator, Mapping
+from typing import TYPE_CHECKING
 
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.params import PlannerInfo
+from vplane_mj.planning.plugins import PlannerError, canonical_spec, import_planner, planner_problem
+
+if TYPE_CHECKING:
+    from importlib.metadata import EntryPoint
 
 BUILT_IN: dict[str, tuple[str, str]] = {
     "apf": ("apf", "ApfPlanner"),
@@ -23,33 +32,121 @@ BUILT_IN: dict[str, tuple[str, str]] = {
 }
 """Planner name: (its module in vplane_mj.planning, its class)."""
 
+ENTRY_POINT_GROUP = "vplane_mj.planners"
+"""The entry point group of installed planners: `name = "module:Class"`."""
+
+
+def _qualified(cls: type) -> str:
+    return f"{cls.__module__}:{cls.__qualname__}"
+
 
 class _Planners(Mapping[str, type[Planner]]):
-    """Planner name -> class, each module imported on first use."""
+    """Planner name -> class: built-in, installed and registered ones, each imported on first use."""
 
     def __init__(self) -> None:
-        self._loaded: dict[str, type[Planner]] = {}
+        self._classes: dict[str, type[Planner]] = {}
+        self._registered: list[str] = []
+        self._specs: dict[str, type[Planner]] = {}
+        self._installed: dict[str, EntryPoint] | None = None
+
+    def installed(self) -> dict[str, EntryPoint]:
+        """The entry points of ENTRY_POINT_GROUP by name (read once; nothing is imported). An
+        entry point with a built-in planner's name is left out: the built-in planner keeps it."""
+        if self._installed is None:
+            from importlib.metadata import entry_points
+
+            found = entry_points(group=ENTRY_POINT_GROUP)
+            self._installed = {ep.name: ep for ep in found if ep.name not in BUILT_IN}
+        return self._installed
 
     def __getitem__(self, name: str) -> type[Planner]:
-        if name not in self._loaded:
-            module_name, class_name = BUILT_IN[name]
-            module = importlib.import_module(f"vplane_mj.planning.{module_name}")
-            self._loaded[name] = getattr(module, class_name)
-        return self._loaded[name]
+        cls = self._classes.get(name)
+        if cls is None:
+            if name in BUILT_IN:
+                module_name, class_name = BUILT_IN[name]
+                module = importlib.import_module(f"vplane_mj.planning.{module_name}")
+                cls = getattr(module, class_name)
+            elif isinstance(name, str) and name in self.installed():
+                cls = _load_entry_point(self.installed()[name])
+            else:
+                raise KeyError(name)
+            self._classes[name] = cls
+        return cls
 
     def __contains__(self, name: object) -> bool:
-        return name in BUILT_IN
+        return (
+            name in BUILT_IN or name in self._classes or (isinstance(name, str) and name in self.installed())
+        )
 
     def __iter__(self) -> Iterator[str]:
-        return iter(BUILT_IN)
+        return iter(dict.fromkeys([*BUILT_IN, *sorted(self.installed()), *self._registered]))
 
     def __len__(self) -> int:
-        return len(BUILT_IN)
+        return sum(1 for _ in self)
+
+    def register(self, cls: type[Planner], source: str | None = None) -> type[Planner]:
+        """Make `cls` a planner that scenarios can name by `cls.name` (PlannerError if it cannot
+        be; the message names `source`, by default the class)."""
+        where = source or getattr(cls, "__qualname__", repr(cls))
+        problem = planner_problem(cls)
+        if problem:
+            raise PlannerError(f"{where}: {problem}")
+        name = cls.name
+        if name in BUILT_IN:
+            raise PlannerError(f"{where}: its name {name!r} is a built-in planner's")
+        known = self._classes.get(name)
+        if known is cls:
+            return cls
+        if known is not None:
+            raise PlannerError(f"{where}: the name {name!r} is taken by {_qualified(known)}")
+        entry_point = self.installed().get(name)
+        if entry_point is not None and entry_point.value != _qualified(cls):
+            taken = f"the installed planner {name} = {entry_point.value}"
+            raise PlannerError(f"{where}: the name {name!r} is taken by {taken}")
+        self._classes[name] = cls
+        self._registered.append(name)
+        return cls
+
+    def load(self, spec: str) -> type[Planner]:
+        """Import, check and register the class an import spec names, once per process."""
+        key = canonical_spec(spec)
+        cls = self._specs.get(key)
+        if cls is None:
+            cls = self.register(import_planner(spec), source=spec)
+            self._specs[key] = cls
+        return cls
 
 
-PLANNERS: Mapping[str, type[Planner]] = _Planners()
+def _load_entry_point(entry_point: EntryPoint) -> type[Planner]:
+    """The class an installed entry point names, imported and checked."""
+    where = f"installed planner {entry_point.name} = {entry_point.value}"
+    try:
+        cls = entry_point.load()
+    except Exception as exc:  # anything the installed module raises on import
+        raise PlannerError(f"{where}: cannot import it: {type(exc).__name__}: {exc}") from exc
+    problem = planner_problem(cls)
+    if problem:
+        raise PlannerError(f"{where}: {problem}")
+    if cls.name != entry_point.name:
+        raise PlannerError(f"{where}: the class's name is {cls.name!r}, not the entry point's")
+    return cls
+
+
+PLANNERS = _Planners()
 
 DEFAULT_PLANNER = "vplane"
+
+
+def register_planner(cls: type[Planner]) -> type[Planner]:
+    """Register a planner class under its `name` in this process (also as a class decorator);
+    PlannerError when it is not a valid planner or its name is taken."""
+    return PLANNERS.register(cls)
+
+
+def load_planner(spec: str) -> type[Planner]:
+    """Import and register the planner class `module:Class` or `path/to/file.py:Class` names
+    (the module looked up as `python -m` would, the current directory first)."""
+    return PLANNERS.load(spec)
 
 
 def planner_info(name: str) -> PlannerInfo:
