@@ -23,8 +23,8 @@ from collections.abc import Callable
 import numpy as np
 
 from vplane_mj.families import random_barn
-from vplane_mj.planning.localmap import LocalMap
-from vplane_mj.planning.registry import PLANNERS, make_planner, planner_info
+from vplane_mj.planning.groups import LocalMapParams
+from vplane_mj.planning.registry import PLANNERS, make_planner
 from vplane_mj.planning.types import Observation
 from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import load_scenario, parse_scenario
@@ -75,9 +75,9 @@ def scenarios(names: list[str], driver: str):
     ]
 
 
-def map_only(params: dict) -> Callable[[Observation], None]:
+def map_only(params: LocalMapParams) -> Callable[[Observation], None]:
     """One tick of the sonar map alone, as vfh, vplane and dwa update it."""
-    grid = LocalMap(params["map_cell_m"], params["map_size_m"])
+    grid = params.local_map()
     return lambda obs: grid.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
 
 
@@ -87,7 +87,7 @@ def per_tick_ms(planners: list[str], observations: list[Observation], repeat: in
     for _ in range(repeat):
         for name in times:
             if name == "map":
-                step = map_only(planner_info("vfh").resolve({}))
+                step = map_only(LocalMapParams())
             else:
                 step = make_planner(name, {}, robot_radius_m()).step
             start = time.process_time()

@@ -60,14 +60,14 @@ def histogram_figure(path: Path) -> None:
         decision, obs = observe(planner, (2.1 + 0.025 * k, 5.0), k * 0.05)
         if decision.mode == "avoiding":
             break
-    cells, certainty = planner.map.cells(planner.params["map_threshold"])
+    cells, certainty = planner.map.cells(planner.params.map_threshold)
     h = histogram.polar_histogram(
         obs.position,
         cells,
         certainty,
         planner.n_sectors,
-        planner.params["window_m"],
-        RADIUS + planner.params["clearance_m"],
+        planner.params.window_m,
+        RADIUS + planner.params.clearance_m,
     )
     fig = plt.figure(figsize=(11, 4.5))
     ax = fig.add_subplot(1, 2, 1)
@@ -84,7 +84,7 @@ def histogram_figure(path: Path) -> None:
     polar = fig.add_subplot(1, 2, 2, projection="polar")
     sector = 2 * math.pi / planner.n_sectors
     angles = (np.arange(planner.n_sectors) + 0.5) * sector
-    blocked = h > planner.params["histogram_threshold"]
+    blocked = h > planner.params.histogram_threshold
     polar.bar(angles, np.log1p(h), width=sector, color=np.where(blocked, "#b03a2e", "#7dcea0"))
     polar.set_title("polar histogram (log density; red: blocked)", fontsize=10)
     fig.tight_layout()

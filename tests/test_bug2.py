@@ -9,6 +9,7 @@ from vplane_mj import shapes, synthetic
 from vplane_mj.control import ControllerGains, heading_command
 from vplane_mj.planning import bug2
 from vplane_mj.planning.types import Observation
+from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim import run_scenario
 
@@ -23,7 +24,7 @@ INFO_KEYS = {"hit_distance_m", "wall_distance_m", "mline_tolerance_m", "max_foll
 
 
 def planner(**overrides) -> bug2.Bug2Planner:
-    return bug2.Bug2Planner(bug2.INFO.resolve(overrides))
+    return bug2.Bug2Planner.build(overrides, robot_radius_m())
 
 
 def observe(footprints, position, yaw, goal, time_s=0.0) -> Observation:
@@ -53,10 +54,11 @@ def drive(footprints, start, goal, seconds, plan=None, dt=0.05):
 
 
 def test_params_have_defaults_units_and_docs():
-    assert set(bug2.INFO.params) >= INFO_KEYS
-    for param in bug2.INFO.params.values():
+    info = bug2.Bug2Planner.info()
+    assert set(info.params) >= INFO_KEYS
+    for param in info.params.values():
         assert param.doc and param.check(param.default) is None
-    assert bug2.INFO.name == "bug2" and "Lumelsky" in bug2.INFO.citation
+    assert info.name == "bug2" and "Lumelsky" in info.citation
 
 
 def test_goes_to_goal_in_the_open_and_follows_near_a_wall():

@@ -22,7 +22,7 @@ GOAL_FAR = np.array([6.0, 0.0])
 
 
 def planner(**overrides):
-    return dwa.DwaPlanner(dwa.INFO.resolve(overrides), RADIUS)
+    return dwa.DwaPlanner.build(overrides, RADIUS)
 
 
 def observe(footprints, time_s, position, yaw, goal=GOAL_FAR):
@@ -75,11 +75,11 @@ def test_the_force_maps_back_to_the_command_through_the_heading_controller(yaw):
 def test_the_window_holds_the_commands_reachable_in_one_period(
     speed, turn, slowest, fastest, leftmost, rightmost
 ):
-    params = dwa.INFO.resolve({})  # 4 m/s^2 and 30 rad/s^2: +-0.2 m/s and +-1.5 rad/s in 0.05 s
+    params = dwa.DwaParams()  # 4 m/s^2 and 30 rad/s^2: +-0.2 m/s and +-1.5 rad/s in 0.05 s
     speeds, turns = dwa.dynamic_window(speed, turn, PERIOD, params)
     assert (speeds[0], speeds[-1]) == pytest.approx((slowest, fastest))
     assert (turns[0], turns[-1]) == pytest.approx((leftmost, rightmost))
-    assert len(speeds) == params["speed_samples"] and len(turns) == params["turn_samples"]
+    assert len(speeds) == params.speed_samples and len(turns) == params.turn_samples
 
 
 def test_each_command_is_reachable_from_the_velocity_of_the_last_period():
@@ -127,7 +127,7 @@ def test_an_arc_into_a_wall_is_not_chosen():
     v, omega = command(decision, 0.0)
     assert v > 0.0 and abs(omega) > 1.0
     chosen = ground_truth_free_length(wall, position, 0.0, v, omega)
-    assert chosen > straight and v * PERIOD + v * v / (2 * dwa_planner.params["accel_mps2"]) < chosen
+    assert chosen > straight and v * PERIOD + v * v / (2 * dwa_planner.params.accel_mps2) < chosen
 
 
 POCKET = shapes.Footprints(

@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 
 from vplane_mj import control, sim
 from vplane_mj.planning import fields, registry
+from vplane_mj.planning.params import PlannerParams
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.planning.vplane_geometry import escape_direction, make_plane, plane_force, virtual_objective
 from vplane_mj.robot import robot_radius_m
@@ -83,7 +84,7 @@ class _BrokenPlanner:
     """A planner whose force turns to NaN after a second of driving toward the goal."""
 
     def __init__(self):
-        self.params = {}
+        self.params = PlannerParams()
 
     def step(self, obs):
         direction = (obs.goal - obs.position) / max(obs.distance_to_goal(), 1e-9)

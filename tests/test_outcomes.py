@@ -11,6 +11,7 @@ import pytest
 
 from vplane_mj import sim
 from vplane_mj.cli import main
+from vplane_mj.planning.params import PlannerParams
 from vplane_mj.planning.types import Decision
 from vplane_mj.world import build_model
 
@@ -21,7 +22,7 @@ class _NaNAfterOneSecond:
     """A planner that drives toward the goal, then returns a non-finite force after 1 s."""
 
     def __init__(self):
-        self.params = {}
+        self.params = PlannerParams()
 
     def step(self, obs):
         direction = (obs.goal - obs.position) / max(obs.distance_to_goal(), 1e-9)

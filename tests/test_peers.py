@@ -37,6 +37,7 @@ def test_peer_planner_known_failures(shipped, planner, scenario, outcome):
 
 
 def test_every_planner_is_documented_with_a_citation_and_parameters():
-    for name, (info, _) in PLANNERS.items():
+    for name, planner in PLANNERS.items():
+        info = planner.info()
         assert info.name == name and info.citation and info.summary
         assert all(p.unit is not None and p.doc for p in info.params.values())

@@ -122,5 +122,5 @@ def test_planner_never_returns_non_finite_forces():
 @pytest.mark.parametrize("name", ["apf", "vplane"])
 def test_planner_parameters_resolve_with_defaults(name):
     planner = make_planner(name, {"influence": 0.5}, RADIUS)
-    assert planner.params["influence"] == 0.5
-    assert planner.params["attract_gain"] == 0.5
+    assert planner.params.influence == 0.5
+    assert planner.params.attract_gain == 0.5

@@ -50,12 +50,18 @@ TABLE_COLUMNS = (
 
 @dataclass(frozen=True)
 class Job:
-    """One run of a sweep: the resolved scenario text and where it came from."""
+    """One run of a sweep: the resolved scenario text and where it came from.
+
+    `planner_imports` are the planner classes the user named by import spec (`module:Class`,
+    `/abs/path/file.py:Class`): a worker registers them before it reads the scenario. They are
+    not part of the key: a run is the same run whichever way its planner was found.
+    """
 
     scenario: str
     planner: str
     seed: int
     toml: str
+    planner_imports: tuple[str, ...] = ()
 
     @property
     def key(self) -> str:
@@ -86,15 +92,20 @@ def parse_seeds(text: str) -> list[int]:
 
 
 def plan_jobs(
-    scenarios: Iterable[str], planners: Iterable[str], seeds: Iterable[int], overrides: Iterable[str] = ()
+    scenarios: Iterable[str],
+    planners: Iterable[str],
+    seeds: Iterable[int],
+    overrides: Iterable[str] = (),
+    planner_imports: tuple[str, ...] = (),
 ) -> list[Job]:
-    """Every combination, with `--set` style overrides, each validated as `vplane-mj run` would."""
+    """Every combination, with `--set` style overrides, each validated as `vplane-mj run` would;
+    `planner_imports` (already registered here) go with every job to its worker."""
     jobs = []
     for ref in scenarios:
         for planner in planners:
             for seed in seeds:
                 scenario = load_scenario(ref, [*overrides, f"planner.name={planner}", f"run.seed={seed}"])
-                jobs.append(Job(scenario.name, planner, seed, scenario.to_toml()))
+                jobs.append(Job(scenario.name, planner, seed, scenario.to_toml(), planner_imports))
     return jobs
 
 
@@ -107,10 +118,13 @@ PATH_TOLERANCE_M = 0.02
 def run_job(job: Job) -> dict:
     """Run one job (in a worker process): its summary, the job's key and, under PATH_KEY,
     the travelled path simplified to PATH_TOLERANCE_M (for the report's picture of it)."""
+    from vplane_mj.planning.registry import load_planner
     from vplane_mj.polyline import PathSimplifier
     from vplane_mj.scenario import parse_scenario
     from vplane_mj.sim import run_scenario
 
+    for spec in job.planner_imports:
+        load_planner(spec)
     result = run_scenario(parse_scenario(job.toml, f"{job.scenario} (bench)"))
     path = PathSimplifier(PATH_TOLERANCE_M)
     for x, y in (*result.positions, result.final_pose[:2]):
@@ -363,9 +377,10 @@ def bench(
     workers: int,
     scheduler: str | None = None,
     overrides: tuple[str, ...] = (),
+    planner_imports: tuple[str, ...] = (),
 ) -> int:
     """The `vplane-mj bench` command after its arguments are parsed."""
-    jobs = plan_jobs(scenarios, planners, seeds, overrides)
+    jobs = plan_jobs(scenarios, planners, seeds, overrides, planner_imports)
     rows = run_sweep(jobs, out_dir, workers, scheduler)
     table = summarize(rows)
     print(format_table(table))

@@ -14,7 +14,8 @@ from vplane_mj.errors import VPlaneError
 from vplane_mj.families import FAMILIES
 from vplane_mj.interrupts import Interrupted, signals_raise_interrupted
 from vplane_mj.outputs import output_directory, prepare_out_dir, write_atomically, write_json
-from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
+from vplane_mj.planning.plugins import PlannerError, canonical_spec, is_import_spec
+from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS, load_planner
 
 if TYPE_CHECKING:
     from vplane_mj.scenario import Scenario
@@ -92,7 +93,12 @@ def _parser() -> argparse.ArgumentParser:
 
     run = commands.add_parser("run", help="one headless run of a scenario")
     run.add_argument("scenario", metavar="SCENARIO", help="a TOML file or a built-in scenario name")
-    run.add_argument("--planner", help="planner name (same as --set planner.name=NAME)")
+    run.add_argument(
+        "--planner",
+        metavar="NAME|module:Class",
+        help="planner name (same as --set planner.name=NAME), or a planner class to import: "
+        "module:Class or path/to/file.py:Class",
+    )
     run.add_argument("--seed", type=int, help="random seed (same as --set run.seed=N)")
     run.add_argument(
         "--set",
@@ -109,7 +115,11 @@ def _parser() -> argparse.ArgumentParser:
 
     sweep = commands.add_parser("bench", help="many runs: scenarios x planners x seeds")
     sweep.add_argument("scenarios", nargs="+", metavar="SCENARIO")
-    sweep.add_argument("--planners", help="comma-separated planner names (default: all)")
+    sweep.add_argument(
+        "--planners",
+        help="comma-separated planner names or classes to import, module:Class or "
+        "path/to/file.py:Class (default: every planner)",
+    )
     sweep.add_argument("--seeds", default="0", help="seeds, e.g. 0-19 or 0,3,5-7 (default 0)")
     sweep.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="worker processes")
     sweep.add_argument(
@@ -164,14 +174,33 @@ def _parser() -> argparse.ArgumentParser:
     video.set_defaults(handler=_video)
 
     listing = commands.add_parser("list", help="built-in scenarios and planners")
+    listing.add_argument(
+        "--planner",
+        action="append",
+        metavar="NAME|module:Class",
+        help="show only this planner and its parameters (repeatable); module:Class or "
+        "path/to/file.py:Class imports it",
+    )
     listing.set_defaults(handler=_list, draws=False)
     return parser
+
+
+def _planner_name(reference: str, option: str) -> str:
+    """The name of a planner given on the command line: a name as it is, or the name of the
+    class an import spec names (imported and registered here: only the user's own command line
+    imports anything, never a scenario file)."""
+    if not is_import_spec(reference):
+        return reference
+    try:
+        return load_planner(reference).name
+    except PlannerError as exc:
+        raise VPlaneError(f"{option}: {exc}") from None
 
 
 def _overrides(args: argparse.Namespace) -> list[str]:
     extra = []
     if args.planner is not None:
-        extra.append(f"planner.name={args.planner}")
+        extra.append(f"planner.name={_planner_name(args.planner, '--planner')}")
     if args.seed is not None:
         extra.append(f"run.seed={args.seed}")
     return [*args.set, *extra]
@@ -257,11 +286,15 @@ def _bench(args: argparse.Namespace) -> int:
 
     if args.jobs < 1:
         raise VPlaneError(f"--jobs: must be at least 1, got {args.jobs}")
-    planners = sorted(PLANNERS) if args.planners is None else [p.strip() for p in args.planners.split(",")]
+    references = sorted(PLANNERS) if args.planners is None else [p.strip() for p in args.planners.split(",")]
+    planners = [_planner_name(reference, "--planners") for reference in references]
+    imports = tuple(canonical_spec(reference) for reference in references if is_import_spec(reference))
     seeds = parse_seeds(args.seeds)
     with signals_raise_interrupted(), output_directory(args.out or DEFAULT_OUT) as out_dir:
         try:
-            return bench(args.scenarios, planners, seeds, out_dir, args.jobs, args.scheduler, tuple(args.set))
+            return bench(
+                args.scenarios, planners, seeds, out_dir, args.jobs, args.scheduler, tuple(args.set), imports
+            )
         except Interrupted as exc:
             end_of_progress_bar = "\n" if sys.stderr.isatty() else ""
             print(
@@ -391,16 +424,36 @@ def _check_parent(target: Path) -> None:
 
 
 def _list(args: argparse.Namespace) -> int:
-    from vplane_mj.scenario import builtin_scenarios
+    if args.planner:
+        names = [_planner_name(reference, "--planner") for reference in args.planner]
+        for name in names:
+            if name not in PLANNERS:
+                known = ", ".join(sorted(PLANNERS))
+                raise VPlaneError(f"--planner: unknown planner {name!r}; available: {known}")
+    else:
+        from vplane_mj.scenario import builtin_scenarios
 
-    print("Built-in scenarios:")
-    for name, description in builtin_scenarios():
-        print(f"  {name:<20} {description}")
+        print("Built-in scenarios:")
+        for name, description in builtin_scenarios():
+            print(f"  {name:<20} {description}")
+        names = sorted(PLANNERS)
     print("\nPlanners (parameters: default, unit, meaning):")
-    for name, (info, _) in sorted(PLANNERS.items()):
-        default = " (default)" if name == DEFAULT_PLANNER else ""
-        print(f"  {name}{default}: {info.summary}")
-        print(f"    after: {info.citation}")
-        for key, param in info.params.items():
-            print(f"    {key:<22} {param.default:<8g} {param.unit:<7} {param.doc}")
+    for name in names:
+        _print_planner(name)
     return 0
+
+
+def _print_planner(name: str) -> None:
+    """One planner of `vplane-mj list`: its summary, citation and parameters (or why an
+    installed one cannot be loaded)."""
+    try:
+        info = PLANNERS[name].info()
+    except PlannerError as exc:
+        print(f"  {name}: cannot be loaded: {exc}")
+        return
+    default = " (default)" if name == DEFAULT_PLANNER else ""
+    print(f"  {name}{default}: {info.summary}")
+    if info.citation:
+        print(f"    after: {info.citation}")
+    for key, param in info.params.items():
+        print(f"    {key:<22} {param.default:<8g} {param.unit:<7} {param.doc}")

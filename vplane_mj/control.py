@@ -14,6 +14,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from vplane_mj.planning.vectors import wrap_angle
+
 
 @dataclass(frozen=True)
 class ControllerGains:
@@ -27,11 +29,6 @@ class ControllerGains:
     wheel_kp: float = 0.06  # N m per rad/s of wheel speed error
     wheel_ki: float = 0.6  # N m per rad of accumulated wheel speed error
     motor_rate_hz: float = 100.0  # how often the wheel PI loop runs
-
-
-def wrap_angle(angle: float) -> float:
-    """The same angle in [-pi, pi)."""
-    return (angle + math.pi) % (2 * math.pi) - math.pi
 
 
 def heading_command(fx: float, fy: float, yaw: float, gains: ControllerGains) -> tuple[float, float]:

@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from vplane_mj import shapes
+from vplane_mj.planning.vectors import wrap_angle
 from vplane_mj.reference import shortest_path_length
 from vplane_mj.scenario import Scenario
 
@@ -62,7 +63,7 @@ def motion_quality(yaws: np.ndarray, path_length: float) -> dict[str, float | No
     reversals of the turning direction per metre (1/m). None when the robot did not move."""
     if len(yaws) < 2 or path_length < 1e-6:
         return {"smoothness_rad_per_m": None, "oscillation_per_m": None}
-    turns = (np.diff(yaws) + math.pi) % (2 * math.pi) - math.pi
+    turns = wrap_angle(np.diff(yaws))
     signs = np.sign(turns[np.abs(turns) > TURN_NOISE_RAD])
     reversals = int(np.count_nonzero(np.diff(signs)))
     return {

@@ -19,9 +19,8 @@ from vplane_mj import shapes
 from vplane_mj.log_mcap import METADATA_NAME
 from vplane_mj.log_read import LogContents, iter_messages
 from vplane_mj.planning import fields
-from vplane_mj.planning.apf import FIELD_PARAMS
 from vplane_mj.planning.events import EventKind
-from vplane_mj.planning.registry import planner_info
+from vplane_mj.planning.groups import FieldParams
 from vplane_mj.render import MODE_RGBA, OTHER_MODE_RGBA, Track
 from vplane_mj.scenario import Scenario
 
@@ -100,8 +99,8 @@ def _draw_field(axes, contents: LogContents, scenario: Scenario) -> None:
     field gains when its planner has them, APF's defaults otherwise.
     """
     info = contents.metadata[METADATA_NAME]
-    resolved = planner_info(scenario.planner).resolve(json.loads(info.get("planner_params", "{}")))
-    params = {key: resolved.get(key, param.default) for key, param in FIELD_PARAMS.items()}
+    logged = json.loads(info.get("planner_params", "{}"))
+    params = {key: logged.get(key, default) for key, default in FieldParams().as_dict().items()}
     times = contents.times_ns / 1e9
     minima = [e.time_s for e in contents.events if e.kind is EventKind.LOCAL_MINIMUM]
     if minima:

@@ -61,7 +61,7 @@ def load_log(path: Path) -> tuple[LogContents, Scenario]:
         raise VPlaneError(f"{path}: the log holds no robot pose")
     if not contents.events:
         raise VPlaneError(f"{path}: no /run/events (written by an older vplane-mj?)")
-    return contents, parse_scenario(info["scenario_toml"], f"{path} (metadata)")
+    return contents, parse_scenario(info["scenario_toml"], f"{path} (metadata)", recorded=True)
 
 
 def summarize(contents: LogContents, scenario: Scenario) -> dict:
@@ -118,7 +118,11 @@ def disagreements(recomputed: dict, stored: dict, tolerance_m: float = 0.01) -> 
 
 def track_from_log(path: Path, contents: LogContents) -> Track:
     """What a render shows, from the log: path, modes, final pose, virtual objects, collisions."""
-    objectives = [e.data["objective"] for e in contents.events if e.kind is EventKind.ESCAPE_STARTED]
+    objectives = [
+        e.data["objective"]
+        for e in contents.events
+        if e.kind is EventKind.ESCAPE_STARTED and "objective" in e.data  # a planner may place none
+    ]
     collisions = [e.data["point"] for e in contents.events if e.kind is EventKind.COLLISION]
     planes = []
     for update in iter_messages(path, ("/virtual",)):

@@ -373,7 +373,7 @@ class Run:
             odometry_error_m=self.localiser.error(self.position),
             trajectory_sha256=trajectory_digest(self.positions, self.position, self.drive.yaw()),
             message="" if reached or ending.outcome is Outcome.TIMEOUT else ending.event.text,
-            planner_params=self.planner.params,
+            planner_params=self.planner.params.as_dict(),
             version=__version__,
         )
 

@@ -1,0 +1,57 @@
+"""Planning: pure numpy, no MuJoCo. What a planner receives each control tick and what it answers.
+
+The names for writing a planner of one's own (README, "Your own planner"):
+
+- `Planner`: the base class (name, summary, citation, Params; `step(obs) -> Decision`);
+- `Observation`, `Decision`, `Event`, `EventKind`, `point`: what it receives and returns;
+- `PlannerParams`, `param`, `with_default`: its parameters as a frozen dataclass;
+- `FieldParams`, `DetectorParams`, `MinimumParams`, `LocalMapParams`, `SonarMapParams`: the
+  parameter groups of the built-in planners with their set-ups (fields, local-minimum
+  detector, sonar map and histogram), `report_trap`, `LocalMinimumDetector`, `LocalMap`;
+- `wrap_angle`, `unit`: angles and vectors;
+- `register_planner`, `load_planner`: registration in code.
+"""
+
+from vplane_mj.planning.base import Planner
+from vplane_mj.planning.events import Event, EventKind, point
+from vplane_mj.planning.groups import (
+    DetectorParams,
+    FieldParams,
+    LocalMapParams,
+    MinimumParams,
+    SonarMapParams,
+)
+from vplane_mj.planning.localmap import LocalMap
+from vplane_mj.planning.minima import LocalMinimumDetector, report_trap
+from vplane_mj.planning.params import Param, ParamError, PlannerParams, param, with_default
+from vplane_mj.planning.plugins import PlannerError
+from vplane_mj.planning.registry import load_planner, register_planner
+from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.planning.vectors import unit, wrap_angle
+
+__all__ = [
+    "Decision",
+    "DetectorParams",
+    "Event",
+    "EventKind",
+    "FieldParams",
+    "LocalMap",
+    "LocalMapParams",
+    "LocalMinimumDetector",
+    "MinimumParams",
+    "Observation",
+    "Param",
+    "ParamError",
+    "Planner",
+    "PlannerError",
+    "PlannerParams",
+    "SonarMapParams",
+    "load_planner",
+    "param",
+    "point",
+    "register_planner",
+    "report_trap",
+    "unit",
+    "with_default",
+    "wrap_angle",
+]

@@ -13,48 +13,44 @@ to the hit point after a loop around the obstacle (the goal is unreachable) or a
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 
+from vplane_mj.planning.base import Planner
 from vplane_mj.planning.events import Event, EventKind, point
-from vplane_mj.planning.params import Param, PlannerInfo
+from vplane_mj.planning.params import PlannerParams, param
 from vplane_mj.planning.types import Decision, Observation
-from vplane_mj.planning.vplane_geometry import unit
+from vplane_mj.planning.vectors import unit, wrap_angle
 
 AHEAD_HALF_ANGLE = math.radians(30.0)
 """Echoes within this angle of the goal direction count as ahead (hit and leave tests)."""
 LEAVE_MARGIN_M = 0.1
 """A leave point must be at least this much closer to the goal than the hit point."""
 
-INFO = PlannerInfo(
-    name="bug2",
-    summary="Bug2: along the start-goal line, sonar wall following around obstacles",
-    citation=(
-        "V. Lumelsky and A. Stepanov, Path-planning strategies for a point mobile automaton "
-        "moving amidst unknown obstacles of arbitrary shape, Algorithmica 2, 1987"
-    ),
-    params={
-        "hit_distance_m": Param(0.45, "m", "an echo this close ahead (+-30 deg of the goal) is a hit", gt=0),
-        "wall_distance_m": Param(0.4, "m", "distance kept from the followed wall (from the centre)", gt=0),
-        "wall_gain": Param(2.0, "1/m", "proportional correction toward the desired wall distance", ge=0),
-        "follow_speed": Param(0.7, "", "force magnitude while following (speed 0.5 m/s per unit)", gt=0),
-        "lost_wall_m": Param(1.2, "m", "no echo on the wall side within this: turn toward the wall", gt=0),
-        "mline_tolerance_m": Param(0.1, "m", "distance from the m-line that counts as on it", gt=0),
-        "mline_gain": Param(1.0, "1/m", "lateral correction back onto the m-line per metre off it", ge=0),
-        "slow_radius_m": Param(1.0, "m", "the force shrinks within this distance of the goal", gt=0),
-        "follow_side": Param(
-            1,
-            "",
-            "1: turn left (wall on the right); -1: turn right; 0: choose by the echoes",
-            ge=-1,
-            le=1,
-            integer=True,
-        ),
-        "loop_radius_m": Param(0.3, "m", "back within this of the hit point after a loop: give up", gt=0),
-        "max_follow_s": Param(120.0, "s", "give up after following one obstacle this long", gt=0),
-    },
-)
+
+@dataclass(frozen=True)
+class Bug2Params(PlannerParams):
+    """Bug2's hit and leave tests, wall following and the m-line."""
+
+    hit_distance_m: float = param(0.45, "m", "an echo this close ahead (+-30 deg of the goal) is a hit", gt=0)
+    wall_distance_m: float = param(0.4, "m", "distance kept from the followed wall (from the centre)", gt=0)
+    wall_gain: float = param(2.0, "1/m", "proportional correction toward the desired wall distance", ge=0)
+    follow_speed: float = param(0.7, "", "force magnitude while following (speed 0.5 m/s per unit)", gt=0)
+    lost_wall_m: float = param(1.2, "m", "no echo on the wall side within this: turn toward the wall", gt=0)
+    mline_tolerance_m: float = param(0.1, "m", "distance from the m-line that counts as on it", gt=0)
+    mline_gain: float = param(1.0, "1/m", "lateral correction back onto the m-line per metre off it", ge=0)
+    slow_radius_m: float = param(1.0, "m", "the force shrinks within this distance of the goal", gt=0)
+    follow_side: int = param(
+        1,
+        "",
+        "1: turn left (wall on the right); -1: turn right; 0: choose by the echoes",
+        ge=-1,
+        le=1,
+        integer=True,
+    )
+    loop_radius_m: float = param(0.3, "m", "back within this of the hit point after a loop: give up", gt=0)
+    max_follow_s: float = param(120.0, "s", "give up after following one obstacle this long", gt=0)
 
 
 def _rotate(v: np.ndarray, angle: float) -> np.ndarray:
@@ -62,15 +58,20 @@ def _rotate(v: np.ndarray, angle: float) -> np.ndarray:
     return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
 
 
-def _wrap(angle: np.ndarray | float) -> np.ndarray | float:
-    return (np.asarray(angle) + math.pi) % (2 * math.pi) - math.pi
-
-
-class Bug2Planner:
+class Bug2Planner(Planner):
     """Bug2: modes "go_to_goal" and "following"; gives up on a closed loop or a timeout."""
 
-    def __init__(self, params: Mapping[str, float]):
-        self.params = dict(params)
+    name = "bug2"
+    summary = "Bug2: along the start-goal line, sonar wall following around obstacles"
+    citation = (
+        "V. Lumelsky and A. Stepanov, Path-planning strategies for a point mobile automaton "
+        "moving amidst unknown obstacles of arbitrary shape, Algorithmica 2, 1987"
+    )
+    Params = Bug2Params
+    params: Bug2Params
+
+    def __init__(self, params: Bug2Params, robot_radius_m: float):
+        super().__init__(params, robot_radius_m)
         self.mode = "go_to_goal"
         self.mline: tuple[np.ndarray, np.ndarray] | None = None
         self.hit_point: np.ndarray | None = None
@@ -92,7 +93,7 @@ class Bug2Planner:
     def _ahead_range(self, obs: Observation) -> float:
         """Shortest echo within +-30 degrees of the goal direction (inf when none)."""
         goal_angle = math.atan2(*(obs.goal - obs.position)[::-1])
-        relative = np.abs(_wrap(obs.yaw + obs.bearings - goal_angle))
+        relative = np.abs(wrap_angle(obs.yaw + obs.bearings - goal_angle))
         ahead = (relative <= AHEAD_HALF_ANGLE + obs.beam_width / 2) & np.isfinite(obs.ranges)
         return float(obs.ranges[ahead].min()) if ahead.any() else math.inf
 
@@ -101,21 +102,21 @@ class Bug2Planner:
     def _go_to_goal(self, obs: Observation) -> dict[str, np.ndarray]:
         to_goal = obs.goal - obs.position
         distance = float(np.hypot(*to_goal))
-        scale = max(0.3, min(1.0, distance / self.params["slow_radius_m"]))
+        scale = max(0.3, min(1.0, distance / self.params.slow_radius_m))
         attract = unit(to_goal) * scale
         start, goal = self.mline
         normal = _rotate(unit(goal - start), math.pi / 2)
         offset = self.mline_offset(obs.position)
-        correction = -normal * float(np.clip(self.params["mline_gain"] * offset, -0.5, 0.5))
+        correction = -normal * float(np.clip(self.params.mline_gain * offset, -0.5, 0.5))
         return {"goal": attract, "mline": correction}
 
     def _choose_side(self, obs: Observation) -> int:
-        fixed = round(self.params["follow_side"])
+        fixed = round(self.params.follow_side)
         if fixed != 0:
             return 1 if fixed > 0 else -1
         # Turn toward the side with more free space: compare the mean free range left and right.
         free = np.where(np.isfinite(obs.ranges), obs.ranges, 3.0)
-        rel = _wrap(obs.bearings)
+        rel = wrap_angle(obs.bearings)
         left = free[(rel > 0.1) & (rel < math.pi / 2 + 0.1)].mean()
         right = free[(rel < -0.1) & (rel > -math.pi / 2 - 0.1)].mean()
         return 1 if left >= right else -1
@@ -124,15 +125,15 @@ class Bug2Planner:
         """Steer along the wall on side `self.side` at `wall_distance_m`."""
         p = self.params
         heading = np.array([math.cos(obs.yaw), math.sin(obs.yaw)])
-        rel = _wrap(obs.bearings)
+        rel = wrap_angle(obs.bearings)
         # The wall side (right for side=+1) and the front; the other side is ignored so that a
         # wall across a narrow passage does not capture the follower.
         usable = (-self.side * rel > -math.radians(50.0)) & (-self.side * rel < math.radians(160.0))
         usable &= np.isfinite(obs.ranges)
-        if not usable.any() or float(obs.ranges[usable].min()) > p["lost_wall_m"]:
+        if not usable.any() or float(obs.ranges[usable].min()) > p.lost_wall_m:
             # Lost the wall: curve toward its side to find it again.
             turn = _rotate(heading, -self.side * math.radians(60.0))
-            return {"search": turn * p["follow_speed"]}
+            return {"search": turn * p.follow_speed}
         ranges = obs.ranges[usable]
         angles = obs.yaw + obs.bearings[usable]
         nearest = float(np.min(ranges))
@@ -142,10 +143,10 @@ class Bug2Planner:
         toward = np.array([np.sum(weights * np.cos(angles[close])), np.sum(weights * np.sin(angles[close]))])
         away = -unit(toward)  # the wall's normal at the robot, pointing away from it
         tangent = _rotate(away, -self.side * math.pi / 2)
-        error = nearest - p["wall_distance_m"]
-        correction = float(np.clip(p["wall_gain"] * error, -1.0, 1.0))
+        error = nearest - p.wall_distance_m
+        correction = float(np.clip(p.wall_gain * error, -1.0, 1.0))
         steer = unit(tangent - correction * away)
-        return {"tangent": steer * p["follow_speed"]}
+        return {"tangent": steer * p.follow_speed}
 
     # ------------------------------------------------------------------ the tick
 
@@ -160,7 +161,7 @@ class Bug2Planner:
 
         distance = obs.distance_to_goal()
         ahead = self._ahead_range(obs)
-        if self.mode == "go_to_goal" and ahead < p["hit_distance_m"] and distance > obs.goal_tolerance:
+        if self.mode == "go_to_goal" and ahead < p.hit_distance_m and distance > obs.goal_tolerance:
             self.mode = "following"
             self.hit_point = position.copy()
             self.hit_distance = distance
@@ -177,11 +178,11 @@ class Bug2Planner:
             )
         elif self.mode == "following":
             from_hit = float(np.hypot(*(position - self.hit_point)))
-            if from_hit > 2.0 * p["loop_radius_m"]:
+            if from_hit > 2.0 * p.loop_radius_m:
                 self.left_hit_area = True
-            on_mline = abs(self.mline_offset(position)) <= p["mline_tolerance_m"]
+            on_mline = abs(self.mline_offset(position)) <= p.mline_tolerance_m
             closer = distance <= self.hit_distance - LEAVE_MARGIN_M
-            clear = ahead > p["hit_distance_m"] + 0.15
+            clear = ahead > p.hit_distance_m + 0.15
             if on_mline and closer and clear:
                 self.mode = "go_to_goal"
                 events.append(
@@ -191,7 +192,7 @@ class Bug2Planner:
                         {"point": point(position)},
                     )
                 )
-            elif self.left_hit_area and from_hit <= p["loop_radius_m"]:
+            elif self.left_hit_area and from_hit <= p.loop_radius_m:
                 self.gave_up = True
                 events.append(
                     Event(
@@ -199,7 +200,7 @@ class Bug2Planner:
                         "gave up: back at the hit point after a loop, the goal is unreachable",
                     )
                 )
-            elif obs.time_s - self.follow_start_s >= p["max_follow_s"]:
+            elif obs.time_s - self.follow_start_s >= p.max_follow_s:
                 self.gave_up = True
                 events.append(
                     Event(

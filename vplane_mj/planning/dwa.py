@@ -34,15 +34,17 @@ The local-minimum detector of the peers makes it give up after `patience_s` trap
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning.apf import MINIMUM_PARAMS, detector_from, report_trap
+from vplane_mj.planning.base import Planner
 from vplane_mj.planning.events import Event, EventKind
-from vplane_mj.planning.localmap import LocalMap
-from vplane_mj.planning.params import LOCAL_MAP_PARAMS, Param, PlannerInfo
+from vplane_mj.planning.groups import LocalMapParams, MinimumParams
+from vplane_mj.planning.minima import report_trap
+from vplane_mj.planning.params import param
 from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.planning.vectors import wrap_angle
 
 SPEED_GAIN, TURN_GAIN = 0.5, 3.0
 """The heading controller's k_v ((m/s) per unit of force) and k_w (1/s), whose law the force
@@ -54,52 +56,49 @@ CREEP_SPEED = 1e-6
 FIRST_PERIOD_S = 0.05
 """Control period (s) assumed on the first tick, before two observations give it (20 Hz)."""
 
-INFO = PlannerInfo(
-    name="dwa",
-    summary="dynamic window approach: the best reachable (v, omega) arc on the sonar grid",
-    citation="D. Fox, W. Burgard, S. Thrun, The dynamic window approach to collision avoidance, "
-    "IEEE Robotics & Automation Magazine 4(1), 1997",
-    params={
-        **MINIMUM_PARAMS,
-        **LOCAL_MAP_PARAMS,
-        "accel_mps2": Param(4.0, "m/s^2", "forward acceleration and braking limit (the robot: ~4.4)", gt=0),
-        "turn_accel_radps2": Param(30.0, "rad/s^2", "turn-rate acceleration limit (the robot: ~32)", gt=0),
-        "max_speed": Param(
-            CONTROLLER_MAX_SPEED,
-            "m/s",
-            "top forward speed (at most the controller's)",
-            gt=0,
-            le=CONTROLLER_MAX_SPEED,
-        ),
-        "max_turn_rate": Param(
-            CONTROLLER_MAX_TURN_RATE,
-            "rad/s",
-            "top turn rate (at most the controller's)",
-            gt=0,
-            le=CONTROLLER_MAX_TURN_RATE,
-        ),
-        "speed_samples": Param(7, "", "forward speeds sampled across the window", ge=2, le=30, integer=True),
-        "turn_samples": Param(31, "", "turn rates sampled across the window", ge=2, le=60, integer=True),
-        "lookahead_m": Param(1.0, "m", "length of each arc checked for obstacles (dist's cap)", gt=0, le=5.0),
-        "margin_m": Param(0.05, "m", "clearance added to the robot radius on the arcs", ge=0, le=1.0),
-        "heading_weight": Param(2.0, "", "alpha: weight of the heading to the goal", ge=0),
-        "clearance_weight": Param(0.2, "", "beta: weight of the free distance along the arc", ge=0),
-        "velocity_weight": Param(0.2, "", "gamma: weight of the forward speed", ge=0),
-        "smoothing": Param(1.0, "", "sigma: Gaussian smoothing of G across samples (0: none)", ge=0, le=10),
-    },
-)
+
+@dataclass(frozen=True)
+class DwaParams(LocalMapParams, MinimumParams):
+    """The detector's and the patience's parameters, the sonar map's and the window's."""
+
+    accel_mps2: float = param(4.0, "m/s^2", "forward acceleration and braking limit (the robot: ~4.4)", gt=0)
+    turn_accel_radps2: float = param(30.0, "rad/s^2", "turn-rate acceleration limit (the robot: ~32)", gt=0)
+    max_speed: float = param(
+        CONTROLLER_MAX_SPEED,
+        "m/s",
+        "top forward speed (at most the controller's)",
+        gt=0,
+        le=CONTROLLER_MAX_SPEED,
+    )
+    max_turn_rate: float = param(
+        CONTROLLER_MAX_TURN_RATE,
+        "rad/s",
+        "top turn rate (at most the controller's)",
+        gt=0,
+        le=CONTROLLER_MAX_TURN_RATE,
+    )
+    speed_samples: int = param(7, "", "forward speeds sampled across the window", ge=2, le=30, integer=True)
+    turn_samples: int = param(31, "", "turn rates sampled across the window", ge=2, le=60, integer=True)
+    lookahead_m: float = param(
+        1.0, "m", "length of each arc checked for obstacles (dist's cap)", gt=0, le=5.0
+    )
+    margin_m: float = param(0.05, "m", "clearance added to the robot radius on the arcs", ge=0, le=1.0)
+    heading_weight: float = param(2.0, "", "alpha: weight of the heading to the goal", ge=0)
+    clearance_weight: float = param(0.2, "", "beta: weight of the free distance along the arc", ge=0)
+    velocity_weight: float = param(0.2, "", "gamma: weight of the forward speed", ge=0)
+    smoothing: float = param(1.0, "", "sigma: Gaussian smoothing of G across samples (0: none)", ge=0, le=10)
 
 
 def dynamic_window(
-    speed: float, turn: float, period_s: float, params: Mapping[str, float]
+    speed: float, turn: float, period_s: float, params: DwaParams
 ) -> tuple[np.ndarray, np.ndarray]:
     """Sampled forward speeds (m/s) and turn rates (rad/s) reachable from (speed, turn) within
     `period_s` under the acceleration limits, inside the speed and turn-rate limits."""
-    top, top_turn = params["max_speed"], params["max_turn_rate"]
-    dv, dw = params["accel_mps2"] * period_s, params["turn_accel_radps2"] * period_s
+    top, top_turn = params.max_speed, params.max_turn_rate
+    dv, dw = params.accel_mps2 * period_s, params.turn_accel_radps2 * period_s
     slow, fast = min(max(speed - dv, 0.0), top), min(max(speed + dv, 0.0), top)
     left, right = min(max(turn - dw, -top_turn), top_turn), min(max(turn + dw, -top_turn), top_turn)
-    return np.linspace(slow, fast, params["speed_samples"]), np.linspace(left, right, params["turn_samples"])
+    return np.linspace(slow, fast, params.speed_samples), np.linspace(left, right, params.turn_samples)
 
 
 def arc_poses(
@@ -141,21 +140,30 @@ def smoothing_matrix(count: int, sigma: float) -> np.ndarray:
     return matrix / matrix.sum(axis=1, keepdims=True)
 
 
-class DwaPlanner:
+class DwaPlanner(Planner):
     """Chooses the admissible command of the dynamic window that maximises G (module docstring)."""
 
-    def __init__(self, params: Mapping[str, float], robot_radius_m: float):
-        p = self.params = dict(params)
-        self.radius = robot_radius_m
-        self.detector = detector_from(p)
-        self.map = LocalMap(p["map_cell_m"], p["map_size_m"])
+    name = "dwa"
+    summary = "dynamic window approach: the best reachable (v, omega) arc on the sonar grid"
+    citation = (
+        "D. Fox, W. Burgard, S. Thrun, The dynamic window approach to collision avoidance, "
+        "IEEE Robotics & Automation Magazine 4(1), 1997"
+    )
+    Params = DwaParams
+    params: DwaParams
+
+    def __init__(self, params: DwaParams, robot_radius_m: float):
+        super().__init__(params, robot_radius_m)
+        p = params
+        self.detector = p.detector()
+        self.map = p.local_map()
         # Points checked along an arc, a map cell apart: between two of them the clearance to a
         # cell centre dips by at most sqrt(d^2 + (cell / 2)^2) - d (8 mm at d = 0.16 m).
-        self.step_m = p["map_cell_m"]
-        count = max(1, math.ceil(p["lookahead_m"] / self.step_m - 1e-9))
+        self.step_m = p.map_cell_m
+        count = max(1, math.ceil(p.lookahead_m / self.step_m - 1e-9))
         self.arc_lengths = self.step_m * np.arange(1, count + 1)
-        self.smooth_speeds = smoothing_matrix(p["speed_samples"], p["smoothing"])
-        self.smooth_turns = smoothing_matrix(p["turn_samples"], p["smoothing"])
+        self.smooth_speeds = smoothing_matrix(p.speed_samples, p.smoothing)
+        self.smooth_turns = smoothing_matrix(p.turn_samples, p.smoothing)
         self.previous: tuple[float, np.ndarray, float] | None = None  # time, position, yaw
         self.period = FIRST_PERIOD_S
         self.blocked = False
@@ -165,7 +173,7 @@ class DwaPlanner:
         self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
         speeds, turns = dynamic_window(*self._velocity(obs), self.period, p)
         dist = self._free_distance(obs, speeds, turns)
-        admissible = (speeds * self.period + speeds**2 / (2 * p["accel_mps2"]))[:, None] <= dist
+        admissible = (speeds * self.period + speeds**2 / (2 * p.accel_mps2))[:, None] <= dist
         decision = Decision(force=np.zeros(2), mode="normal")
         if admissible.any():
             score = np.where(admissible, self._objective(obs, speeds, turns, dist), 0.0)
@@ -183,7 +191,7 @@ class DwaPlanner:
             self.blocked = True
         decision.force = force_for_command(*command, obs.yaw)
         decision.components = {"command": decision.force}
-        report_trap(self.detector, obs, decision, p["patience_s"])
+        report_trap(self.detector, obs, decision, p.patience_s)
         return decision
 
     def _velocity(self, obs: Observation) -> tuple[float, float]:
@@ -193,7 +201,7 @@ class DwaPlanner:
             return 0.0, 0.0
         time0, position0, yaw0 = previous
         self.period = obs.time_s - time0
-        turned = (obs.yaw - yaw0 + math.pi) % (2 * math.pi) - math.pi
+        turned = wrap_angle(obs.yaw - yaw0)
         heading = yaw0 + turned / 2
         moved = obs.position - position0
         speed = (moved[0] * math.cos(heading) + moved[1] * math.sin(heading)) / self.period
@@ -203,7 +211,7 @@ class DwaPlanner:
         """dist(v, omega) (speeds, turns): length (m) along each arc before the disc plus margin
         meets an obstacle cell, `lookahead_m` when it never does (step 3 of the module docstring)."""
         p = self.params
-        dist = np.full((len(speeds), len(turns)), p["lookahead_m"])
+        dist = np.full((len(speeds), len(turns)), p.lookahead_m)
         moving = speeds > 0  # a turn on the spot sweeps nothing the disc does not already cover
         if not moving.any():
             return dist
@@ -211,17 +219,15 @@ class DwaPlanner:
         points, _ = arc_poses(
             obs.position, obs.yaw, self.arc_lengths, curvature[..., None] * self.arc_lengths
         )
-        safe = self.radius + p["margin_m"]
-        field = self.map.clearance_field(
-            p["map_threshold"], obs.position, p["lookahead_m"] + safe + self.step_m
-        )
+        safe = self.radius + p.margin_m
+        field = self.map.clearance_field(p.map_threshold, obs.position, p.lookahead_m + safe + self.step_m)
         clearance = field.at(np.vstack((obs.position, points.reshape(-1, 2))))
         limit = min(safe, clearance[0])  # never closer than the robot already is
         hits = clearance[1:].reshape(points.shape[:-1]) < limit
-        if obs.distance_to_goal() < p["lookahead_m"] + obs.goal_tolerance:  # arcs may enter the goal
+        if obs.distance_to_goal() < p.lookahead_m + obs.goal_tolerance:  # arcs may enter the goal
             arrived = np.hypot(*np.moveaxis(points - obs.goal, -1, 0)) <= obs.goal_tolerance
             hits &= ~np.logical_or.accumulate(arrived, axis=-1)
-        dist[moving] = np.where(hits.any(axis=-1), np.argmax(hits, axis=-1) * self.step_m, p["lookahead_m"])
+        dist[moving] = np.where(hits.any(axis=-1), np.argmax(hits, axis=-1) * self.step_m, p.lookahead_m)
         return dist
 
     def _objective(
@@ -229,13 +235,13 @@ class DwaPlanner:
     ) -> np.ndarray:
         """alpha heading + beta dist + gamma velocity (speeds, turns), each term in [0, 1]."""
         p = self.params
-        travel = (speeds * self.period + speeds**2 / (2 * p["accel_mps2"]))[:, None]
-        turned = (turns * self.period + turns * np.abs(turns) / (2 * p["turn_accel_radps2"]))[None, :]
+        travel = (speeds * self.period + speeds**2 / (2 * p.accel_mps2))[:, None]
+        turned = (turns * self.period + turns * np.abs(turns) / (2 * p.turn_accel_radps2))[None, :]
         points, headings = arc_poses(obs.position, obs.yaw, travel, turned)
         to_goal = obs.goal - points
-        theta = (np.arctan2(to_goal[..., 1], to_goal[..., 0]) - headings + math.pi) % (2 * math.pi) - math.pi
+        theta = wrap_angle(np.arctan2(to_goal[..., 1], to_goal[..., 0]) - headings)
         return (
-            p["heading_weight"] * (1 - np.abs(theta) / math.pi)
-            + p["clearance_weight"] * dist / p["lookahead_m"]
-            + p["velocity_weight"] * (speeds / p["max_speed"])[:, None]
+            p.heading_weight * (1 - np.abs(theta) / math.pi)
+            + p.clearance_weight * dist / p.lookahead_m
+            + p.velocity_weight * (speeds / p.max_speed)[:, None]
         )

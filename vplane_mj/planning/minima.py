@@ -19,6 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vplane_mj.planning.events import Event, EventKind
+from vplane_mj.planning.types import Decision, Observation
+
 
 @dataclass(frozen=True)
 class MinimumState:
@@ -93,3 +96,22 @@ class LocalMinimumDetector:
             return False
         # The oldest sample's speed belongs to the step before the window.
         return all(s[3] <= self.speed_mps for s in itertools.islice(self._samples, 1, None))
+
+
+def report_trap(
+    detector: LocalMinimumDetector, obs: Observation, decision: Decision, patience_s: float
+) -> None:
+    """Feed the detector; mark a new local minimum, the trapped mode, and giving up after
+    `patience_s` trapped (for planners that have no escape)."""
+    near_goal = obs.distance_to_goal() <= obs.goal_tolerance
+    state = detector.update(obs.time_s, obs.position, near_goal)
+    if state.new:
+        decision.local_minimum = True
+        decision.events.append(Event(EventKind.LOCAL_MINIMUM, "local minimum detected"))
+    if state.trapped:
+        decision.mode = "trapped"
+        if state.trapped_for_s >= patience_s:
+            decision.gave_up = True
+            decision.events.append(
+                Event(EventKind.GAVE_UP, f"gave up: trapped for {state.trapped_for_s:.1f} s")
+            )

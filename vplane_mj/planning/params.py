@@ -1,15 +1,29 @@
-"""Planner parameters as data: each has a default, a unit, bounds and a one-line meaning."""
+"""Planner parameters as frozen dataclasses: each field a number with a default, a unit, bounds
+and a one-line meaning.
+
+A planner declares its parameters as a subclass of `PlannerParams`, each field made by
+`param(...)`; groups that several planners share (`groups.py`) are reused by inheritance.
+`PlannerParams.resolve` turns a mapping of overrides (a scenario's `[planner]` table, `--set
+planner.KEY=VALUE`, a dict in code) into the dataclass, checking every key and value first.
+"""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Any, Self
+
+from vplane_mj.errors import VPlaneError
 
 MAX_MAGNITUDE = 1e6
 """No planner parameter may exceed this in absolute value: a larger one is surely a mistake,
 and such values overflow the planners' force arithmetic to inf (the run would end in error)."""
+
+PARAM = "vplane_mj.param"
+"""The key of a dataclass field's metadata that holds its `Param`."""
 
 
 @dataclass(frozen=True)
@@ -28,10 +42,10 @@ class Param:
         """Return why `value` is unacceptable, or None when it is fine."""
         if isinstance(value, bool) or not isinstance(value, int | float):
             return f"must be a number, got {type(value).__name__}"
+        if abs(value) > sys.float_info.max or not math.isfinite(value):
+            return f"must be finite, got {value!r}"
         if self.integer and not isinstance(value, int):
             return f"must be an integer, got {value!r}"
-        if (isinstance(value, int) and abs(value) > sys.float_info.max) or not math.isfinite(value):
-            return f"must be finite, got {value!r}"
         if abs(value) > MAX_MAGNITUDE:
             return f"must be at most {MAX_MAGNITUDE:g} in magnitude, got {value!r}"
         if self.gt is not None and not value > self.gt:
@@ -43,36 +57,81 @@ class Param:
         return None
 
 
+def param(
+    default: float,
+    unit: str,
+    doc: str,
+    gt: float | None = None,
+    ge: float | None = None,
+    le: float | None = None,
+    integer: bool = False,
+) -> Any:
+    """A field of a `PlannerParams` dataclass: its default, unit ("" for none), meaning and
+    bounds (exclusive `gt`, inclusive `ge` and `le`); `integer` for counts."""
+    spec = Param(default, unit, doc, gt=gt, ge=ge, le=le, integer=integer)
+    return field(default=default, metadata={PARAM: spec})
+
+
+def with_default(params: type[PlannerParams], name: str, default: float) -> Any:
+    """The field `name` of `params` with another default (unit, meaning and bounds kept), for a
+    subclass that shares a group's parameter but not its default."""
+    spec = params.table()[name]
+    return field(default=default, metadata={PARAM: dataclasses.replace(spec, default=default)})
+
+
+class ParamError(VPlaneError):
+    """A planner parameter that is unknown or has a bad value: `key` and `reason`."""
+
+    def __init__(self, key: str, reason: str):
+        self.key = key
+        self.reason = reason
+        super().__init__(f"planner.{key}: {reason}")
+
+
+@dataclass(frozen=True)
+class PlannerParams:
+    """The base of every planner's parameters (a frozen dataclass of `param` fields).
+
+    Groups combine by inheritance; a dataclass lists the fields of its bases in reverse
+    order of the bases (`class P(B, A)` holds A's fields, then B's, then its own).
+    """
+
+    @classmethod
+    def table(cls) -> dict[str, Param]:
+        """Every parameter by name, in declaration order (what `vplane-mj list` shows)."""
+        return {f.name: f.metadata[PARAM] for f in dataclasses.fields(cls)}
+
+    @classmethod
+    def checked(cls, overrides: Mapping[str, object], planner: str) -> dict[str, float]:
+        """The overrides with every key and value checked (ParamError for the first bad one),
+        each number as the dataclass holds it: an int for an integer parameter, else a float."""
+        table = cls.table()
+        values: dict[str, float] = {}
+        for key, value in overrides.items():
+            spec = table.get(key)
+            if spec is None:
+                raise ParamError(key, f"not a parameter of planner {planner!r} ({', '.join(table)})")
+            reason = spec.check(value)
+            if reason:
+                raise ParamError(key, reason)
+            values[key] = value if spec.integer else float(value)
+        return values
+
+    @classmethod
+    def resolve(cls, overrides: Mapping[str, object], planner: str) -> Self:
+        """The defaults updated with the overrides, checked (see `checked`)."""
+        return cls(**cls.checked(overrides, planner))
+
+    def as_dict(self) -> dict[str, float]:
+        """Every value by name, in declaration order (the run summary's `planner_params`)."""
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+
+
 @dataclass(frozen=True)
 class PlannerInfo:
-    """What `vplane-mj list` shows of a planner, and what the scenario validator checks."""
+    """What `vplane-mj list` shows of a planner: derived from its class and its parameters."""
 
     name: str
     summary: str
     citation: str
     params: Mapping[str, Param] = field(default_factory=dict)
-
-    def resolve(self, overrides: Mapping[str, float]) -> dict[str, float]:
-        """Defaults updated with already-validated overrides."""
-        values = {key: p.default for key, p in self.params.items()}
-        values.update(overrides)
-        return values
-
-
-LOCAL_MAP_PARAMS: dict[str, Param] = {
-    "map_cell_m": Param(0.1, "m", "cell size of the local sonar map", ge=0.05, le=1.0),
-    "map_size_m": Param(8.0, "m", "side of the square local map that follows the robot", gt=0, le=20.0),
-    "map_threshold": Param(4, "", "certainty at which a map cell counts as an obstacle", ge=1, integer=True),
-}
-"""The sonar certainty grid (localmap.py), shared by the planners that keep one."""
-
-SONAR_MAP_PARAMS: dict[str, Param] = {
-    **LOCAL_MAP_PARAMS,
-    "sector_deg": Param(5.0, "deg", "polar histogram sector width", ge=0.5, le=45),
-    "window_m": Param(2.0, "m", "radius of the histogram's active window", gt=0),
-    "histogram_threshold": Param(1.0, "", "sector density above which a sector is blocked", gt=0),
-}
-"""The sonar certainty grid and polar histogram, shared by the planners that use them.
-
-The bounds keep the grid (at most 400 x 400 cells) and the histogram (at most 720 sectors)
-small enough to update at the control rate."""

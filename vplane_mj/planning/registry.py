@@ -1,74 +1,159 @@
-"""The planners a scenario can name, with their parameter tables and constructors.
+"""The planners a scenario can name, by name, each a `Planner` class.
 
-A planner's module is imported when the planner is first looked up, not before: a run loads
-only the planner it uses (some need scipy, whose import costs more than a short run's loop).
+Three kinds: the built-in planners; the installed entry points of the group
+`vplane_mj.planners` (`name = "module:Class"`), listed from the installed packages' metadata
+without importing anything until the planner is used; and the classes registered in this
+process (`register_planner`, `load_planner`, or `--planner module:Class` on the command line).
+A module is imported when its planner is first looked up, not before: a run loads only the
+planner it uses (some need scipy, whose import costs more than a short run's loop).
 """
 
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable, Iterator, Mapping
-from typing import Protocol
+from collections.abc import Iterator, Mapping
+from typing import TYPE_CHECKING
 
+from vplane_mj.planning.base import Planner
 from vplane_mj.planning.params import PlannerInfo
-from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.planning.plugins import PlannerError, canonical_spec, import_planner, planner_problem
 
+if TYPE_CHECKING:
+    from importlib.metadata import EntryPoint
 
-class Planner(Protocol):
-    """A planner: resolved parameters, and one decision per control tick."""
-
-    params: dict[str, float]
-
-    def step(self, obs: Observation) -> Decision: ...
-
-
-Factory = Callable[[Mapping[str, float], float], Planner]
-
-_MODULES = {
-    "apf": ("apf", "ApfPlanner", False),
-    "vplane": ("vplane", "VPlanePlanner", True),
-    "vplane_plus": ("vplane_plus", "VPlanePlusPlanner", True),
-    "vobs": ("vobs", "VobsPlanner", False),
-    "vfh": ("vfh", "VfhPlanner", True),
-    "bug2": ("bug2", "Bug2Planner", False),
-    "dwa": ("dwa", "DwaPlanner", True),
+BUILT_IN: dict[str, tuple[str, str]] = {
+    "apf": ("apf", "ApfPlanner"),
+    "vplane": ("vplane", "VPlanePlanner"),
+    "vplane_plus": ("vplane_plus", "VPlanePlusPlanner"),
+    "vobs": ("vobs", "VobsPlanner"),
+    "vfh": ("vfh", "VfhPlanner"),
+    "bug2": ("bug2", "Bug2Planner"),
+    "dwa": ("dwa", "DwaPlanner"),
 }
-"""Planner name: (module in vplane_mj.planning, class, whether it takes the robot radius)."""
+"""Planner name: (its module in vplane_mj.planning, its class)."""
+
+ENTRY_POINT_GROUP = "vplane_mj.planners"
+"""The entry point group of installed planners: `name = "module:Class"`."""
 
 
-class _Planners(Mapping[str, tuple[PlannerInfo, Factory]]):
-    """Planner name -> (parameter table, constructor), each module imported on first use."""
+def _qualified(cls: type) -> str:
+    return f"{cls.__module__}:{cls.__qualname__}"
+
+
+class _Planners(Mapping[str, type[Planner]]):
+    """Planner name -> class: built-in, installed and registered ones, each imported on first use."""
 
     def __init__(self) -> None:
-        self._loaded: dict[str, tuple[PlannerInfo, Factory]] = {}
+        self._classes: dict[str, type[Planner]] = {}
+        self._registered: list[str] = []
+        self._specs: dict[str, type[Planner]] = {}
+        self._installed: dict[str, EntryPoint] | None = None
 
-    def __getitem__(self, name: str) -> tuple[PlannerInfo, Factory]:
-        if name not in self._loaded:
-            module_name, class_name, takes_radius = _MODULES[name]
-            module = importlib.import_module(f"vplane_mj.planning.{module_name}")
-            cls = getattr(module, class_name)
-            factory = cls if takes_radius else (lambda params, _radius, cls=cls: cls(params))
-            self._loaded[name] = (module.INFO, factory)
-        return self._loaded[name]
+    def installed(self) -> dict[str, EntryPoint]:
+        """The entry points of ENTRY_POINT_GROUP by name (read once; nothing is imported). An
+        entry point with a built-in planner's name is left out: the built-in planner keeps it."""
+        if self._installed is None:
+            from importlib.metadata import entry_points
+
+            found = entry_points(group=ENTRY_POINT_GROUP)
+            self._installed = {ep.name: ep for ep in found if ep.name not in BUILT_IN}
+        return self._installed
+
+    def __getitem__(self, name: str) -> type[Planner]:
+        cls = self._classes.get(name)
+        if cls is None:
+            if name in BUILT_IN:
+                module_name, class_name = BUILT_IN[name]
+                module = importlib.import_module(f"vplane_mj.planning.{module_name}")
+                cls = getattr(module, class_name)
+            elif isinstance(name, str) and name in self.installed():
+                cls = _load_entry_point(self.installed()[name])
+            else:
+                raise KeyError(name)
+            self._classes[name] = cls
+        return cls
+
+    def __contains__(self, name: object) -> bool:
+        return (
+            name in BUILT_IN or name in self._classes or (isinstance(name, str) and name in self.installed())
+        )
 
     def __iter__(self) -> Iterator[str]:
-        return iter(_MODULES)
+        return iter(dict.fromkeys([*BUILT_IN, *sorted(self.installed()), *self._registered]))
 
     def __len__(self) -> int:
-        return len(_MODULES)
+        return sum(1 for _ in self)
+
+    def register(self, cls: type[Planner], source: str | None = None) -> type[Planner]:
+        """Make `cls` a planner that scenarios can name by `cls.name` (PlannerError if it cannot
+        be; the message names `source`, by default the class)."""
+        where = source or getattr(cls, "__qualname__", repr(cls))
+        problem = planner_problem(cls)
+        if problem:
+            raise PlannerError(f"{where}: {problem}")
+        name = cls.name
+        if name in BUILT_IN:
+            raise PlannerError(f"{where}: its name {name!r} is a built-in planner's")
+        known = self._classes.get(name)
+        if known is cls:
+            return cls
+        if known is not None:
+            raise PlannerError(f"{where}: the name {name!r} is taken by {_qualified(known)}")
+        entry_point = self.installed().get(name)
+        if entry_point is not None and entry_point.value != _qualified(cls):
+            taken = f"the installed planner {name} = {entry_point.value}"
+            raise PlannerError(f"{where}: the name {name!r} is taken by {taken}")
+        self._classes[name] = cls
+        self._registered.append(name)
+        return cls
+
+    def load(self, spec: str) -> type[Planner]:
+        """Import, check and register the class an import spec names, once per process."""
+        key = canonical_spec(spec)
+        cls = self._specs.get(key)
+        if cls is None:
+            cls = self.register(import_planner(spec), source=spec)
+            self._specs[key] = cls
+        return cls
 
 
-PLANNERS: Mapping[str, tuple[PlannerInfo, Factory]] = _Planners()
+def _load_entry_point(entry_point: EntryPoint) -> type[Planner]:
+    """The class an installed entry point names, imported and checked."""
+    where = f"installed planner {entry_point.name} = {entry_point.value}"
+    try:
+        cls = entry_point.load()
+    except Exception as exc:  # anything the installed module raises on import
+        raise PlannerError(f"{where}: cannot import it: {type(exc).__name__}: {exc}") from exc
+    problem = planner_problem(cls)
+    if problem:
+        raise PlannerError(f"{where}: {problem}")
+    if cls.name != entry_point.name:
+        raise PlannerError(f"{where}: the class's name is {cls.name!r}, not the entry point's")
+    return cls
+
+
+PLANNERS = _Planners()
 
 DEFAULT_PLANNER = "vplane"
 
 
+def register_planner(cls: type[Planner]) -> type[Planner]:
+    """Register a planner class under its `name` in this process (also as a class decorator);
+    PlannerError when it is not a valid planner or its name is taken."""
+    return PLANNERS.register(cls)
+
+
+def load_planner(spec: str) -> type[Planner]:
+    """Import and register the planner class `module:Class` or `path/to/file.py:Class` names
+    (the module looked up as `python -m` would, the current directory first)."""
+    return PLANNERS.load(spec)
+
+
 def planner_info(name: str) -> PlannerInfo:
-    """The parameter table of planner `name` (KeyError when there is none)."""
-    return PLANNERS[name][0]
+    """Name, summary, citation and parameter table of planner `name` (KeyError when there is none)."""
+    return PLANNERS[name].info()
 
 
-def make_planner(name: str, params: Mapping[str, float], robot_radius_m: float) -> Planner:
-    """A fresh planner `name`, its parameters resolved against the defaults."""
-    info, factory = PLANNERS[name]
-    return factory(info.resolve(params), robot_radius_m)
+def make_planner(name: str, params: Mapping[str, object], robot_radius_m: float) -> Planner:
+    """A fresh planner `name`, its parameters resolved against the defaults (each checked)."""
+    return PLANNERS[name].build(params, robot_radius_m)

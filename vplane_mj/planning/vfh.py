@@ -13,58 +13,63 @@ stops; the local-minimum detector then makes it give up after `patience_s` (`stu
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 
 from vplane_mj.planning import histogram
-from vplane_mj.planning.apf import MINIMUM_PARAMS, detector_from, report_trap
-from vplane_mj.planning.localmap import LocalMap
-from vplane_mj.planning.params import SONAR_MAP_PARAMS, Param, PlannerInfo
+from vplane_mj.planning.base import Planner
+from vplane_mj.planning.groups import MinimumParams, SonarMapParams
+from vplane_mj.planning.minima import report_trap
+from vplane_mj.planning.params import param
 from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.planning.vectors import wrap_angle
 
 GOAL_WEIGHT, HEADING_WEIGHT, PREVIOUS_WEIGHT = 5.0, 2.0, 2.0
 """VFH+ cost weights (Ulrich and Borenstein, 1998)."""
 
-INFO = PlannerInfo(
-    name="vfh",
-    summary="VFH+ polar-histogram steering toward the goal, from the sonar grid",
-    citation="J. Borenstein, Y. Koren, The vector field histogram, IEEE TRA 7(3), 1991; "
-    "I. Ulrich, J. Borenstein, VFH+, ICRA 1998",
-    params={
-        **MINIMUM_PARAMS,
-        **SONAR_MAP_PARAMS,
-        "clearance_m": Param(0.1, "m", "clearance added to the robot radius (enlargement)", ge=0),
-        "wide_valley_deg": Param(80.0, "deg", "valleys at least this wide are wide (s_max)", gt=0),
-    },
-)
+
+@dataclass(frozen=True)
+class VfhParams(SonarMapParams, MinimumParams):
+    """The detector's and the patience's parameters, the sonar map's and VFH+'s own."""
+
+    clearance_m: float = param(0.1, "m", "clearance added to the robot radius (enlargement)", ge=0)
+    wide_valley_deg: float = param(80.0, "deg", "valleys at least this wide are wide (s_max)", gt=0)
 
 
 def _angle_between(a: float, b: float) -> float:
-    return abs((a - b + math.pi) % (2 * math.pi) - math.pi)
+    return abs(wrap_angle(a - b))
 
 
-class VfhPlanner:
+class VfhPlanner(Planner):
     """Steers along the cheapest free direction of the polar histogram."""
 
-    def __init__(self, params: Mapping[str, float], robot_radius_m: float):
-        self.params = dict(params)
-        self.radius = robot_radius_m
-        self.detector = detector_from(self.params)
-        self.map = LocalMap(self.params["map_cell_m"], self.params["map_size_m"])
-        self.n_sectors = max(8, round(360.0 / self.params["sector_deg"]))
+    name = "vfh"
+    summary = "VFH+ polar-histogram steering toward the goal, from the sonar grid"
+    citation = (
+        "J. Borenstein, Y. Koren, The vector field histogram, IEEE TRA 7(3), 1991; "
+        "I. Ulrich, J. Borenstein, VFH+, ICRA 1998"
+    )
+    Params = VfhParams
+    params: VfhParams
+
+    def __init__(self, params: VfhParams, robot_radius_m: float):
+        super().__init__(params, robot_radius_m)
+        self.detector = params.detector()
+        self.map = params.local_map()
+        self.n_sectors = params.sector_count()
         self.previous: float | None = None
 
     def step(self, obs: Observation) -> Decision:
         p = self.params
         self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
-        enlarge = self.radius + p["clearance_m"]
-        window = min(p["window_m"], obs.distance_to_goal() + enlarge)  # nothing beyond the goal blocks it
-        cells, certainty = self.map.cells(p["map_threshold"], obs.position, window)
+        enlarge = self.radius + p.clearance_m
+        window = min(p.window_m, obs.distance_to_goal() + enlarge)  # nothing beyond the goal blocks it
+        cells, certainty = self.map.cells(p.map_threshold, obs.position, window)
         h = histogram.polar_histogram(obs.position, cells, certainty, self.n_sectors, window, enlarge)
         to_goal = obs.goal - obs.position
         goal_bearing = math.atan2(to_goal[1], to_goal[0])
-        direction = self._choose(histogram.find_valleys(h > p["histogram_threshold"]), goal_bearing, obs.yaw)
+        direction = self._choose(histogram.find_valleys(h > p.histogram_threshold), goal_bearing, obs.yaw)
         decision = Decision(force=np.zeros(2), mode="normal")
         if direction is None:
             decision.mode = "blocked"
@@ -73,13 +78,13 @@ class VfhPlanner:
             scale = min(1.0, obs.distance_to_goal())
             decision.force = scale * np.array([math.cos(direction), math.sin(direction)])
         decision.components = {"steering": decision.force}
-        report_trap(self.detector, obs, decision, p["patience_s"])
+        report_trap(self.detector, obs, decision, p.patience_s)
         return decision
 
     def _choose(self, valleys: list[histogram.Valley], goal: float, heading: float) -> float | None:
         """The VFH+ candidate direction of least cost, or None when every sector is blocked."""
         sector = 2 * math.pi / self.n_sectors
-        wide = max(1, round(math.radians(self.params["wide_valley_deg"]) / sector))
+        wide = max(1, round(math.radians(self.params.wide_valley_deg) / sector))
         goal_sector = histogram.sector_of(goal, self.n_sectors)
         candidates = []
         for valley in valleys:

@@ -9,49 +9,54 @@ gives up (outcome `stuck`).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 
 from vplane_mj.planning import fields
-from vplane_mj.planning.apf import DETECTOR_PARAMS, FIELD_PARAMS, detector_from, firas_components
+from vplane_mj.planning.base import Planner
 from vplane_mj.planning.events import Event, EventKind, point
-from vplane_mj.planning.params import Param, PlannerInfo
+from vplane_mj.planning.groups import DetectorParams, FieldParams
+from vplane_mj.planning.params import param
 from vplane_mj.planning.types import Decision, Observation
 
-INFO = PlannerInfo(
-    name="vobs",
-    summary="APF with a virtual obstacle placed at each local minimum",
-    citation="M. G. Park, J. H. Jeon, M. C. Lee, Obstacle avoidance for mobile robots using "
-    "artificial potential field approach with simulated annealing, ISIE 2001 (the paper's ref. 9)",
-    params={
-        **FIELD_PARAMS,
-        **DETECTOR_PARAMS,
-        "vobs_gain": Param(0.3, "m", "eta of eq. 5 for a virtual obstacle", gt=0),
-        "vobs_influence_m": Param(1.5, "m", "f0 of eq. 5 for a virtual obstacle", gt=0),
-        "vobs_lifetime_s": Param(30.0, "s", "a virtual obstacle is cleared after this time", gt=0),
-        "max_virtual": Param(6, "", "virtual obstacles placed before giving up", ge=1, integer=True),
-    },
-)
+
+@dataclass(frozen=True)
+class VobsParams(DetectorParams, FieldParams):
+    """The fields' and the detector's parameters, and the virtual obstacles'."""
+
+    vobs_gain: float = param(0.3, "m", "eta of eq. 5 for a virtual obstacle", gt=0)
+    vobs_influence_m: float = param(1.5, "m", "f0 of eq. 5 for a virtual obstacle", gt=0)
+    vobs_lifetime_s: float = param(30.0, "s", "a virtual obstacle is cleared after this time", gt=0)
+    max_virtual: int = param(6, "", "virtual obstacles placed before giving up", ge=1, integer=True)
 
 
-class VobsPlanner:
+class VobsPlanner(Planner):
     """F = F_A + F_R + the repulsion of the virtual obstacles that are still in force."""
 
-    def __init__(self, params: Mapping[str, float]):
-        self.params = dict(params)
-        self.detector = detector_from(self.params)
+    name = "vobs"
+    summary = "APF with a virtual obstacle placed at each local minimum"
+    citation = (
+        "M. G. Park, J. H. Jeon, M. C. Lee, Obstacle avoidance for mobile robots using "
+        "artificial potential field approach with simulated annealing, ISIE 2001 (the paper's ref. 9)"
+    )
+    Params = VobsParams
+    params: VobsParams
+
+    def __init__(self, params: VobsParams, robot_radius_m: float):
+        super().__init__(params, robot_radius_m)
+        self.detector = params.detector()
         self.virtual: list[tuple[float, np.ndarray]] = []  # (time placed, position)
         self.placed = 0
 
     def step(self, obs: Observation) -> Decision:
         p = self.params
-        components = firas_components(obs, p)
+        components = p.firas_components(obs)
         decision = Decision(force=np.zeros(2), mode="normal", components=components)
         near_goal = obs.distance_to_goal() <= obs.goal_tolerance
         if self.detector.update(obs.time_s, obs.position, near_goal).new:
             decision.local_minimum = True
-            if self.placed >= p["max_virtual"]:
+            if self.placed >= p.max_virtual:
                 decision.gave_up = True
                 decision.events.append(Event(EventKind.LOCAL_MINIMUM, "local minimum detected"))
                 decision.events.append(
@@ -69,16 +74,14 @@ class VobsPlanner:
                         {"point": point(obs.position)},
                     )
                 )
-        expired = [v for v in self.virtual if obs.time_s - v[0] > p["vobs_lifetime_s"]]
+        expired = [v for v in self.virtual if obs.time_s - v[0] > p.vobs_lifetime_s]
         if expired:
             decision.events.append(
                 Event(EventKind.VIRTUAL_OBSTACLES_CLEARED, f"{len(expired)} virtual obstacle(s) cleared")
             )
             self.virtual = [v for v in self.virtual if v not in expired]
         points = np.array([position for _, position in self.virtual]).reshape(-1, 2)
-        components["virtual"] = fields.repulsive_force(
-            obs.position, points, p["vobs_gain"], p["vobs_influence_m"]
-        )
+        components["virtual"] = fields.repulsive_force(obs.position, points, p.vobs_gain, p.vobs_influence_m)
         decision.force = sum(components.values(), np.zeros(2))
         decision.mode = "escaping" if len(self.virtual) else "normal"
         decision.planes = []

@@ -25,23 +25,19 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 
 from vplane_mj.planning import fields, histogram
-from vplane_mj.planning.apf import DETECTOR_PARAMS, FIELD_PARAMS, detector_from, firas_components
+from vplane_mj.planning.base import Planner
 from vplane_mj.planning.events import Event, EventKind, point
-from vplane_mj.planning.localmap import LocalMap, angular_extremes
-from vplane_mj.planning.params import SONAR_MAP_PARAMS, Param, PlannerInfo
+from vplane_mj.planning.groups import DetectorParams, FieldParams, SonarMapParams
+from vplane_mj.planning.localmap import angular_extremes
+from vplane_mj.planning.params import param
 from vplane_mj.planning.types import Decision, Observation
-from vplane_mj.planning.vplane_geometry import (
-    VirtualPlane,
-    make_plane,
-    plane_force,
-    unit,
-    virtual_objective,
-)
+from vplane_mj.planning.vectors import unit
+from vplane_mj.planning.vplane_geometry import VirtualPlane, make_plane, plane_force, virtual_objective
 
 CONCAVITY_CHECK_PERIOD_S = 0.2
 """How often (s) the map is examined for a concave obstacle ahead (cheap checks run every tick)."""
@@ -49,40 +45,36 @@ CONCAVITY_CHECK_PERIOD_S = 0.2
 EDGE_OFFSETS_M = (0.05, 0.3, 0.6)
 """Distances beyond the robot's width at which a waypoint past a concave obstacle's edge is tried."""
 
-PARAMS: dict[str, Param] = {
-    **FIELD_PARAMS,
-    **DETECTOR_PARAMS,
-    **SONAR_MAP_PARAMS,
-    "echo_memory": Param(100, "", "sonar scans kept for the extreme points e1, e2", ge=1, integer=True),
-    "clearance_m": Param(
-        0.08, "m", "clearance added to the robot radius (gap width, VFH+ enlargement)", ge=0, le=1.0
-    ),
-    "min_gap_deg": Param(10.0, "deg", "narrowest valley that counts as a passage", gt=0),
-    "concave_depth_m": Param(0.3, "m", "depth behind the chord e1-e2 that makes an obstacle concave", gt=0),
-    "lookahead_m": Param(2.0, "m", "how far ahead toward the goal obstacles are examined", gt=0),
-    "goal_fade_m": Param(
-        0.6, "m", "echo repulsion fades (quadratically) to zero within this distance of the goal", ge=0
-    ),
-    "vno_gain": Param(0.5, "1/m", "gamma of eq. 7, attraction of the virtual new objective", gt=0),
-    "vno_tolerance_m": Param(0.15, "m", "distance at which the virtual objective counts as reached", gt=0),
-    "escape_margin_m": Param(0.3, "m", "objective lies at least radius + this outside the trap", ge=0),
-    "escape_timeout_s": Param(25.0, "s", "an escape that takes longer starts over", gt=0),
-    "max_escapes": Param(4, "", "escapes tried before giving up", ge=1, integer=True),
-    "plane_gain": Param(0.05, "m", "eta of eqs. 8-10, virtual plane repulsion gain", gt=0),
-    "plane_influence_m": Param(0.6, "m", "r of eq. 8, the virtual plane's radius of influence", gt=0),
-    "plane_step_m": Param(0.05, "m", "spacing of the points p_i on the plane (eqs. 9-10)", ge=0.005),
-    "plane_margin_m": Param(0.3, "m", "the corridor extends this far past the plane's ends", ge=0),
-    "slide_gain": Param(1.0, "", "tangential force along the plane, relative to its normal force", ge=0),
-    "max_planes": Param(4, "", "virtual planes kept at most (list L)", ge=1, integer=True),
-}
 
-INFO = PlannerInfo(
-    name="vplane",
-    summary="APF with histogram avoidance, virtual new objective and virtual plane (the paper)",
-    citation="A Novel Approach to Local Minima Problem in Robot Path Planning Using Artificial "
-    "Potential Field (virtual plane method)",
-    params=PARAMS,
-)
+@dataclass(frozen=True)
+class VPlaneParams(SonarMapParams, DetectorParams, FieldParams):
+    """The fields', the detector's and the sonar map's parameters, and the escape's."""
+
+    echo_memory: int = param(100, "", "sonar scans kept for the extreme points e1, e2", ge=1, integer=True)
+    clearance_m: float = param(
+        0.08, "m", "clearance added to the robot radius (gap width, VFH+ enlargement)", ge=0, le=1.0
+    )
+    min_gap_deg: float = param(10.0, "deg", "narrowest valley that counts as a passage", gt=0)
+    concave_depth_m: float = param(
+        0.3, "m", "depth behind the chord e1-e2 that makes an obstacle concave", gt=0
+    )
+    lookahead_m: float = param(2.0, "m", "how far ahead toward the goal obstacles are examined", gt=0)
+    goal_fade_m: float = param(
+        0.6, "m", "echo repulsion fades (quadratically) to zero within this distance of the goal", ge=0
+    )
+    vno_gain: float = param(0.5, "1/m", "gamma of eq. 7, attraction of the virtual new objective", gt=0)
+    vno_tolerance_m: float = param(
+        0.15, "m", "distance at which the virtual objective counts as reached", gt=0
+    )
+    escape_margin_m: float = param(0.3, "m", "objective lies at least radius + this outside the trap", ge=0)
+    escape_timeout_s: float = param(25.0, "s", "an escape that takes longer starts over", gt=0)
+    max_escapes: int = param(4, "", "escapes tried before giving up", ge=1, integer=True)
+    plane_gain: float = param(0.05, "m", "eta of eqs. 8-10, virtual plane repulsion gain", gt=0)
+    plane_influence_m: float = param(0.6, "m", "r of eq. 8, the virtual plane's radius of influence", gt=0)
+    plane_step_m: float = param(0.05, "m", "spacing of the points p_i on the plane (eqs. 9-10)", ge=0.005)
+    plane_margin_m: float = param(0.3, "m", "the corridor extends this far past the plane's ends", ge=0)
+    slide_gain: float = param(1.0, "", "tangential force along the plane, relative to its normal force", ge=0)
+    max_planes: int = param(4, "", "virtual planes kept at most (list L)", ge=1, integer=True)
 
 
 def escape_started(e1: np.ndarray, e2: np.ndarray, objective: np.ndarray) -> Event:
@@ -104,16 +96,24 @@ def plane_created(plane: VirtualPlane) -> Event:
     )
 
 
-class VPlanePlanner:
+class VPlanePlanner(Planner):
     """Algorithm 3 with its flags: `temp_goal` (escaping) and the list L of virtual planes."""
 
-    def __init__(self, params: Mapping[str, float], robot_radius_m: float):
-        self.params = dict(params)
-        self.radius = robot_radius_m
-        p = self.params
-        self.detector = detector_from(p)
-        self.map = LocalMap(p["map_cell_m"], p["map_size_m"])
-        self.n_sectors = max(8, round(360.0 / p["sector_deg"]))
+    name = "vplane"
+    summary = "APF with histogram avoidance, virtual new objective and virtual plane (the paper)"
+    citation = (
+        "A Novel Approach to Local Minima Problem in Robot Path Planning Using Artificial "
+        "Potential Field (virtual plane method)"
+    )
+    Params = VPlaneParams
+    params: VPlaneParams
+
+    def __init__(self, params: VPlaneParams, robot_radius_m: float):
+        super().__init__(params, robot_radius_m)
+        p = params
+        self.detector = p.detector()
+        self.map = p.local_map()
+        self.n_sectors = p.sector_count()
         self.planes: list[VirtualPlane] = []
         self.temp_goal: np.ndarray | None = None  # the virtual new objective while escaping
         self.pending_plane: VirtualPlane | None = None
@@ -121,7 +121,7 @@ class VPlanePlanner:
         self.escapes_tried = 0
         self.avoid_waypoint: np.ndarray | None = None
         self.next_concavity_check_s = 0.0
-        self.echoes: deque[np.ndarray] = deque(maxlen=max(1, round(p["echo_memory"])))
+        self.echoes: deque[np.ndarray] = deque(maxlen=max(1, round(p.echo_memory)))
 
     # -- the loop -------------------------------------------------------------------------
     def step(self, obs: Observation) -> Decision:
@@ -139,26 +139,26 @@ class VPlanePlanner:
             decision.events.append(Event(EventKind.LOCAL_MINIMUM, "local minimum detected"))
             if not self._start_escape(obs, decision):
                 return decision
-        elif self.temp_goal is not None and obs.time_s - self.escape_started_s > p["escape_timeout_s"]:
+        elif self.temp_goal is not None and obs.time_s - self.escape_started_s > p.escape_timeout_s:
             decision.events.append(Event(EventKind.ESCAPE_TIMED_OUT, "escape timed out"))
             if not self._start_escape(obs, decision):
                 return decision
 
-        if self.temp_goal is not None and np.hypot(*(obs.position - self.temp_goal)) <= p["vno_tolerance_m"]:
+        if self.temp_goal is not None and np.hypot(*(obs.position - self.temp_goal)) <= p.vno_tolerance_m:
             self._finish_escape(decision)
 
-        components = firas_components(obs, p)
-        if p["goal_fade_m"] > 0:  # goals near obstacles stay reachable (GNRON)
-            components["repulsive"] *= min(1.0, obs.distance_to_goal() / p["goal_fade_m"]) ** 2
+        components = p.firas_components(obs)
+        if p.goal_fade_m > 0:  # goals near obstacles stay reachable (GNRON)
+            components["repulsive"] *= min(1.0, obs.distance_to_goal() / p.goal_fade_m) ** 2
         if self.temp_goal is not None:
             decision.mode = "escaping"
-            components["attractive"] = -2.0 * p["vno_gain"] * (obs.position - self.temp_goal)  # eq. 7
+            components["attractive"] = -2.0 * p.vno_gain * (obs.position - self.temp_goal)  # eq. 7
         else:
             self._update_avoidance(obs, decision)
             if self.avoid_waypoint is not None:
                 decision.mode = "avoiding"
                 components["attractive"] = fields.attractive_force(
-                    obs.position, self.avoid_waypoint, p["attract_gain"], p["attract_radius"]
+                    obs.position, self.avoid_waypoint, p.attract_gain, p.attract_radius
                 )
         components["virtual"] = self._planes_force(obs.position)
         decision.components = components
@@ -171,7 +171,7 @@ class VPlanePlanner:
     def _start_escape(self, obs: Observation, decision: Decision) -> bool:
         """Place a virtual new objective; False (and gave_up) when escapes are exhausted."""
         self.avoid_waypoint = None
-        if self.escapes_tried >= self.params["max_escapes"]:
+        if self.escapes_tried >= self.params.max_escapes:
             decision.gave_up = True
             decision.events.append(Event(EventKind.GAVE_UP, f"gave up after {self.escapes_tried} escapes"))
             return False
@@ -185,7 +185,7 @@ class VPlanePlanner:
         i1, i2, _ = angular_extremes(obs.position, trap)
         e1, e2 = trap[i1], trap[i2]
         plane = make_plane(e1, e2, trap, obs.position, obs.goal, extend=self._link_m())
-        clearance = self.radius + self.params["escape_margin_m"]
+        clearance = self.radius + self.params.escape_margin_m
         self.temp_goal = virtual_objective(obs.position, e1, e2, obs.goal, plane, clearance)
         self.pending_plane = plane
         self.escape_started_s = obs.time_s
@@ -199,7 +199,7 @@ class VPlanePlanner:
         self.temp_goal = None
         self.planes.append(self.pending_plane)
         self.pending_plane = None
-        if len(self.planes) > self.params["max_planes"]:
+        if len(self.planes) > self.params.max_planes:
             self.planes.pop(0)
             decision.events.append(Event(EventKind.PLANE_RETIRED, "oldest virtual plane retired"))
         self.detector.reset()
@@ -213,7 +213,7 @@ class VPlanePlanner:
         taken from the echoes themselves (the sonar's acoustic axis), not from the map's
         beam-wide arcs, so the plane spans the trap's true mouth.
         """
-        cells, labels, grid_labels = self.map.clusters(self.params["map_threshold"], self._link_m())
+        cells, labels, grid_labels = self.map.clusters(self.params.map_threshold, self._link_m())
         if len(cells) == 0:
             return None
         rel = cells - position
@@ -228,21 +228,21 @@ class VPlanePlanner:
 
     def _link_m(self) -> float:
         """Obstacle cells closer than this leave no gap for the robot: one cluster."""
-        return 2 * self.radius + self.params["clearance_m"]
+        return 2 * self.radius + self.params.clearance_m
 
     # -- the virtual planes -------------------------------------------------------------------
     def _planes_force(self, position: np.ndarray) -> np.ndarray:
         p = self.params
         total = np.zeros(2)
         for plane in self.planes:
-            if plane.in_corridor(position, p["plane_influence_m"], p["plane_margin_m"]):
+            if plane.in_corridor(position, p.plane_influence_m, p.plane_margin_m):
                 total += plane_force(
                     position,
                     plane,
-                    p["plane_gain"],
-                    p["plane_influence_m"],
-                    p["plane_step_m"],
-                    p["slide_gain"],
+                    p.plane_gain,
+                    p.plane_influence_m,
+                    p.plane_step_m,
+                    p.slide_gain,
                 )
         return total
 
@@ -265,15 +265,15 @@ class VPlanePlanner:
         """Enter, keep or leave the avoiding mode (steering past a concave obstacle's edge)."""
         p = self.params
         # Only cells within the histogram's window count: those of the square around the robot.
-        cells, certainty = self.map.cells(p["map_threshold"], obs.position, p["window_m"])
+        cells, certainty = self.map.cells(p.map_threshold, obs.position, p.window_m)
         goal_bearing = math.atan2(*(obs.goal - obs.position)[::-1])
-        if len(cells) == 0 and not self.map.any_cells(p["map_threshold"]):
+        if len(cells) == 0 and not self.map.any_cells(p.map_threshold):
             self.avoid_waypoint = None
             return
         h = histogram.polar_histogram(
-            obs.position, cells, certainty, self.n_sectors, p["window_m"], self.radius + p["clearance_m"]
+            obs.position, cells, certainty, self.n_sectors, p.window_m, self.radius + p.clearance_m
         )
-        blocked = h > p["histogram_threshold"]
+        blocked = h > p.histogram_threshold
         goal_free = not blocked[histogram.sector_of(goal_bearing, self.n_sectors)]
         if goal_free:
             if self.avoid_waypoint is not None:
@@ -308,7 +308,7 @@ class VPlanePlanner:
         begin up to `min_gap_deg` beside its bearing.
         """
         p = self.params
-        min_sectors = max(1, math.ceil(p["min_gap_deg"] / p["sector_deg"]))
+        min_sectors = max(1, math.ceil(p.min_gap_deg / p.sector_deg))
         _, distance = histogram.nearest_wide_valley(
             histogram.find_valleys(blocked),
             math.atan2(direction[1], direction[0]),
@@ -320,17 +320,17 @@ class VPlanePlanner:
     def _concave_edge_waypoint(self, obs: Observation) -> np.ndarray | None:
         """A point just past the nearer edge of a concave obstacle ahead, or None."""
         p = self.params
-        cells, _ = self.map.cells(p["map_threshold"])
+        cells, _ = self.map.cells(p.map_threshold)
         heading = unit(obs.goal - obs.position)
         rel = cells - obs.position
         forward = rel @ heading
         lateral = np.abs(rel @ np.array([-heading[1], heading[0]]))
-        reach = min(p["lookahead_m"], obs.distance_to_goal())
-        ahead = (forward > 0) & (forward < reach) & (lateral < self.radius + p["clearance_m"])
+        reach = min(p.lookahead_m, obs.distance_to_goal())
+        ahead = (forward > 0) & (forward < reach) & (lateral < self.radius + p.clearance_m)
         if not ahead.any():
             return None
         nearest = np.flatnonzero(ahead)[np.argmin(forward[ahead])]
-        _, labels, _ = self.map.clusters(p["map_threshold"], self._link_m())  # the same cells, in order
+        _, labels, _ = self.map.clusters(p.map_threshold, self._link_m())  # the same cells, in order
         cluster = cells[labels == labels[nearest]]
         i1, i2, span = angular_extremes(obs.position, cluster)
         if span >= math.pi:  # it surrounds the robot: that is a trap, not an obstacle ahead
@@ -341,7 +341,7 @@ class VPlanePlanner:
         if (e1 - obs.position) @ away < 0:
             away = -away
         depth = float(np.max((cluster - e1) @ away))
-        if depth < p["concave_depth_m"]:
+        if depth < p.concave_depth_m:
             return None
         via = [np.hypot(*(e - obs.position)) + np.hypot(*(obs.goal - e)) for e in (e1, e2)]
         edge = e1 if via[0] <= via[1] else e2
@@ -363,4 +363,4 @@ class VPlanePlanner:
         span = end - start
         t = np.clip((cells - start) @ span / max(float(span @ span), 1e-12), 0.0, 1.0)
         nearest = start + t[:, None] * span
-        return bool(np.min(np.hypot(*(cells - nearest).T)) > self.radius + self.params["clearance_m"])
+        return bool(np.min(np.hypot(*(cells - nearest).T)) > self.radius + self.params.clearance_m)

@@ -13,12 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vplane_mj.planning.fields import MIN_DISTANCE_M
-
-
-def unit(v: np.ndarray) -> np.ndarray:
-    """v / |v|, or zeros for a (near) zero vector."""
-    norm = float(np.hypot(v[0], v[1]))
-    return v / norm if norm > 1e-12 else np.zeros(2)
+from vplane_mj.planning.vectors import unit
 
 
 @dataclass(frozen=True)

@@ -25,22 +25,20 @@ Every decision is an event (`/events`), and objectives and planes appear in `/vi
 
 from __future__ import annotations
 
-import dataclasses
 import math
-from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import ndimage
 
 from vplane_mj.planning import fields, gridsearch
-from vplane_mj.planning.apf import firas_components
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.localmap import LocalMap, angular_extremes
-from vplane_mj.planning.params import Param, PlannerInfo
+from vplane_mj.planning.params import param, with_default
 from vplane_mj.planning.types import Decision, Observation
-from vplane_mj.planning.vplane import PARAMS as VPLANE_PARAMS
-from vplane_mj.planning.vplane import VPlanePlanner, escape_started, plane_created
-from vplane_mj.planning.vplane_geometry import VirtualPlane, make_plane, unit, virtual_objective
+from vplane_mj.planning.vectors import unit, wrap_angle
+from vplane_mj.planning.vplane import VPlaneParams, VPlanePlanner, escape_started, plane_created
+from vplane_mj.planning.vplane_geometry import VirtualPlane, make_plane, virtual_objective
 
 CLOSE_ECHO_MARGIN_M = 0.1
 """An echo this close beyond the robot's disc (m) repels in full, even against the way."""
@@ -69,61 +67,71 @@ def plane_refused(e1: np.ndarray, e2: np.ndarray, why: str) -> Event:
     )
 
 
-def _with_default(param: Param, default: float) -> Param:
-    return dataclasses.replace(param, default=default)
+@dataclass(frozen=True)
+class VPlanePlusParams(VPlaneParams):
+    """vplane's parameters (a finer, larger map), and those of the map's ways."""
 
-
-PARAMS: dict[str, Param] = {
-    **VPLANE_PARAMS,
-    "map_cell_m": _with_default(VPLANE_PARAMS["map_cell_m"], 0.05),
-    "map_size_m": _with_default(VPLANE_PARAMS["map_size_m"], 16.0),
-    "map_hit": Param(1, "", "certainty an echo adds to each cell of its arc", ge=1, le=15, integer=True),
-    "map_miss": Param(
+    map_cell_m: float = with_default(VPlaneParams, "map_cell_m", 0.05)
+    map_size_m: float = with_default(VPlaneParams, "map_size_m", 16.0)
+    map_hit: int = param(1, "", "certainty an echo adds to each cell of its arc", ge=1, le=15, integer=True)
+    map_miss: int = param(
         2, "", "certainty a reading removes from the cells it shows free", ge=0, le=15, integer=True
-    ),
-    "path_clearance_m": Param(
+    )
+    path_clearance_m: float = param(
         0.01, "m", "the map's ways never pass closer than the robot radius plus this", ge=0, le=1.0
-    ),
-    "inflation_m": Param(0.3, "m", "beyond that, the map's ways pay for passing closer than this", gt=0),
-    "inflation_weight": Param(4.0, "", "extra step cost right at the clearance (costmap inflation)", ge=0),
-    "map_hit_range_m": Param(1.5, "m", "echoes farther than this only clear the map (arcs too wide)", gt=0),
-    "map_sure": Param(
+    )
+    inflation_m: float = param(0.3, "m", "beyond that, the map's ways pay for passing closer than this", gt=0)
+    inflation_weight: float = param(
+        4.0, "", "extra step cost right at the clearance (costmap inflation)", ge=0
+    )
+    map_hit_range_m: float = param(
+        1.5, "m", "echoes farther than this only clear the map (arcs too wide)", gt=0
+    )
+    map_sure: int = param(
         10, "", "certainty at which an obstacle cell is sure (lower: doubtful)", ge=1, integer=True
-    ),
-    "doubt_cost": Param(20.0, "", "extra step cost of passing a doubtful obstacle cell", ge=0),
-    "waypoint_m": Param(1.0, "m", "how far along the map's way the robot is attracted", gt=0),
-    "replan_period_s": Param(0.5, "s", "the map's way is searched again this often", gt=0),
-    "search_margin_m": Param(2.5, "m", "the search covers the robot and the goal plus this margin", gt=0),
-    "follow_influence_m": Param(0.35, "m", "f0 of the echo repulsion while following the map's way", gt=0),
-    "guard_m": Param(0.25, "m", "f0 of the repulsion of the nearest mapped obstacle cell", gt=0),
-    "fallback_after": Param(
+    )
+    doubt_cost: float = param(20.0, "", "extra step cost of passing a doubtful obstacle cell", ge=0)
+    waypoint_m: float = param(1.0, "m", "how far along the map's way the robot is attracted", gt=0)
+    replan_period_s: float = param(0.5, "s", "the map's way is searched again this often", gt=0)
+    search_margin_m: float = param(
+        2.5, "m", "the search covers the robot and the goal plus this margin", gt=0
+    )
+    follow_influence_m: float = param(
+        0.35, "m", "f0 of the echo repulsion while following the map's way", gt=0
+    )
+    guard_m: float = param(0.25, "m", "f0 of the repulsion of the nearest mapped obstacle cell", gt=0)
+    fallback_after: int = param(
         2, "", "escapes before the map's way is followed to the goal", ge=0, integer=True
-    ),
-    "no_way_patience_s": Param(8.0, "s", "give up after the map has held no way to the goal this long", gt=0),
-}
-
-INFO = PlannerInfo(
-    name="vplane_plus",
-    summary="the paper's method with map-checked extreme points, objectives and planes, and a "
-    "map-way fallback (clutter)",
-    citation="A Novel Approach to Local Minima Problem in Robot Path Planning Using Artificial "
-    "Potential Field (virtual plane method), extended for clutter",
-    params=PARAMS,
-)
+    )
+    no_way_patience_s: float = param(
+        8.0, "s", "give up after the map has held no way to the goal this long", gt=0
+    )
 
 
 class VPlanePlusPlanner(VPlanePlanner):
     """The paper's state machine plus the map's ways (see the module docstring)."""
 
-    def __init__(self, params: Mapping[str, float], robot_radius_m: float):
+    name = "vplane_plus"
+    summary = (
+        "the paper's method with map-checked extreme points, objectives and planes, and a "
+        "map-way fallback (clutter)"
+    )
+    citation = (
+        "A Novel Approach to Local Minima Problem in Robot Path Planning Using Artificial "
+        "Potential Field (virtual plane method), extended for clutter"
+    )
+    Params = VPlanePlusParams
+    params: VPlanePlusParams
+
+    def __init__(self, params: VPlanePlusParams, robot_radius_m: float):
         super().__init__(params, robot_radius_m)
-        p = self.params
+        p = params
         self.map = LocalMap(
-            p["map_cell_m"],
-            p["map_size_m"],
-            hit=round(p["map_hit"]),
-            miss=round(p["map_miss"]),
-            hit_range_m=p["map_hit_range_m"],
+            p.map_cell_m,
+            p.map_size_m,
+            hit=round(p.map_hit),
+            miss=round(p.map_miss),
+            hit_range_m=p.map_hit_range_m,
             track_seen=True,
             silent_free_m=SILENT_FREE_M,
         )
@@ -166,39 +174,37 @@ class VPlanePlusPlanner(VPlanePlanner):
                 self.detector.reset()
             else:
                 self._start_escape(obs, decision)
-        elif self.temp_goal is not None and obs.time_s - self.escape_started_s > p["escape_timeout_s"]:
+        elif self.temp_goal is not None and obs.time_s - self.escape_started_s > p.escape_timeout_s:
             decision.events.append(Event(EventKind.ESCAPE_TIMED_OUT, "escape timed out"))
             self._start_escape(obs, decision)
 
-        if self.temp_goal is not None and np.hypot(*(obs.position - self.temp_goal)) <= p["vno_tolerance_m"]:
+        if self.temp_goal is not None and np.hypot(*(obs.position - self.temp_goal)) <= p.vno_tolerance_m:
             self._finish_escape(obs, decision)
 
-        components = firas_components(obs, p)
-        if p["goal_fade_m"] > 0:  # goals near obstacles stay reachable (GNRON)
-            components["repulsive"] *= min(1.0, obs.distance_to_goal() / p["goal_fade_m"]) ** 2
+        components = p.firas_components(obs)
+        if p.goal_fade_m > 0:  # goals near obstacles stay reachable (GNRON)
+            components["repulsive"] *= min(1.0, obs.distance_to_goal() / p.goal_fade_m) ** 2
         if self.temp_goal is not None:
             decision.mode = "escaping"
             if self._way_is_blocked(obs.position, self.escape_way):
-                window = self._window(obs.position, self.temp_goal, self.planes, margin=p["search_margin_m"])
+                window = self._window(obs.position, self.temp_goal, self.planes, margin=p.search_margin_m)
                 self.escape_way = self._way(window, obs.position, self.temp_goal) or []
             target = self._next_waypoint(obs.position, self.escape_way, self.temp_goal)
-            pull = 2.0 * p["vno_gain"] * float(np.hypot(*(obs.position - self.temp_goal)))  # eq. 7
+            pull = 2.0 * p.vno_gain * float(np.hypot(*(obs.position - self.temp_goal)))  # eq. 7
             self._along_the_way(obs, components, target, pull, bool(self.escape_way))
         elif self.following:
             decision.mode = "following"
             target = self._follow_target(obs, decision)
             if decision.gave_up:
                 return decision
-            goal_pull = fields.attractive_force(
-                obs.position, obs.goal, p["attract_gain"], p["attract_radius"]
-            )
+            goal_pull = fields.attractive_force(obs.position, obs.goal, p.attract_gain, p.attract_radius)
             self._along_the_way(obs, components, target, float(np.hypot(*goal_pull)), bool(self.follow_way))
         else:
             self._update_avoidance(obs, decision)
             if self.avoid_waypoint is not None:
                 decision.mode = "avoiding"
                 components["attractive"] = fields.attractive_force(
-                    obs.position, self.avoid_waypoint, p["attract_gain"], p["attract_radius"]
+                    obs.position, self.avoid_waypoint, p.attract_gain, p.attract_radius
                 )
         # While following the map's way the planes act as walls of the search instead: their
         # force would push the robot off a way that skirts a plane's end.
@@ -215,7 +221,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         scans from one pose repeat the same phantoms of a wide beam, and are no new evidence."""
         last = self.last_scan_pose
         if last is not None:
-            turned = abs((obs.yaw - last[2] + math.pi) % (2 * math.pi) - math.pi)
+            turned = abs(wrap_angle(obs.yaw - last[2]))
             if math.hypot(obs.position[0] - last[0], obs.position[1] - last[1]) < SCAN_MOVE_M and (
                 turned < SCAN_TURN_RAD
             ):
@@ -247,8 +253,8 @@ class VPlanePlusPlanner(VPlanePlanner):
             return
         echoes = obs.echo_points()
         close = np.hypot(*(echoes - obs.position).T) < self.radius + CLOSE_ECHO_MARGIN_M
-        fade = min(1.0, obs.distance_to_goal() / p["goal_fade_m"]) ** 2 if p["goal_fade_m"] > 0 else 1.0
-        gain, influence = p["repulse_gain"], p["follow_influence_m"]
+        fade = min(1.0, obs.distance_to_goal() / p.goal_fade_m) ** 2 if p.goal_fade_m > 0 else 1.0
+        gain, influence = p.repulse_gain, p.follow_influence_m
         farther = fade * fields.repulsive_force(obs.position, echoes[~close], gain, influence)
         near = fade * fields.repulsive_force(obs.position, echoes[close], gain, influence)
         components["repulsive"] = near + farther - min(float(farther @ heading), 0.0) * heading
@@ -263,7 +269,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         if np.any(hi <= lo):
             return np.empty((0, 2))
         near = (slice(lo[0], hi[0]), slice(lo[1], hi[1]))
-        i, j = np.nonzero((self.map.grid[near] >= p["map_threshold"]) & ~self.map.swept[near])
+        i, j = np.nonzero((self.map.grid[near] >= p.map_threshold) & ~self.map.swept[near])
         return (np.column_stack((i, j)) + lo + self.map.origin + 0.5) * cell
 
     def _way_is_blocked(self, position: np.ndarray, way: list[np.ndarray]) -> bool:
@@ -283,11 +289,11 @@ class VPlanePlusPlanner(VPlanePlanner):
         """FIRAS repulsion (eq. 5) of the nearest mapped obstacle cell within `guard_m`: the map
         remembers corners that fall between the sonar's rays at close range."""
         p = self.params
-        cells = self._mapped_cells_near(position, p["guard_m"])
+        cells = self._mapped_cells_near(position, p.guard_m)
         if not len(cells):
             return np.zeros(2)
         nearest = cells[np.argmin(np.hypot(*(cells - position).T))]
-        return fields.repulsive_force(position, nearest[None], p["repulse_gain"], p["guard_m"])
+        return fields.repulsive_force(position, nearest[None], p.repulse_gain, p.guard_m)
 
     # -- Algorithm 2 with the map ------------------------------------------------------------
     def _start_escape(self, obs: Observation, decision: Decision) -> bool:
@@ -296,7 +302,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         self.temp_goal = None
         self.pending_plane = None
         self.detector.reset()
-        if self.escapes_tried >= self.params["fallback_after"]:
+        if self.escapes_tried >= self.params.fallback_after:
             self._start_following(obs, decision, f"after {self.escapes_tried} escapes")
             return True
         trap = self._trap_obstacle(obs.position, obs.goal)
@@ -310,8 +316,8 @@ class VPlanePlusPlanner(VPlanePlanner):
         plane = make_plane(
             e1, e2, cells, obs.position, obs.goal, extend=self._link_m() / 2, to_outermost=False
         )
-        clearance = self.radius + self.params["escape_margin_m"]
-        window = self._window(obs.position, obs.goal, self.planes, margin=self.params["search_margin_m"])
+        clearance = self.radius + self.params.escape_margin_m
+        window = self._window(obs.position, obs.goal, self.planes, margin=self.params.search_margin_m)
         if self._spans_a_gap(plane, others):
             decision.events.append(plane_refused(e1, e2, "would span a gap between obstacles"))
             plane = None
@@ -353,7 +359,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             )
             return
         self.planes.append(plane)
-        if len(self.planes) > self.params["max_planes"]:
+        if len(self.planes) > self.params.max_planes:
             self.planes.pop(0)
             decision.events.append(Event(EventKind.PLANE_RETIRED, "oldest virtual plane retired"))
         decision.events.append(plane_created(plane))
@@ -367,7 +373,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         the robot's width plus clearance (so a gap the robot fits through separates two).
         """
         p = self.params
-        occupied = (self.map.grid >= p["map_sure"]) & ~self.map.swept
+        occupied = (self.map.grid >= p.map_sure) & ~self.map.swept
         if self.map.origin is None or not occupied.any():
             return None
         reach = round(self._link_m() / 2 / self.map.cell_m)
@@ -426,7 +432,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         # the sonar has not seen free (an obstacle the map has not placed may stand there).
         room = self.radius + OBJECTIVE_ROOM_M
         roomy = gridsearch.clear_step_cost(
-            OBJECTIVE_ROOM_M, self.params["inflation_m"], self.params["inflation_weight"]
+            OBJECTIVE_ROOM_M, self.params.inflation_m, self.params.inflation_weight
         )
         seen_around = ndimage.distance_transform_edt(window.seen) * window.cell_m >= room
         usable = np.isfinite(costs) & seen_around & (window.cost <= roomy)
@@ -464,19 +470,19 @@ class VPlanePlusPlanner(VPlanePlanner):
             decision.events.append(
                 Event(EventKind.WAY_CHANGED, "the way ahead is blocked on the map: searched again")
             )
-        self.next_replan_s = obs.time_s + p["replan_period_s"]
+        self.next_replan_s = obs.time_s + p.replan_period_s
         way = self._way_to_goal(obs, decision)
         if way is None:
             self.follow_way = []
             if self.no_way_since is None:
                 self.no_way_since = obs.time_s
                 decision.events.append(Event(EventKind.WAY_CHANGED, "the map holds no way to the goal"))
-            elif obs.time_s - self.no_way_since >= p["no_way_patience_s"]:
+            elif obs.time_s - self.no_way_since >= p.no_way_patience_s:
                 decision.gave_up = True
                 decision.events.append(
                     Event(
                         EventKind.GAVE_UP,
-                        f"gave up: the map has held no way to the goal for {p['no_way_patience_s']:g} s",
+                        f"gave up: the map has held no way to the goal for {p.no_way_patience_s:g} s",
                     )
                 )
             return obs.goal
@@ -512,7 +518,7 @@ class VPlanePlusPlanner(VPlanePlanner):
     ) -> list[np.ndarray] | None:
         """The map's way from the robot to the goal: searched near them first (quick), then over
         the whole map before concluding there is none."""
-        for margin in (self.params["search_margin_m"], None):
+        for margin in (self.params.search_margin_m, None):
             way = self._way(self._window(robot, goal, planes, margin, relaxed), robot, goal)
             if way is not None:
                 return way
@@ -541,19 +547,19 @@ class VPlanePlusPlanner(VPlanePlanner):
         inside = (slice(low[0], high[0]), slice(low[1], high[1]))
         certainty = np.where(self.map.swept[inside], 0, grid[inside])
         cost = gridsearch.step_costs(
-            certainty >= p["map_sure"],
-            (certainty >= p["map_threshold"]) & (certainty < p["map_sure"]),
+            certainty >= p.map_sure,
+            (certainty >= p.map_threshold) & (certainty < p.map_sure),
             cell,
-            self.radius + p["path_clearance_m"],
-            p["inflation_m"],
-            p["inflation_weight"],
-            p["doubt_cost"],
+            self.radius + p.path_clearance_m,
+            p.inflation_m,
+            p.inflation_weight,
+            p.doubt_cost,
         )
         seen = self.map.seen[inside].copy()
         window = gridsearch.Window(cost, (self.map.origin + low) * cell, cell, seen)
         for k, stall in enumerate(self.stalls):
             again = any(np.hypot(*(stall - earlier)) < STALL_RADIUS_M for earlier in self.stalls[:k])
-            window.charge_disc(stall, STALL_RADIUS_M, np.inf if again and not relaxed else p["doubt_cost"])
+            window.charge_disc(stall, STALL_RADIUS_M, np.inf if again and not relaxed else p.doubt_cost)
         window.clear_disc(robot, self.radius)  # the robot stands there: its disc is free
         for plane in planes:  # but no way crosses a virtual plane, even under the robot
             window.block_segment(plane.e1, plane.e2)
@@ -590,7 +596,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         the robot are dropped from `way`: the robot has passed them."""
         if not way:
             return end
-        reach = self.params["waypoint_m"]
+        reach = self.params.waypoint_m
         distances = np.hypot(*(np.array(way) - position).T)
         nearest = int(np.argmin(distances))
         del way[:nearest]  # the robot has passed these

@@ -29,12 +29,12 @@ def _freeze(value: Any) -> Any:
     return value
 
 
-def _build_scenario(doc: dict[str, Any], source: str) -> Scenario:
+def _build_scenario(doc: dict[str, Any], source: str, recorded: bool) -> Scenario:
     """Validate a parsed document section by section, then the start and goal placement."""
     top = read_top(doc)
     world = read_world(doc)
     robot = read_robot(doc)
-    planner, params = read_planner(doc)
+    planner, params = read_planner(doc, recorded)
     scenario = Scenario(
         name=top["name"],
         description=top.get("description", ""),
@@ -59,13 +59,16 @@ def _parse_toml(text: str, source: str) -> dict[str, Any]:
         raise ScenarioError(source, "", f"invalid TOML: {exc}") from None
 
 
-def parse_scenario(text: str, source: str, overrides: Sequence[str] = ()) -> Scenario:
-    """Parse TOML text, apply `--set KEY=VALUE` overrides, validate: a Scenario or ScenarioError."""
+def parse_scenario(text: str, source: str, overrides: Sequence[str] = (), recorded: bool = False) -> Scenario:
+    """Parse TOML text, apply `--set KEY=VALUE` overrides, validate: a Scenario or ScenarioError.
+
+    `recorded`: the text is a finished run's scenario (from its log), whose planner need not be
+    registered in this process (nothing is imported either way)."""
     doc = _parse_toml(text, source)
     try:
         for override in overrides:
             apply_override(doc, override)
-        return _build_scenario(doc, source)
+        return _build_scenario(doc, source, recorded)
     except Invalid as exc:
         raise ScenarioError(source, exc.key, exc.reason) from None
     except Exception as exc:  # promised: no input ever escapes as anything but ScenarioError

@@ -14,13 +14,12 @@ from types import MappingProxyType
 from typing import Any
 
 from vplane_mj.planning import registry
-from vplane_mj.planning.params import Param
+from vplane_mj.planning.params import ParamError
+from vplane_mj.planning.plugins import is_import_spec
 from vplane_mj.robot import robot_facts
 from vplane_mj.scenario.fields import (
     Invalid,
     checked,
-    is_finite,
-    is_number,
     join_key,
     read_fields,
     sub_table,
@@ -113,34 +112,32 @@ def read_robot(doc: Mapping[str, Any]) -> RobotSpec:
     return RobotSpec(**values)
 
 
-def _param_reason(param: Param, value: Any) -> str | None:
-    """Param.check, also for integers too large for a float."""
-    if is_number(value) and not is_finite(value):
-        return f"must be finite, got {value!r}"
-    return param.check(value)
+def read_planner(doc: Mapping[str, Any], recorded: bool = False) -> tuple[str, Mapping[str, float]]:
+    """The planner's name and the parameters the file gives (checked against its dataclass).
 
-
-def read_planner(doc: Mapping[str, Any]) -> tuple[str, Mapping[str, float]]:
-    """The planner's name and the parameters the file gives (checked against its table)."""
+    `recorded`: the scenario of a finished run (a log's metadata), whose planner was checked
+    when it ran and need not be registered in this process; its parameters are kept as given.
+    """
     table = sub_table(doc, "planner")
     given = "name" in table
     name = checked(table.get("name", registry.DEFAULT_PLANNER), STRING, "planner.name")
+    if recorded and name not in registry.PLANNERS and NAME_PATTERN.fullmatch(name):
+        return name, MappingProxyType({key: value for key, value in table.items() if key != "name"})
     if name not in registry.PLANNERS:
         default = "" if given else " (the default)"
         known = ", ".join(sorted(registry.PLANNERS))
-        raise Invalid("planner.name", f"unknown planner {name!r}{default}; available: {known}")
-    info = registry.planner_info(name)
-    params = {}
-    for key, value in table.items():
-        if key == "name":
-            continue
-        if key not in info.params:
-            known = ", ".join(info.params)
-            raise Invalid(join_key("planner", key), f"not a parameter of planner {name!r} ({known})")
-        reason = _param_reason(info.params[key], value)
-        if reason:
-            raise Invalid(join_key("planner", key), reason)
-        params[key] = value if info.params[key].integer else float(value)
+        reason = f"unknown planner {name!r}{default}; available: {known}"
+        if is_import_spec(name):
+            reason += (
+                "; a scenario names a planner only by name: a planner class is imported only when "
+                "named on the command line (--planner module:Class) or registered in code"
+            )
+        raise Invalid("planner.name", reason)
+    overrides = {key: value for key, value in table.items() if key != "name"}
+    try:
+        params = registry.PLANNERS[name].Params.checked(overrides, name)
+    except ParamError as exc:
+        raise Invalid(join_key("planner", exc.key), exc.reason) from None
     return name, MappingProxyType(params)
 
 

@@ -1,0 +1,354 @@
+"""Planners from outside the package: the example planner through `run`, `bench` and `list`,
+registration in code and by installed entry points, and the rule that a scenario file never
+makes anything be imported."""
+
+from __future__ import annotations
+
+import json
+import multiprocessing
+import os
+import re
+import subprocess
+import sys
+import textwrap
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from vplane_mj.bench import plan_jobs, run_job
+from vplane_mj.errors import ScenarioError
+from vplane_mj.planning import (
+    DetectorParams,
+    Observation,
+    Planner,
+    PlannerError,
+    PlannerParams,
+    load_planner,
+    param,
+    register_planner,
+    registry,
+)
+from vplane_mj.robot import robot_radius_m
+from vplane_mj.sim import run_scenario
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLE = ROOT / "examples" / "random_walk_planner.py"
+EXAMPLE_SPEC = f"{EXAMPLE}:RandomWalkPlanner"
+
+SIDE_EFFECT_MODULE = """
+from pathlib import Path
+Path("imported.marker").write_text("imported")  # the import itself leaves a trace
+
+from vplane_mj.planning import Decision, Planner
+
+class Evil(Planner):
+    name = "evil"
+    summary = citation = "imports itself"
+
+    def step(self, obs):
+        return Decision(force=obs.goal - obs.position, mode="normal")
+"""
+
+OPEN_FIELD = """
+format = 1
+name = "from_a_file"
+[world]
+size = [5.0, 5.0]
+[robot]
+start = [1.0, 1.0]
+goal = [4.0, 4.0]
+[planner]
+name = "{planner}"
+"""
+
+
+def vplane_mj(*args: str, cwd: Path, env: dict | None = None) -> subprocess.CompletedProcess:
+    """`python -m vplane_mj ARGS` in a fresh process, in `cwd`."""
+    return subprocess.run(
+        [sys.executable, "-m", "vplane_mj", *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+    )
+
+
+@pytest.fixture
+def own_registry(monkeypatch):
+    """A registry of this test's own: what it registers is gone afterwards."""
+    monkeypatch.setattr(registry, "PLANNERS", registry._Planners())
+    return registry.PLANNERS
+
+
+# -- a scenario file is data: it never imports ----------------------------------------------
+
+
+@pytest.mark.parametrize("planner", ["os:system", "side_effect:Evil", "./side_effect.py:Evil"])
+def test_a_scenario_file_naming_a_class_is_refused_and_imports_nothing(tmp_path, planner):
+    (tmp_path / "side_effect.py").write_text(SIDE_EFFECT_MODULE)
+    (tmp_path / "attack.toml").write_text(OPEN_FIELD.format(planner=planner))
+    probe = (
+        "import sys\nfrom vplane_mj.cli import main\nstatus = main(sys.argv[1:])\n"
+        "print(status, 'side_effect' in sys.modules, any('side_effect' in m for m in sys.modules))"
+    )
+    for command in (["check", "attack.toml"], ["run", "attack.toml", "--out", "out"]):
+        done = subprocess.run(
+            [sys.executable, "-c", probe, *command], cwd=tmp_path, capture_output=True, text=True, timeout=120
+        )
+        assert done.stdout.split("\n")[-2] == "2 False False", done.stdout + done.stderr
+        expected = f"error: attack.toml: planner.name: unknown planner '{planner}'; available: apf, "
+        assert done.stderr.startswith(expected), done.stderr
+        assert "imported only when named on the command line (--planner module:Class)" in done.stderr
+        assert "Traceback" not in done.stderr
+    assert not (tmp_path / "imported.marker").exists()
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
+
+
+def test_set_planner_name_to_a_class_is_refused_too(tmp_path):
+    (tmp_path / "side_effect.py").write_text(SIDE_EFFECT_MODULE)
+    done = vplane_mj("run", "open_field", "--set", "planner.name=side_effect:Evil", cwd=tmp_path)
+    assert done.returncode == 2 and "planner.name: unknown planner 'side_effect:Evil'" in done.stderr
+    assert not (tmp_path / "imported.marker").exists()
+
+
+def test_the_command_line_imports_a_module_from_the_current_directory(tmp_path):
+    (tmp_path / "side_effect.py").write_text(SIDE_EFFECT_MODULE)
+    args = ["--no-render", "--no-log", "--set", "run.time_limit_s=3", "--out", "out"]
+    done = vplane_mj("run", "open_field", "--planner", "side_effect:Evil", *args, cwd=tmp_path)
+    assert done.returncode == 1, done.stderr  # 3 s are too short to reach the goal
+    assert (tmp_path / "imported.marker").exists()
+    summary = json.loads((tmp_path / "out" / "open_field-evil-0.json").read_text())
+    assert summary["planner"] == "evil" and summary["outcome"] == "timeout" and summary["path_length_m"] > 0.5
+
+
+@pytest.mark.parametrize(
+    ("spec", "reason"),
+    [
+        ("no_such_module:Planner", "cannot import no_such_module: ModuleNotFoundError"),
+        ("side_effect:Missing", "side_effect has no Missing"),
+        ("os:path", "path is not a subclass of vplane_mj.planning.Planner"),
+        ("missing/file.py:Planner", "no such file"),
+        ("bad_name:Bad", "its name must match [a-z0-9_]+ (it names output files), got 'Bad-Name'"),
+        ("clash:Clash", "its name 'apf' is a built-in planner's"),
+    ],
+)
+def test_a_bad_planner_class_on_the_command_line_is_exit_2_with_the_reason(tmp_path, spec, reason):
+    (tmp_path / "side_effect.py").write_text(SIDE_EFFECT_MODULE)
+    (tmp_path / "bad_name.py").write_text(
+        SIDE_EFFECT_MODULE.replace('"evil"', '"Bad-Name"').replace("Evil", "Bad")
+    )
+    (tmp_path / "clash.py").write_text(SIDE_EFFECT_MODULE.replace('"evil"', '"apf"').replace("Evil", "Clash"))
+    done = vplane_mj("run", "open_field", "--planner", spec, "--out", "out", cwd=tmp_path)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith(f"error: --planner: {spec}: ") and reason in done.stderr, done.stderr
+    assert "Traceback" not in done.stderr and not (tmp_path / "out").exists()
+
+
+# -- the example planner through the command line ----------------------------------------------
+
+
+def test_bench_runs_the_example_beside_a_built_in_planner_and_resumes(tmp_path):
+    spec = os.path.relpath(EXAMPLE, tmp_path) + ":RandomWalkPlanner"  # a relative path, as users type
+    args = ["bench", "paper_c_escape", "--planners", f"apf,{spec}", "--seeds", "0-1", "--jobs", "2"]
+    args += ["--set", "sensors.noise_std=0.01", "--set", "run.time_limit_s=80", "--out", "out"]
+    done = vplane_mj(*args, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    report = json.loads((tmp_path / "out" / "bench.json").read_text())
+    rows = {(row["planner"], row["seed"]): row for row in report["rows"]}
+    assert sorted(rows) == [("apf", 0), ("apf", 1), ("random_walk", 0), ("random_walk", 1)]
+    assert all(row["outcome"] in ("reached", "stuck", "timeout") for row in rows.values())
+    assert all(rows[("apf", seed)]["outcome"] == "stuck" for seed in (0, 1))  # APF has no escape
+    walks = [rows[("random_walk", seed)] for seed in (0, 1)]
+    assert all(row["local_minima"] >= 1 and row["escapes"] >= 1 for row in walks)  # it walked out
+    assert any(row["reached"] for row in walks)
+    assert all(row["planner_params"]["walk_s"] == 10.0 for row in walks)
+    assert [row["planner"] for row in report["table"]] == ["apf", "random_walk"]
+    assert "random_walk" in done.stdout and (tmp_path / "out" / "bench.html").exists()
+
+    again = vplane_mj(*args, cwd=tmp_path)  # the journal's keys name the planner: nothing to redo
+    assert again.returncode == 0 and "4 runs: 4 already done, 0 to run" in again.stderr
+
+
+def test_run_names_outputs_by_the_class_name_and_the_log_replays_without_it(tmp_path):
+    args = ["--set", "planner.walk_s=12", "--set", "run.time_limit_s=60", "--no-render", "--out", "out"]
+    done = vplane_mj("run", "paper_c_escape", "--planner", EXAMPLE_SPEC, *args, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    summary = json.loads((tmp_path / "out" / "paper_c_escape-random_walk-0.json").read_text())
+    assert summary["planner"] == "random_walk" and summary["planner_params"]["walk_s"] == 12.0
+    assert summary["reached"] and summary["escapes"] >= 1
+    # The log's own commands read it in a process where the planner is not registered.
+    replayed = vplane_mj("summary", "out/paper_c_escape-random_walk-0.mcap", cwd=tmp_path)
+    assert replayed.returncode == 0 and "agrees with the run's stored summary" in replayed.stdout
+
+
+def test_set_and_list_work_for_a_class_named_on_the_command_line(tmp_path):
+    bad = vplane_mj("run", "open_field", "--planner", EXAMPLE_SPEC, "--set", "planner.walk_z=3", cwd=tmp_path)
+    assert bad.returncode == 2
+    assert "open_field.toml: planner.walk_z: not a parameter of planner 'random_walk' (attract_gain," in (
+        bad.stderr
+    )
+    low = vplane_mj("run", "open_field", "--planner", EXAMPLE_SPEC, "--set", "planner.walk_s=0", cwd=tmp_path)
+    assert low.returncode == 2 and "planner.walk_s: must be greater than 0, got 0" in low.stderr
+    listed = vplane_mj("list", "--planner", EXAMPLE_SPEC, "--planner", "apf", cwd=tmp_path)
+    assert listed.returncode == 0, listed.stderr
+    lines = listed.stdout.splitlines()
+    assert "  random_walk: APF with a random-walk escape from local minima (an example planner)" in lines
+    assert any(line.split()[:3] == ["walk_s", "10", "s"] for line in lines)
+    assert any(line.startswith("  apf: ") for line in lines) and "Built-in scenarios:" not in lines
+
+
+# -- registration in code, and in the workers of a sweep ----------------------------------------
+
+
+@dataclass(frozen=True)
+class StraightParams(DetectorParams):
+    speed: float = param(0.6, "", "force toward the goal", gt=0, le=2)
+
+
+class StraightPlanner(Planner):
+    """Straight to the goal, blind."""
+
+    name = "straight"
+    summary = "straight to the goal"
+    citation = ""
+    Params = StraightParams
+
+    def step(self, obs: Observation):
+        from vplane_mj.planning import Decision, unit
+
+        return Decision(force=self.params.speed * unit(obs.goal - obs.position), mode="normal")
+
+
+def test_register_planner_makes_a_class_nameable_by_scenarios(own_registry, shipped):
+    assert "straight" not in own_registry
+    with pytest.raises(ScenarioError, match="unknown planner 'straight'"):
+        shipped("open_field", "planner.name=straight")
+    assert register_planner(StraightPlanner) is StraightPlanner
+    assert register_planner(StraightPlanner) is StraightPlanner  # again: nothing changes
+    assert list(own_registry)[-1] == "straight"
+    summary = run_scenario(shipped("open_field", "planner.name=straight", "planner.speed=1.2")).summary
+    assert summary.planner == "straight" and summary.reached
+    assert summary.planner_params == {**StraightParams().as_dict(), "speed": 1.2}
+    with pytest.raises(ScenarioError) as error:
+        shipped("open_field", "planner.name=straight", "planner.speed=3")
+    assert (error.value.key, error.value.reason) == ("planner.speed", "must be at most 2, got 3")
+
+
+def test_register_planner_refuses_what_is_no_planner(own_registry):
+    class Undecorated(StraightParams):  # no @dataclass(frozen=True): `gain` would be no field
+        gain: float = param(1.0, "", "a gain")
+
+    @dataclass(frozen=True)
+    class Plain(PlannerParams):
+        gain: float = 1.0  # not made by param()
+
+    @dataclass(frozen=True)
+    class OutOfBounds(PlannerParams):
+        gain: float = param(-1.0, "", "a gain", ge=0)
+
+    cases = {
+        "its Params is not a frozen dataclass": {"Params": Undecorated},
+        "its parameter 'gain' is not made by param(...)": {"Params": Plain},
+        "the default of its parameter 'gain' must be at least 0, got -1.0": {"Params": OutOfBounds},
+        "its name must match [a-z0-9_]+": {"name": "Straight"},
+        "its name 'vplane' is a built-in planner's": {"name": "vplane"},
+    }
+    for reason, attributes in cases.items():
+        cls = type("Variant", (StraightPlanner,), attributes)
+        with pytest.raises(PlannerError, match=re.escape(reason)):
+            register_planner(cls)
+    register_planner(StraightPlanner)
+    with pytest.raises(PlannerError, match="the name 'straight' is taken by"):
+        register_planner(type("Other", (StraightPlanner,), {}))
+    with pytest.raises(PlannerError, match="does not implement step"):
+        register_planner(type("Abstract", (Planner,), {"name": "abstract", "summary": "", "citation": ""}))
+
+
+def test_a_fresh_worker_registers_the_classes_the_job_names(own_registry):
+    load_planner(EXAMPLE_SPEC)
+    jobs = plan_jobs(["open_field"], ["random_walk"], [3], ["run.time_limit_s=2"], (EXAMPLE_SPEC,))
+    assert jobs[0].key.startswith("open_field|random_walk|3|")  # the key of a built-in's job, same form
+    # A spawned process starts with nothing registered, as a Dask worker does.
+    with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as pool:
+        row = pool.submit(run_job, jobs[0]).result(timeout=300)
+    assert row["key"] == jobs[0].key and row["planner"] == "random_walk" and row["outcome"] == "timeout"
+
+
+def test_the_example_walks_out_of_a_trap_repeatably(own_registry):
+    cls = load_planner(EXAMPLE_SPEC)
+    assert load_planner(EXAMPLE_SPEC) is cls and own_registry["random_walk"] is cls
+
+    def decisions(seed: int) -> list:
+        planner = cls.build({"walk_seed": seed}, robot_radius_m())
+        bearings = np.linspace(0.0, 2 * np.pi, 8, endpoint=False)
+        ranges = np.array([0.3] + [np.nan] * 7)  # a wall right in front of the robot
+        goal, here = np.array([5.0, 1.0]), np.array([1.0, 1.0])
+        # 12 s at 20 Hz without moving: a local minimum after 6 s, then a random walk
+        return [
+            planner.step(Observation(tick * 0.05, here, 0.0, goal, 0.15, bearings, ranges, 0.35))
+            for tick in range(240)
+        ]
+
+    first, again, other = decisions(0), decisions(0), decisions(1)
+    modes = [d.mode for d in first]
+    assert modes[0] == "normal" and modes[-1] == "escaping" and sum(d.local_minimum for d in first) == 1
+    walking = [d for d in first if d.mode == "escaping"]
+    assert all(np.isclose(np.hypot(*d.components["attractive"]), 0.8) for d in walking)
+    assert len({tuple(d.components["attractive"]) for d in walking}) >= 2  # a new direction every 2 s
+    assert all(np.array_equal(a.force, b.force) for a, b in zip(first, again, strict=True))
+    assert not all(np.array_equal(a.force, b.force) for a, b in zip(first, other, strict=True))
+
+
+# -- installed entry points -------------------------------------------------------------------
+
+INSTALLED = """
+from vplane_mj.planning import Decision, DetectorParams, Planner, param
+from dataclasses import dataclass
+import sys
+print("IMPORTING wander_pkg", file=sys.stderr)
+
+@dataclass(frozen=True)
+class WanderParams(DetectorParams):
+    pull: float = param(0.7, "", "force toward the goal", gt=0)
+
+class Wander(Planner):
+    name = "wander"
+    summary = "an installed planner"
+    citation = "none"
+    Params = WanderParams
+
+    def step(self, obs):
+        return Decision(force=self.params.pull * (obs.goal - obs.position), mode="normal")
+"""
+
+
+def test_an_installed_entry_point_is_listed_without_import_and_usable_by_name(tmp_path):
+    site = tmp_path / "site"
+    (site / "wander_pkg").mkdir(parents=True)
+    (site / "wander_pkg" / "__init__.py").write_text(INSTALLED)
+    info = site / "wander_pkg-1.0.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: wander-pkg\nVersion: 1.0\n")
+    (info / "entry_points.txt").write_text("[vplane_mj.planners]\nwander = wander_pkg:Wander\n")
+    env = {**os.environ, "PYTHONPATH": str(site)}
+    probe = textwrap.dedent(
+        """
+        import sys
+        from vplane_mj.planning.registry import PLANNERS
+        names = list(PLANNERS)
+        print(names[-1], "wander" in PLANNERS, "wander_pkg" in sys.modules)
+        print(PLANNERS["wander"].Params().pull, "wander_pkg" in sys.modules)
+        """
+    )
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, env=env, timeout=120)
+    assert done.stdout.split("\n")[:2] == ["wander True False", "0.7 True"], done.stdout + done.stderr
+    (tmp_path / "uses_it.toml").write_text(OPEN_FIELD.format(planner="wander"))
+    run = vplane_mj("run", "uses_it.toml", "--no-render", "--no-log", "--out", "out", cwd=tmp_path, env=env)
+    assert run.returncode == 0, run.stderr
+    assert json.loads((tmp_path / "out" / "from_a_file-wander-0.json").read_text())["planner"] == "wander"
+    listed = vplane_mj("list", cwd=tmp_path, env=env)
+    assert "  wander: an installed planner" in listed.stdout.splitlines()

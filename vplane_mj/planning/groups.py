@@ -1,0 +1,99 @@
+"""Parameter groups that several planners share, each with the set-up of what it configures.
+
+A planner's parameters combine them by inheritance (bases listed last group first, see
+`PlannerParams`): `FieldParams` (Khatib's fields, eqs. 2-6), `DetectorParams` (the
+local-minimum detector), `MinimumParams` (the detector and the patience of a planner without
+an escape), `LocalMapParams` (the sonar certainty grid) and `SonarMapParams` (the grid and its
+polar histogram).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vplane_mj.planning import fields
+from vplane_mj.planning.localmap import LocalMap
+from vplane_mj.planning.minima import LocalMinimumDetector
+from vplane_mj.planning.params import PlannerParams, param
+from vplane_mj.planning.types import Observation
+
+
+@dataclass(frozen=True)
+class FieldParams(PlannerParams):
+    """Khatib's FIRAS attraction and repulsion (the paper's eqs. 2-6)."""
+
+    attract_gain: float = param(0.5, "1/m", "omega of eqs. 2-3, attraction gain", gt=0)
+    attract_radius: float = param(1.0, "m", "r of eqs. 2-3, quadratic-to-conic switch distance", gt=0)
+    repulse_gain: float = param(0.02, "m", "eta of eqs. 4-5, repulsion gain per sonar echo", ge=0)
+    influence: float = param(0.8, "m", "f0 of eqs. 4-5, distance of influence of an echo", gt=0)
+
+    def firas_components(self, obs: Observation) -> dict[str, np.ndarray]:
+        """Eq. 6's two terms at the robot: attraction to the goal and repulsion from the echoes."""
+        return {
+            "attractive": fields.attractive_force(
+                obs.position, obs.goal, self.attract_gain, self.attract_radius
+            ),
+            "repulsive": fields.repulsive_force(
+                obs.position, obs.echo_points(), self.repulse_gain, self.influence
+            ),
+        }
+
+
+@dataclass(frozen=True)
+class DetectorParams(PlannerParams):
+    """The local-minimum detector's parameters (planners with an escape use only these)."""
+
+    stuck_window_s: float = param(4.0, "s", "t: window of the local-minimum criteria", gt=0)
+    stuck_displacement_m: float = param(0.2, "m", "d_th: least travel over the window", gt=0)
+    stuck_speed_mps: float = param(0.02, "m/s", "v_th: speed below which the robot counts as halted", ge=0)
+    startup_s: float = param(2.0, "s", "no detection during this time after the start", ge=0)
+
+    def detector(self) -> LocalMinimumDetector:
+        """A fresh local-minimum detector with these parameters."""
+        return LocalMinimumDetector(
+            window_s=self.stuck_window_s,
+            displacement_m=self.stuck_displacement_m,
+            speed_mps=self.stuck_speed_mps,
+            startup_s=self.startup_s,
+        )
+
+
+@dataclass(frozen=True)
+class MinimumParams(DetectorParams):
+    """The detector's parameters plus the patience of a planner without an escape."""
+
+    patience_s: float = param(15.0, "s", "time spent trapped before giving up (outcome stuck)", gt=0)
+
+
+@dataclass(frozen=True)
+class LocalMapParams(PlannerParams):
+    """The sonar certainty grid (localmap.py), shared by the planners that keep one."""
+
+    map_cell_m: float = param(0.1, "m", "cell size of the local sonar map", ge=0.05, le=1.0)
+    map_size_m: float = param(8.0, "m", "side of the square local map that follows the robot", gt=0, le=20.0)
+    map_threshold: int = param(
+        4, "", "certainty at which a map cell counts as an obstacle", ge=1, integer=True
+    )
+
+    def local_map(self) -> LocalMap:
+        """A fresh, empty sonar map of this cell size and side."""
+        return LocalMap(self.map_cell_m, self.map_size_m)
+
+
+@dataclass(frozen=True)
+class SonarMapParams(LocalMapParams):
+    """The sonar certainty grid and its polar histogram, shared by the planners that use them.
+
+    The bounds keep the grid (at most 400 x 400 cells) and the histogram (at most 720 sectors)
+    small enough to update at the control rate.
+    """
+
+    sector_deg: float = param(5.0, "deg", "polar histogram sector width", ge=0.5, le=45)
+    window_m: float = param(2.0, "m", "radius of the histogram's active window", gt=0)
+    histogram_threshold: float = param(1.0, "", "sector density above which a sector is blocked", gt=0)
+
+    def sector_count(self) -> int:
+        """Sectors of the polar histogram (at least 8)."""
+        return max(8, round(360.0 / self.sector_deg))
