@@ -353,22 +353,3 @@ def family_of(scenario: str) -> str:
     while len(parts) > 1 and parts[-1].isdigit():
         parts.pop()
     return "_".join(parts)
-
-
-def bench(
-    scenarios: list[str],
-    planners: list[str],
-    seeds: list[int],
-    out_dir: Path,
-    workers: int,
-    scheduler: str | None = None,
-    overrides: tuple[str, ...] = (),
-) -> int:
-    """The `vplane-mj bench` command after its arguments are parsed."""
-    jobs = plan_jobs(scenarios, planners, seeds, overrides)
-    rows = run_sweep(jobs, out_dir, workers, scheduler)
-    table = summarize(rows)
-    print(format_table(table))
-    for path in write_outputs(rows, table, out_dir, jobs):
-        print(f"wrote {path}")
-    return 0

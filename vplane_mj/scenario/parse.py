@@ -61,7 +61,12 @@ def _parse_toml(text: str, source: str) -> dict[str, Any]:
 
 def parse_scenario(text: str, source: str, overrides: Sequence[str] = ()) -> Scenario:
     """Parse TOML text, apply `--set KEY=VALUE` overrides, validate: a Scenario or ScenarioError."""
-    doc = _parse_toml(text, source)
+    return parse_document(_parse_toml(text, source), source, overrides)
+
+
+def parse_document(doc: dict[str, Any], source: str, overrides: Sequence[str] = ()) -> Scenario:
+    """Validate a document as TOML parses it (tables as dicts, arrays as lists), after the
+    `--set KEY=VALUE` overrides (applied to `doc` in place): a Scenario or ScenarioError."""
     try:
         for override in overrides:
             apply_override(doc, override)
