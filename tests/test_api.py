@@ -343,3 +343,12 @@ def test_sweep_rejects_invalid_input_before_any_run_and_leaves_no_directory(tmp_
     with pytest.raises(VPlaneError, match="jobs: must be at least 1, got 0"):
         sweep(["open_field"], ["apf"], jobs=0, out=tmp_path / "new" / "dir")
     assert not (tmp_path / "new").exists()
+
+
+def test_the_readme_examples_run(tmp_path, monkeypatch, readme_examples, capsys):
+    monkeypatch.chdir(tmp_path)
+    exec(compile(readme_examples("Python API"), "README.md", "exec"), {})
+    assert load_scenario("my_trap.toml").name == "my_trap"
+    assert (tmp_path / "logs" / "paper_c_escape-vplane-3.json").exists()
+    assert json.loads((tmp_path / "results" / "bench.json").read_text())["table"][0]["runs"] == 6
+    assert "paper_c_escape vplane 2 reached" in capsys.readouterr().out
