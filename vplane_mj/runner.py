@@ -11,6 +11,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -21,6 +22,9 @@ from vplane_mj.planning.events import Event, EventKind
 from vplane_mj.scenario import Scenario, load_scenario
 from vplane_mj.sim import RunResult, Tick, run_scenario
 from vplane_mj.summary import RunSummary
+
+if TYPE_CHECKING:
+    from vplane_mj.log_mcap import McapLog
 
 
 @dataclass(frozen=True)
@@ -148,7 +152,7 @@ def _simulate(
     return result
 
 
-def _open_log(scenario: Scenario, target: Path):
+def _open_log(scenario: Scenario, target: Path) -> McapLog:
     """An MCAP log written under a temporary name beside `target` (renamed when finished).
 
     A process killed outright leaves that `.partial` file: its flushed part (all but
@@ -163,7 +167,7 @@ def _open_log(scenario: Scenario, target: Path):
     return McapLog(partial, scenario, robot_radius_m(), bearings, scenario.sensors.range_max, {})
 
 
-def _finish_log(log, target: Path, summary: dict | None) -> Path:
+def _finish_log(log: McapLog, target: Path, summary: dict | None) -> Path:
     """Close the log (with the summary when the run finished) and give it its final name."""
     log.close(summary)
     os.replace(log.path, target)
