@@ -5,8 +5,10 @@ The on-disk cache is a fresh temporary directory for each run of the suite.
 """
 
 import os
+import re
 import shutil
 import tempfile
+from pathlib import Path
 
 import pytest
 from hypothesis import settings
@@ -45,3 +47,15 @@ def shipped():
         return load_scenario(name, list(overrides))
 
     return load
+
+
+@pytest.fixture
+def readme_examples():
+    """The Python code blocks of a README section (`## TITLE`), joined into one script."""
+
+    def blocks(title: str) -> str:
+        text = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
+        section = text.split(f"\n## {title}\n", 1)[1].split("\n## ", 1)[0]
+        return "\n".join(re.findall(r"```python\n(.*?)```", section, re.S))
+
+    return blocks

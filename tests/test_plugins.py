@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from vplane_mj.bench import plan_jobs, run_job
-from vplane_mj.errors import ScenarioError
+from vplane_mj.errors import ScenarioError, VPlaneError
 from vplane_mj.planning import (
     DetectorParams,
     Observation,
@@ -31,8 +31,10 @@ from vplane_mj.planning import (
     register_planner,
     registry,
 )
+from vplane_mj.planning.plugins import canonical_spec
 from vplane_mj.robot import robot_radius_m
 from vplane_mj.sim import run_scenario
+from vplane_mj.sweeps import sweep
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLE = ROOT / "examples" / "random_walk_planner.py"
@@ -270,8 +272,9 @@ def test_register_planner_refuses_what_is_no_planner(own_registry):
 
 def test_a_fresh_worker_registers_the_classes_the_job_names(own_registry):
     load_planner(EXAMPLE_SPEC)
-    jobs = plan_jobs(["open_field"], ["random_walk"], [3], ["run.time_limit_s=2"], (EXAMPLE_SPEC,))
+    jobs = plan_jobs(["open_field"], ["random_walk", "apf"], [3], ["run.time_limit_s=2"])
     assert jobs[0].key.startswith("open_field|random_walk|3|")  # the key of a built-in's job, same form
+    assert jobs[0].planner_imports == (canonical_spec(EXAMPLE_SPEC),)  # what a worker must import
     # A spawned process starts with nothing registered, as a Dask worker does.
     with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as pool:
         row = pool.submit(run_job, jobs[0]).result(timeout=300)
@@ -352,3 +355,12 @@ def test_an_installed_entry_point_is_listed_without_import_and_usable_by_name(tm
     assert json.loads((tmp_path / "out" / "from_a_file-wander-0.json").read_text())["planner"] == "wander"
     listed = vplane_mj("list", cwd=tmp_path, env=env)
     assert "  wander: an installed planner" in listed.stdout.splitlines()
+
+
+def test_sweep_takes_planner_classes_and_import_specs(own_registry):
+    cls = load_planner(EXAMPLE_SPEC)
+    result = sweep(["open_field"], [cls, "apf"], [0], ["run.time_limit_s=3"], jobs=1, out=None)
+    assert [row["planner"] for row in result.rows] == ["random_walk", "apf"]
+    assert all(row["outcome"] == "timeout" for row in result.rows)  # 3 s is too short to arrive
+    with pytest.raises(VPlaneError, match=r"^planners: nowhere:Nope: cannot import nowhere"):
+        sweep(["open_field"], ["nowhere:Nope"], [0], jobs=1, out=None)

@@ -1,6 +1,13 @@
-"""vplane-mj: artificial potential fields and the virtual-plane escape from local minima in MuJoCo."""
+"""vplane-mj: artificial potential fields and the virtual-plane escape from local minima in MuJoCo.
 
+The Python API (README "Python API"): `load_scenario` and `build_scenario` (with the obstacle
+helpers `box`, `wall`, `cylinder`, `cup`, `h_shape`), `run` and `sweep`. Each name is imported
+on first use, so `import vplane_mj` loads neither MuJoCo nor any plotting or OpenGL library.
+"""
+
+import importlib
 import os
+from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
 
@@ -9,3 +16,78 @@ __version__ = "0.1.0"
 GL_CHOSEN_BY_USER = "MUJOCO_GL" in os.environ
 os.environ.setdefault("MUJOCO_GL", "osmesa")
 os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
+
+_EXPORTS = {
+    "vplane_mj.scenario": (
+        "Scenario",
+        "ScenarioError",
+        "box",
+        "build_scenario",
+        "cup",
+        "cylinder",
+        "h_shape",
+        "load_scenario",
+        "wall",
+    ),
+    "vplane_mj.errors": ("VPlaneError",),
+    "vplane_mj.summary": ("Outcome", "RunSummary"),
+    "vplane_mj.planning.events": ("EventKind",),
+    "vplane_mj.runner": ("RunEvent", "RunRecord", "Trajectory", "run"),
+    "vplane_mj.sweeps": ("SweepResult", "sweep"),
+}
+"""Module -> the public names it provides."""
+_MODULE_OF = {name: module for module, names in _EXPORTS.items() for name in names}
+
+__all__ = [
+    "EventKind",
+    "Outcome",
+    "RunEvent",
+    "RunRecord",
+    "RunSummary",
+    "Scenario",
+    "ScenarioError",
+    "SweepResult",
+    "Trajectory",
+    "VPlaneError",
+    "box",
+    "build_scenario",
+    "cup",
+    "cylinder",
+    "h_shape",
+    "load_scenario",
+    "run",
+    "sweep",
+    "wall",
+]
+
+if TYPE_CHECKING:
+    from vplane_mj.errors import VPlaneError
+    from vplane_mj.planning.events import EventKind
+    from vplane_mj.runner import RunEvent, RunRecord, Trajectory, run
+    from vplane_mj.scenario import (
+        Scenario,
+        ScenarioError,
+        box,
+        build_scenario,
+        cup,
+        cylinder,
+        h_shape,
+        load_scenario,
+        wall,
+    )
+    from vplane_mj.summary import Outcome, RunSummary
+    from vplane_mj.sweeps import SweepResult, sweep
+
+
+def __getattr__(name: str) -> Any:
+    """A public name, imported from its module on first use (PEP 562)."""
+    module = _MODULE_OF.get(name)
+    if module is None:
+        raise AttributeError(f"module 'vplane_mj' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

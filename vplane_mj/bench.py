@@ -92,21 +92,26 @@ def parse_seeds(text: str) -> list[int]:
 
 
 def plan_jobs(
-    scenarios: Iterable[str],
-    planners: Iterable[str],
-    seeds: Iterable[int],
-    overrides: Iterable[str] = (),
-    planner_imports: tuple[str, ...] = (),
+    scenarios: Iterable[str], planners: Iterable[str], seeds: Iterable[int], overrides: Iterable[str] = ()
 ) -> list[Job]:
     """Every combination, with `--set` style overrides, each validated as `vplane-mj run` would;
-    `planner_imports` (already registered here) go with every job to its worker."""
+    the import specs of the planners registered in this process go with every job to its worker."""
+    planners = list(planners)
+    imports = worker_imports(planners)
     jobs = []
     for ref in scenarios:
         for planner in planners:
             for seed in seeds:
                 scenario = load_scenario(ref, [*overrides, f"planner.name={planner}", f"run.seed={seed}"])
-                jobs.append(Job(scenario.name, planner, seed, scenario.to_toml(), planner_imports))
+                jobs.append(Job(scenario.name, planner, seed, scenario.to_toml(), imports))
     return jobs
+
+
+def worker_imports(planners: Iterable[str]) -> tuple[str, ...]:
+    """The import specs a worker needs for these planners (none for built-in or installed ones)."""
+    from vplane_mj.planning.registry import worker_spec
+
+    return tuple(dict.fromkeys(spec for name in planners if (spec := worker_spec(name))))
 
 
 PATH_KEY = "path_xy"
@@ -367,23 +372,3 @@ def family_of(scenario: str) -> str:
     while len(parts) > 1 and parts[-1].isdigit():
         parts.pop()
     return "_".join(parts)
-
-
-def bench(
-    scenarios: list[str],
-    planners: list[str],
-    seeds: list[int],
-    out_dir: Path,
-    workers: int,
-    scheduler: str | None = None,
-    overrides: tuple[str, ...] = (),
-    planner_imports: tuple[str, ...] = (),
-) -> int:
-    """The `vplane-mj bench` command after its arguments are parsed."""
-    jobs = plan_jobs(scenarios, planners, seeds, overrides, planner_imports)
-    rows = run_sweep(jobs, out_dir, workers, scheduler)
-    table = summarize(rows)
-    print(format_table(table))
-    for path in write_outputs(rows, table, out_dir, jobs):
-        print(f"wrote {path}")
-    return 0

@@ -13,15 +13,14 @@ import vplane_mj
 from vplane_mj.errors import VPlaneError
 from vplane_mj.families import FAMILIES
 from vplane_mj.interrupts import Interrupted, signals_raise_interrupted
-from vplane_mj.outputs import output_directory, prepare_out_dir, write_atomically, write_json
-from vplane_mj.planning.plugins import PlannerError, canonical_spec, is_import_spec
-from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS, load_planner
+from vplane_mj.outputs import DEFAULT_OUT, prepare_out_dir, write_atomically
+from vplane_mj.planning.plugins import PlannerError
+from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
 
 if TYPE_CHECKING:
     from vplane_mj.scenario import Scenario
     from vplane_mj.summary import RunSummary
 
-DEFAULT_OUT = Path("logs")
 EXIT_REACHED, EXIT_NOT_REACHED, EXIT_INVALID = 0, 1, 2
 
 
@@ -189,12 +188,9 @@ def _planner_name(reference: str, option: str) -> str:
     """The name of a planner given on the command line: a name as it is, or the name of the
     class an import spec names (imported and registered here: only the user's own command line
     imports anything, never a scenario file)."""
-    if not is_import_spec(reference):
-        return reference
-    try:
-        return load_planner(reference).name
-    except PlannerError as exc:
-        raise VPlaneError(f"{option}: {exc}") from None
+    from vplane_mj.sweeps import planner_name
+
+    return planner_name(reference, option)
 
 
 def _overrides(args: argparse.Namespace) -> list[str]:
@@ -207,68 +203,36 @@ def _overrides(args: argparse.Namespace) -> list[str]:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from vplane_mj.runner import run
     from vplane_mj.scenario import load_scenario
-    from vplane_mj.sim import run_scenario
 
     scenario = load_scenario(args.scenario, _overrides(args))
     if args.video and args.no_log:
         raise VPlaneError("--video: the video is made from the log: drop --no-log")
     out_dir = prepare_out_dir(args.out or DEFAULT_OUT)
-    base = out_dir / f"{scenario.name}-{scenario.planner}-{scenario.run.seed}"
-    mcap_path = base.with_suffix(".mcap")
-    log = None if args.no_log else _open_log(scenario, mcap_path)
     try:
         with signals_raise_interrupted():
-            result = run_scenario(scenario, observers=(log,) if log else ())
+            record = run(scenario, out_dir, log=not args.no_log, render=not args.no_render, video=args.video)
     except Interrupted as exc:
-        written = [_finish_log(log, mcap_path, None)] if log else []
-        print(f"interrupted by {exc}: the run was stopped, no summary was written", file=sys.stderr)
-        for path in written:
-            print(f"wrote {path} (closed cleanly, up to the interruption)", file=sys.stderr)
+        _report_interrupted_run(exc)
         return exc.exit_status
-    except BaseException:
-        if log:  # keep nothing half-written
-            log.close()
-            log.path.unlink(missing_ok=True)
-        raise
-    summary = result.summary
-    written = [_finish_log(log, mcap_path, summary.to_dict())] if log else []
-    written.append(write_json(base.with_suffix(".json"), summary.to_dict()))
-    if not args.no_render:
-        from vplane_mj.render import render_top_view, write_png
-
-        image = render_top_view(scenario, result.track())
-        written.append(write_atomically(base.with_suffix(".png"), lambda tmp: write_png(image, tmp)))
-    if args.video:
-        from vplane_mj.video import write_video
-
-        written.append(write_video(mcap_path, base.with_suffix(".mp4")))
-    print(_summary_line(scenario, summary))
-    for path in written:
+    print(_summary_line(scenario, record.summary))
+    for path in record.files.values():
         print(f"wrote {path}")
-    return EXIT_REACHED if summary.reached else EXIT_NOT_REACHED
+    return EXIT_REACHED if record.reached else EXIT_NOT_REACHED
 
 
-def _open_log(scenario: Scenario, target: Path):
-    """An MCAP log written under a temporary name beside `target` (renamed when finished).
-
-    A process killed outright leaves that `.partial` file: its flushed part (all but
-    about the last simulated second) is readable with `vplane_mj.log_read.read_log`.
-    """
-    from vplane_mj.log_mcap import McapLog
-    from vplane_mj.robot import robot_radius_m
-    from vplane_mj.world import SonarLayout
-
-    bearings = SonarLayout.from_spec(scenario.sensors).bearings
-    partial = target.with_name(f".{target.name}.partial")
-    return McapLog(partial, scenario, robot_radius_m(), bearings, scenario.sensors.range_max, {})
-
-
-def _finish_log(log, target: Path, summary: dict | None) -> Path:
-    """Close the log (with the summary when the run finished) and give it its final name."""
-    log.close(summary)
-    os.replace(log.path, target)
-    return target
+def _report_interrupted_run(exc: Interrupted) -> None:
+    """Say what an interruption left: the log closed cleanly up to it, or the whole outputs of a
+    run that had finished and was being written."""
+    if "summary" in exc.written:
+        print(f"interrupted by {exc}: the run's outputs were being written", file=sys.stderr)
+        closed = ""
+    else:
+        print(f"interrupted by {exc}: the run was stopped, no summary was written", file=sys.stderr)
+        closed = " (closed cleanly, up to the interruption)"
+    for path in exc.written.values():
+        print(f"wrote {path}{closed}", file=sys.stderr)
 
 
 def _summary_line(scenario: Scenario, s: RunSummary) -> str:
@@ -282,27 +246,32 @@ def _summary_line(scenario: Scenario, s: RunSummary) -> str:
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from vplane_mj.bench import bench, parse_seeds
+    from vplane_mj.bench import format_table, parse_seeds
+    from vplane_mj.sweeps import sweep
 
     if args.jobs < 1:
         raise VPlaneError(f"--jobs: must be at least 1, got {args.jobs}")
     references = sorted(PLANNERS) if args.planners is None else [p.strip() for p in args.planners.split(",")]
     planners = [_planner_name(reference, "--planners") for reference in references]
-    imports = tuple(canonical_spec(reference) for reference in references if is_import_spec(reference))
     seeds = parse_seeds(args.seeds)
-    with signals_raise_interrupted(), output_directory(args.out or DEFAULT_OUT) as out_dir:
-        try:
-            return bench(
-                args.scenarios, planners, seeds, out_dir, args.jobs, args.scheduler, tuple(args.set), imports
+    out_dir = args.out or DEFAULT_OUT
+    try:
+        with signals_raise_interrupted():
+            result = sweep(
+                args.scenarios, planners, seeds, tuple(args.set), args.jobs, args.scheduler, out_dir
             )
-        except Interrupted as exc:
-            end_of_progress_bar = "\n" if sys.stderr.isatty() else ""
-            print(
-                f"{end_of_progress_bar}interrupted by {exc}: finished runs are kept in "
-                f"{out_dir / 'bench.jsonl'}; run the same command again to complete the sweep",
-                file=sys.stderr,
-            )
-            return exc.exit_status
+    except Interrupted as exc:
+        end_of_progress_bar = "\n" if sys.stderr.isatty() else ""
+        print(
+            f"{end_of_progress_bar}interrupted by {exc}: finished runs are kept in "
+            f"{out_dir / 'bench.jsonl'}; run the same command again to complete the sweep",
+            file=sys.stderr,
+        )
+        return exc.exit_status
+    print(format_table(result.table))
+    for path in result.files:
+        print(f"wrote {path}")
+    return 0
 
 
 def _generate(args: argparse.Namespace) -> int:

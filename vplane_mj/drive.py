@@ -67,6 +67,14 @@ class Drive:
         qvel = self.data.qvel
         return math.hypot(qvel[self.root_dof], qvel[self.root_dof + 1])
 
+    def body_velocity(self) -> tuple[float, float]:
+        """The speed along the heading (m/s, negative when reversing) and the turn rate about +z
+        (rad/s): the free joint's linear velocity is in the world frame, its angular one in
+        base_link's."""
+        qvel, yaw = self.data.qvel, self.yaw()
+        forward = qvel[self.root_dof] * math.cos(yaw) + qvel[self.root_dof + 1] * math.sin(yaw)
+        return float(forward), float(qvel[self.root_dof + 5])
+
     def wheel_angles(self) -> tuple[float, float]:
         """The wheels' encoder angles (rad), left and right."""
         return float(self.data.qpos[self.wheel_qpos[0]]), float(self.data.qpos[self.wheel_qpos[1]])

@@ -5,14 +5,20 @@ from __future__ import annotations
 import contextlib
 import signal
 from collections.abc import Iterator
+from pathlib import Path
 
 
 class Interrupted(Exception):
-    """The process received SIGINT or SIGTERM; `exit_status` is the conventional 128 + signal."""
+    """The process received SIGINT or SIGTERM; `exit_status` is the conventional 128 + signal.
+
+    `written` holds the files that the interrupted work had written whole, by role (as
+    `RunRecord.files`), for the message.
+    """
 
     def __init__(self, signum: int):
         self.signum = signum
         self.exit_status = 128 + signum
+        self.written: dict[str, Path] = {}
         super().__init__(signal.Signals(signum).name)
 
 

@@ -11,6 +11,9 @@ from pathlib import Path
 
 from vplane_mj.errors import VPlaneError
 
+DEFAULT_OUT = Path("logs")
+"""Where runs and sweeps write their files unless told otherwise."""
+
 
 def prepare_out_dir(path: Path) -> Path:
     """`path` as a directory that files can be written into, created with its parents if missing.

@@ -2,6 +2,8 @@
 
 `Run` steps one control tick at a time (`step`) and decides in one place how the run ends
 (`_ending`: the six ways, in the order they are checked); `run_scenario` runs it to the end.
+A tick is two halves: `observe` (sense) and `apply` (a decision drives the wheels), so that
+a decision can also come from outside (the Gymnasium environment, `vplane_mj.gym_env`).
 The planner sees only an Observation (pose, goal, sonar ranges). The simulator's obstacle
 geometry is used only to score the run (clearance) and to draw it, never to plan.
 """
@@ -28,6 +30,9 @@ from vplane_mj.scenario import Scenario
 from vplane_mj.sonar import SonarRays, SonarRing
 from vplane_mj.summary import Outcome, RunSummary
 from vplane_mj.world import ROBOT_PREFIX, SonarLayout, build_model
+
+EXTERNAL_PLANNER = "external"
+"""The summary's planner name of a run whose decisions come from outside the package."""
 
 
 @dataclass(frozen=True)
@@ -72,6 +77,8 @@ class RunResult:
     summary: RunSummary
     times: np.ndarray
     positions: np.ndarray
+    yaws: np.ndarray
+    """base_link's yaw (rad) at each control tick, like `positions` (m) and `modes`."""
     modes: list[str]
     final_pose: tuple[float, float, float]
     """base_link's x, y (m) and yaw (rad) when the run ended."""
@@ -98,7 +105,10 @@ class RunResult:
 class Run:
     """One run of a scenario, a control tick at a time (see the module docstring)."""
 
-    def __init__(self, scenario: Scenario, observers: tuple[Observer, ...] = ()):
+    def __init__(self, scenario: Scenario, observers: tuple[Observer, ...] = (), external: bool = False):
+        """`external`: the decisions come from outside through `observe` and `apply` (a learned
+        policy, say), not from the scenario's planner, which is then not made; the summary
+        names the planner EXTERNAL_PLANNER."""
         self.scenario = scenario
         self.observers = observers
         self.model = build_model(scenario, rangefinders=False)
@@ -122,7 +132,10 @@ class Run:
         self.rays = SonarRays(sonar_model, first_ray, sensors.count * sensors.rays_per_sonar, self.data)
         self.localiser = Localiser(self.drive, scenario)
         self.radius = self.drive.geometry["radius_m"]
-        self.planner = make_planner(scenario.planner, scenario.planner_params, self.radius)
+        self.planner_name = EXTERNAL_PLANNER if external else scenario.planner
+        self.planner = (
+            None if external else make_planner(scenario.planner, scenario.planner_params, self.radius)
+        )
         world = scenario.world
         self.clearance = Clearance(
             shapes.scene_footprints(world.obstacles, world.size if world.border else None)
@@ -149,39 +162,90 @@ class Run:
         self.wall_time_s = 0.0
         self._belief: tuple[np.ndarray, float] | None = None
         self._decision: Decision | None = None
+        self._observation: Observation | None = None
         self._note(
             Event(
                 EventKind.RUN_STARTED,
-                f"run started: {scenario.name}, planner {scenario.planner}, seed {scenario.run.seed}",
+                f"run started: {scenario.name}, planner {self.planner_name}, seed {scenario.run.seed}",
             )
         )
 
     # -- the loop ---------------------------------------------------------------------------
     def step(self) -> Ending | None:
-        """One control tick: sense, plan and act; the ending once the run is over (it stays over)."""
-        if self.ending is not None:
+        """One control tick with the planner: `observe`, its decision, `apply`; the ending once
+        the run is over (it stays over)."""
+        if self.planner is None:
+            raise RuntimeError("step: this run's decisions come from outside: use observe and apply")
+        observation = self.observe()
+        if observation is None:
             return self.ending
         started = time.perf_counter()
-        self._belief = self._decision = None
-        if (ending := self._ending()) is None:
-            self._sense()
-            if (ending := self._ending()) is None:
-                self._plan()
-                ending = self._ending()
-                if ending is None or ending.outcome is Outcome.STUCK:
-                    self._report()  # observers see the tick the planner gave up on
-                if ending is None:
-                    self._act()
-        self.wall_time_s += time.perf_counter() - started
-        if ending is not None:
-            self._finish(ending)
-        return ending
+        decision = self.planner.step(observation)
+        elapsed = time.perf_counter() - started
+        self.planner_cpu.append(elapsed)
+        self.wall_time_s += elapsed
+        return self.apply(decision)
 
     def run(self) -> RunResult:
         """Step to the end of the run; its result."""
         while self.step() is None:
             pass
         return self.result()
+
+    def observe(self) -> Observation | None:
+        """Begin a control tick: check the physics state, read the sonar and the pose; what the
+        planner sees on this tick, or None once the run is over.
+
+        `step` passes it to the planner; a decision made elsewhere (a learned policy) is
+        given back through `apply`, which ends the tick.
+        """
+        if self.ending is not None:
+            return None
+        if self._observation is not None:
+            raise RuntimeError("observe: the decision of the current tick has not been applied")
+        started = time.perf_counter()
+        self._belief = self._decision = None
+        if (ending := self._ending()) is None:
+            self._sense()
+            ending = self._ending()
+        self.wall_time_s += time.perf_counter() - started
+        if ending is not None:
+            self._finish(ending)
+            return None
+        believed_xy, believed_yaw = self._belief
+        self._observation = Observation(
+            self.data.time,
+            believed_xy,
+            believed_yaw,
+            self.goal,
+            self.tolerance,
+            self.layout.bearings,
+            self.ranges,
+            self.beam,
+        )
+        return self._observation
+
+    def apply(self, decision: Decision, command: tuple[float, float] | None = None) -> Ending | None:
+        """End the tick begun by `observe` with a decision: record it, drive the wheels for one
+        control period; the ending once the run is over.
+
+        `command`, when given, is the body speed (m/s) and turn rate (rad/s) to drive instead
+        of the heading controller's answer to the decision's force.
+        """
+        if self._observation is None:
+            raise RuntimeError("apply: call observe first (and only while the run goes on)")
+        self._observation = None
+        started = time.perf_counter()
+        self._take(decision)
+        ending = self._ending()
+        if ending is None or ending.outcome is Outcome.STUCK:
+            self._report(command)  # observers see the tick the planner gave up on
+        if ending is None:
+            self._act()
+        self.wall_time_s += time.perf_counter() - started
+        if ending is not None:
+            self._finish(ending)
+        return ending
 
     def _ending(self) -> Ending | None:
         """The one place that decides whether the run is over, and how (dm_env's LAST step).
@@ -214,7 +278,7 @@ class Run:
             return None
         force = self._decision.force
         if not (math.isfinite(force[0]) and math.isfinite(force[1])):
-            message = f"planner {self.scenario.planner!r} gave a non-finite force at t = {time_s:.3f} s"
+            message = f"planner {self.planner_name!r} gave a non-finite force at t = {time_s:.3f} s"
             return Ending(Outcome.ERROR, Event(EventKind.ERROR, message))
         if self._decision.gave_up:
             gave_up = [e for e in self._decision.events if e.kind is EventKind.GAVE_UP]
@@ -233,22 +297,8 @@ class Run:
         self.yaws.append(self.yaw)
         self._belief = self.localiser.pose(self.position, self.yaw)
 
-    def _plan(self) -> None:
-        """The planner's decision on this tick's observation, its events and its virtual objects."""
-        believed_xy, believed_yaw = self._belief
-        observation = Observation(
-            self.data.time,
-            believed_xy,
-            believed_yaw,
-            self.goal,
-            self.tolerance,
-            self.layout.bearings,
-            self.ranges,
-            self.beam,
-        )
-        started = time.perf_counter()
-        decision = self.planner.step(observation)
-        self.planner_cpu.append(time.perf_counter() - started)
+    def _take(self, decision: Decision) -> None:
+        """Keep the tick's decision: its events, its local minima and escapes, its virtual objects."""
         self._decision = decision
         force = decision.force
         if not (math.isfinite(force[0]) and math.isfinite(force[1])):
@@ -261,13 +311,16 @@ class Run:
         if decision.objective is not None or decision.planes:
             _collect_virtual(decision, self.objectives, self.planes)
 
-    def _report(self) -> None:
-        """Record the tick and show it to the observers."""
+    def _report(self, command: tuple[float, float] | None) -> None:
+        """Record the tick (with its command: the given one, else the heading controller's) and
+        show it to the observers."""
         decision = self._decision
         believed_xy, believed_yaw = self._belief
-        self.command = heading_command(
-            float(decision.force[0]), float(decision.force[1]), believed_yaw, self.drive.gains
-        )
+        if command is None:
+            command = heading_command(
+                float(decision.force[0]), float(decision.force[1]), believed_yaw, self.drive.gains
+            )
+        self.command = command
         self.times.append(self.data.time)
         self.positions.append(self.position)
         self.modes.append(decision.mode)
@@ -323,6 +376,7 @@ class Run:
             summary=self.summary(),
             times=np.array(self.times),
             positions=np.array(self.positions).reshape(-1, 2),
+            yaws=np.array(self.yaws[: len(self.times)]),  # a last reading may end the run unrecorded
             modes=self.modes,
             final_pose=(float(self.position[0]), float(self.position[1]), self.drive.yaw()),
             torques=np.array(self.drive.torques).reshape(-1, 2),
@@ -338,7 +392,7 @@ class Run:
         cpu = self.planner_cpu
         return RunSummary(
             scenario=scenario.name,
-            planner=scenario.planner,
+            planner=self.planner_name,
             seed=scenario.run.seed,
             outcome=ending.outcome,
             reached=reached,
@@ -373,7 +427,7 @@ class Run:
             odometry_error_m=self.localiser.error(self.position),
             trajectory_sha256=trajectory_digest(self.positions, self.position, self.drive.yaw()),
             message="" if reached or ending.outcome is Outcome.TIMEOUT else ending.event.text,
-            planner_params=self.planner.params.as_dict(),
+            planner_params={} if self.planner is None else self.planner.params.as_dict(),
             version=__version__,
         )
 

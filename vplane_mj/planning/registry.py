@@ -11,7 +11,9 @@ planner it uses (some need scipy, whose import costs more than a short run's loo
 from __future__ import annotations
 
 import importlib
+import sys
 from collections.abc import Iterator, Mapping
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from vplane_mj.planning.base import Planner
@@ -47,6 +49,7 @@ class _Planners(Mapping[str, type[Planner]]):
         self._classes: dict[str, type[Planner]] = {}
         self._registered: list[str] = []
         self._specs: dict[str, type[Planner]] = {}
+        self._worker_specs: dict[str, str | None] = {}
         self._installed: dict[str, EntryPoint] | None = None
 
     def installed(self) -> dict[str, EntryPoint]:
@@ -105,6 +108,7 @@ class _Planners(Mapping[str, type[Planner]]):
             raise PlannerError(f"{where}: the name {name!r} is taken by {taken}")
         self._classes[name] = cls
         self._registered.append(name)
+        self._worker_specs[name] = _importable_spec(cls)
         return cls
 
     def load(self, spec: str) -> type[Planner]:
@@ -114,7 +118,22 @@ class _Planners(Mapping[str, type[Planner]]):
         if cls is None:
             cls = self.register(import_planner(spec), source=spec)
             self._specs[key] = cls
+            self._worker_specs[cls.name] = key
         return cls
+
+    def worker_spec(self, name: str) -> str | None:
+        """The import spec another process (a sweep's worker) imports to know planner `name`:
+        None for a built-in or installed planner, which every process knows by its name."""
+        return self._worker_specs.get(name)
+
+
+def _importable_spec(cls: type) -> str | None:
+    """`module:Class` for a class another process can import; for a class of the script being
+    run (`__main__`), that script's file; None when neither exists (an interactive session)."""
+    if cls.__module__ != "__main__":
+        return _qualified(cls)
+    script = getattr(sys.modules["__main__"], "__file__", None)
+    return f"{Path(script).resolve()}:{cls.__qualname__}" if script else None
 
 
 def _load_entry_point(entry_point: EntryPoint) -> type[Planner]:
@@ -147,6 +166,11 @@ def load_planner(spec: str) -> type[Planner]:
     """Import and register the planner class `module:Class` or `path/to/file.py:Class` names
     (the module looked up as `python -m` would, the current directory first)."""
     return PLANNERS.load(spec)
+
+
+def worker_spec(name: str) -> str | None:
+    """How a worker process imports registered planner `name` (None: it needs no import)."""
+    return PLANNERS.worker_spec(name)
 
 
 def planner_info(name: str) -> PlannerInfo:

@@ -10,7 +10,8 @@ reason. The parts, one job each:
 - `sections.py`: each table read into its dataclass, with the rules that span keys;
 - `placement.py`: start and goal inside the arena and clear of walls and obstacles;
 - `overrides.py`: `--set KEY=VALUE` applied to the parsed document;
-- `parse.py`: text and overrides -> Scenario.
+- `parse.py`: text and overrides -> Scenario;
+- `build.py`: a scenario from Python values, as the document a file would hold.
 
 This module finds the files: a path, a name in ./scenarios/, or a built-in scenario.
 """
@@ -22,6 +23,7 @@ from pathlib import Path
 
 from vplane_mj.errors import ScenarioError
 from vplane_mj.resources import data_dir
+from vplane_mj.scenario.build import CODE_SOURCE, box, build_scenario, cup, cylinder, h_shape, wall
 from vplane_mj.scenario.fields import Field
 from vplane_mj.scenario.keys import (
     FORMAT,
@@ -32,10 +34,11 @@ from vplane_mj.scenario.keys import (
     MIN_OBSTACLE_M,
     NAME_PATTERN,
 )
-from vplane_mj.scenario.parse import parse_scenario
+from vplane_mj.scenario.parse import parse_document, parse_scenario
 from vplane_mj.scenario.spec import RobotSpec, RunSpec, Scenario, SensorSpec, WorldSpec
 
 __all__ = [
+    "CODE_SOURCE",
     "FORMAT",
     "MAX_ARENA_M",
     "MAX_NAME_LENGTH",
@@ -50,10 +53,17 @@ __all__ = [
     "ScenarioError",
     "SensorSpec",
     "WorldSpec",
+    "box",
+    "build_scenario",
     "builtin_scenarios",
+    "cup",
+    "cylinder",
+    "h_shape",
     "load_scenario",
+    "parse_document",
     "parse_scenario",
     "resolve_path",
+    "wall",
 ]
 
 

@@ -64,7 +64,14 @@ def parse_scenario(text: str, source: str, overrides: Sequence[str] = (), record
 
     `recorded`: the text is a finished run's scenario (from its log), whose planner need not be
     registered in this process (nothing is imported either way)."""
-    doc = _parse_toml(text, source)
+    return parse_document(_parse_toml(text, source), source, overrides, recorded)
+
+
+def parse_document(
+    doc: dict[str, Any], source: str, overrides: Sequence[str] = (), recorded: bool = False
+) -> Scenario:
+    """Validate a document as TOML parses it (tables as dicts, arrays as lists), after the
+    `--set KEY=VALUE` overrides (applied to `doc` in place): a Scenario or ScenarioError."""
     try:
         for override in overrides:
             apply_override(doc, override)

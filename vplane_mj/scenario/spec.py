@@ -6,12 +6,15 @@ Units: metres and seconds; degrees in the file, radians here. Obstacles are the 
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import tomli_w
 
+from vplane_mj.outputs import write_atomically
 from vplane_mj.shapes import Obstacle
 
 
@@ -77,11 +80,15 @@ class RunSpec:
 
 @dataclass(frozen=True)
 class Scenario:
-    """A validated scenario. `raw` is the document as read, with overrides applied (read-only)."""
+    """A validated scenario. `raw` is the document as read, with overrides applied (read-only).
+
+    `source` names where it came from in messages (a file, or "<code>"); two scenarios of the
+    same content are equal wherever they came from.
+    """
 
     name: str
     description: str
-    source: str
+    source: str = field(compare=False)
     world: WorldSpec
     robot: RobotSpec
     planner: str
@@ -93,3 +100,9 @@ class Scenario:
     def to_toml(self) -> str:
         """The resolved scenario as TOML text; parsing it back gives an equal Scenario."""
         return tomli_w.dumps(self.raw)
+
+    def save(self, path: str | os.PathLike[str]) -> Path:
+        """Write `to_toml()` to `path` (whole or not at all): a file `vplane-mj run` takes and
+        that loads back equal. Returns the path."""
+        text = self.to_toml()
+        return write_atomically(Path(path), lambda tmp: tmp.write_text(text, encoding="utf-8"))

@@ -1,0 +1,183 @@
+"""One run from Python (`vplane_mj.run`): simulate a scenario and write what `vplane-mj run`
+writes (docs/interface.md section 3). The RunRecord it returns holds the summary, the
+trajectory, the events and the paths of the files; the command line's `run` is this call
+with its flags.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from types import MappingProxyType
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from vplane_mj.errors import VPlaneError
+from vplane_mj.interrupts import Interrupted
+from vplane_mj.outputs import DEFAULT_OUT, prepare_out_dir, write_atomically, write_json
+from vplane_mj.planning.events import Event, EventKind
+from vplane_mj.scenario import Scenario, load_scenario
+from vplane_mj.sim import RunResult, Tick, run_scenario
+from vplane_mj.summary import RunSummary
+
+if TYPE_CHECKING:
+    from vplane_mj.log_mcap import McapLog
+
+
+@dataclass(frozen=True)
+class RunEvent:
+    """One event of a run: its simulated time (s), kind, text for people and points (x, y) in m."""
+
+    time_s: float
+    kind: EventKind
+    text: str
+    data: Mapping[str, tuple[float, float]]
+
+
+@dataclass(frozen=True, eq=False)
+class Trajectory:
+    """The robot at every control tick: `times` (n,) in s, `positions` (n, 2) in m, `yaws` (n,)
+    in rad and the planner's `modes`; `final_pose` is x, y (m) and yaw (rad) at the end."""
+
+    times: np.ndarray
+    positions: np.ndarray
+    yaws: np.ndarray
+    modes: tuple[str, ...]
+    final_pose: tuple[float, float, float]
+
+
+@dataclass(frozen=True, eq=False)
+class RunRecord:
+    """What a run gave: the scenario it ran, its summary, trajectory and events, and the files
+    written, by role in the order written: "log" (.mcap), "summary" (.json), "render" (.png),
+    "video" (.mp4)."""
+
+    scenario: Scenario
+    summary: RunSummary
+    trajectory: Trajectory
+    events: tuple[RunEvent, ...]
+    files: Mapping[str, Path]
+
+    @property
+    def reached(self) -> bool:
+        """Whether the robot reached the goal."""
+        return self.summary.reached
+
+
+class EventRecorder:
+    """An observer of a run that keeps its events, each with its time."""
+
+    def __init__(self) -> None:
+        self.events: list[RunEvent] = []
+
+    def on_tick(self, tick: Tick) -> None:
+        """Ticks are the trajectory's, which the run keeps itself."""
+
+    def on_event(self, time_s: float, event: Event) -> None:
+        self.events.append(RunEvent(time_s, event.kind, event.text, MappingProxyType(dict(event.data))))
+
+
+def output_base(scenario: Scenario, out_dir: Path) -> Path:
+    """The files of a run are this path with a suffix: `<out_dir>/<name>-<planner>-<seed>`."""
+    return out_dir / f"{scenario.name}-{scenario.planner}-{scenario.run.seed}"
+
+
+def run(
+    scenario: Scenario | str | os.PathLike[str],
+    out: str | os.PathLike[str] | None = DEFAULT_OUT,
+    *,
+    log: bool = True,
+    render: bool = True,
+    video: bool = False,
+) -> RunRecord:
+    """Run a scenario (a Scenario, or a file or a built-in scenario's name) headless.
+
+    Into `out` (created with its parents when missing) it writes the `.json` summary, and
+    with `log` the `.mcap` log, with `render` the `.png` render, with `video` an `.mp4`
+    replay (from the log); `out=None` writes nothing. Invalid input raises a VPlaneError
+    before anything is written. Interrupted (KeyboardInterrupt) during the simulation, the
+    log is closed cleanly and kept; files are always whole or absent.
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(os.fspath(scenario))
+    if video and not log:
+        raise VPlaneError("video: the video is made from the log: keep log=True")
+    recorder = EventRecorder()
+    if out is None:
+        return _record(scenario, run_scenario(scenario, (recorder,)), recorder, {})
+    base = output_base(scenario, prepare_out_dir(Path(out)))
+    files: dict[str, Path] = {}
+    result = _simulate(scenario, base, log, recorder, files)
+    try:
+        files["summary"] = write_json(base.with_suffix(".json"), result.summary.to_dict())
+        if render:
+            from vplane_mj.render import render_top_view, write_png
+
+            image = render_top_view(scenario, result.track())
+            files["render"] = write_atomically(base.with_suffix(".png"), lambda tmp: write_png(image, tmp))
+        if video:
+            from vplane_mj.video import write_video
+
+            files["video"] = write_video(files["log"], base.with_suffix(".mp4"))
+    except Interrupted as exc:
+        exc.written = dict(files)
+        raise
+    return _record(scenario, result, recorder, files)
+
+
+def _simulate(
+    scenario: Scenario, base: Path, log: bool, recorder: EventRecorder, files: dict[str, Path]
+) -> RunResult:
+    """The run, observed by the recorder and, with `log`, by the MCAP log, which is then closed
+    under its name (also when the run is interrupted) or removed (when it fails)."""
+    if not log:
+        return run_scenario(scenario, (recorder,))
+    target = base.with_suffix(".mcap")
+    mcap = _open_log(scenario, target)
+    try:
+        result = run_scenario(scenario, (mcap, recorder))
+    except (Interrupted, KeyboardInterrupt) as exc:
+        files["log"] = _finish_log(mcap, target, None)
+        if isinstance(exc, Interrupted):
+            exc.written = dict(files)
+        raise
+    except BaseException:  # keep nothing half-written
+        mcap.close()
+        mcap.path.unlink(missing_ok=True)
+        raise
+    files["log"] = _finish_log(mcap, target, result.summary.to_dict())
+    return result
+
+
+def _open_log(scenario: Scenario, target: Path) -> McapLog:
+    """An MCAP log written under a temporary name beside `target` (renamed when finished).
+
+    A process killed outright leaves that `.partial` file: its flushed part (all but
+    about the last simulated second) is readable with `vplane_mj.log_read.read_log`.
+    """
+    from vplane_mj.log_mcap import McapLog
+    from vplane_mj.robot import robot_radius_m
+    from vplane_mj.world import SonarLayout
+
+    bearings = SonarLayout.from_spec(scenario.sensors).bearings
+    partial = target.with_name(f".{target.name}.partial")
+    return McapLog(partial, scenario, robot_radius_m(), bearings, scenario.sensors.range_max, {})
+
+
+def _finish_log(log: McapLog, target: Path, summary: dict | None) -> Path:
+    """Close the log (with the summary when the run finished) and give it its final name."""
+    log.close(summary)
+    os.replace(log.path, target)
+    return target
+
+
+def _record(
+    scenario: Scenario, result: RunResult, recorder: EventRecorder, files: dict[str, Path]
+) -> RunRecord:
+    trajectory = Trajectory(
+        result.times, result.positions, result.yaws, tuple(result.modes), result.final_pose
+    )
+    return RunRecord(scenario, result.summary, trajectory, tuple(recorder.events), MappingProxyType(files))

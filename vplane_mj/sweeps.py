@@ -1,0 +1,134 @@
+"""Many runs from Python (`vplane_mj.sweep`): scenarios x planners x seeds, as `vplane-mj bench`
+runs them (`vplane_mj.bench`: the jobs, the resumable journal, the process pool or a Dask
+cluster, the table and the report); the command line's `bench` is this call with its flags.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from vplane_mj.bench import (
+    Job,
+    format_table,
+    parse_seeds,
+    plan_jobs,
+    run_sweep,
+    summarize,
+    worker_imports,
+    write_outputs,
+)
+from vplane_mj.errors import VPlaneError
+from vplane_mj.outputs import DEFAULT_OUT, output_directory
+from vplane_mj.planning.base import Planner
+from vplane_mj.planning.plugins import PlannerError, is_import_spec
+from vplane_mj.planning.registry import PLANNERS, load_planner, register_planner
+from vplane_mj.scenario import Scenario, parse_scenario
+from vplane_mj.summary import RunSummary
+
+
+@dataclass(frozen=True, eq=False)
+class SweepResult:
+    """A sweep's rows (one per run, in the order scenario, planner, seed: the run's summary as
+    a dict, its journal `key` and its simplified path `path_xy`), its table (one row per
+    planner, the columns of `vplane_mj.bench.TABLE_COLUMNS`) and the report files written."""
+
+    rows: list[dict]
+    table: list[dict]
+    files: tuple[Path, ...]
+
+    def summaries(self) -> list[RunSummary]:
+        """The rows as run summaries."""
+        return [RunSummary.from_dict(row) for row in self.rows]
+
+    def table_text(self) -> str:
+        """The table as `vplane-mj bench` prints it."""
+        return format_table(self.table)
+
+
+def sweep(
+    scenarios: Iterable[Scenario | str | os.PathLike[str]],
+    planners: Iterable[str | type[Planner]] | None = None,
+    seeds: Iterable[int] | str = (0,),
+    overrides: Sequence[str] = (),
+    jobs: int | None = None,
+    scheduler: str | None = None,
+    out: str | os.PathLike[str] | None = DEFAULT_OUT,
+    *,
+    report: bool = True,
+) -> SweepResult:
+    """Run every scenario (a Scenario, or a file or a built-in scenario's name) with every
+    planner (default: all of them; a name, an import spec `module:Class` or `file.py:Class`, or
+    a `Planner` class, the last two registered here and imported by the workers) and seed (a
+    list, or text like "0-19"), each with the `--set` style `overrides`, in `jobs` worker
+    processes (default: one per core) or on the Dask `scheduler` at that address.
+
+    As `vplane-mj bench`: every run is validated before any starts (a VPlaneError names the
+    scenario and key), progress is shown on stderr, finished runs are appended to
+    `bench.jsonl` in `out` and the same sweep again runs only what is missing; with `report`
+    the table and figures are written too (bench.csv, bench.json, bench.png,
+    bench-scenarios.png, bench.html). `out=None` keeps nothing: the journal goes to a
+    temporary directory and no report is written.
+    """
+    workers = (os.cpu_count() or 1) if jobs is None else jobs
+    if workers < 1:
+        raise VPlaneError(f"jobs: must be at least 1, got {workers}")
+    chosen = sorted(PLANNERS) if planners is None else [planner_name(p) for p in planners]
+    seed_list = parse_seeds(seeds) if isinstance(seeds, str) else list(seeds)
+
+    def sweep_into(out_dir: Path, report: bool) -> SweepResult:
+        planned = _plan(scenarios, chosen, seed_list, overrides)
+        rows = run_sweep(planned, out_dir, workers, scheduler)
+        table = summarize(rows)
+        files = tuple(write_outputs(rows, table, out_dir, planned)) if report else ()
+        return SweepResult(rows, table, files)
+
+    if out is None:
+        with tempfile.TemporaryDirectory(prefix="vplane-mj-sweep-") as scratch:
+            return sweep_into(Path(scratch), report=False)
+    with output_directory(Path(out)) as out_dir:
+        return sweep_into(out_dir, report)
+
+
+def planner_name(planner: str | type[Planner], option: str = "planners") -> str:
+    """The name a sweep's rows give `planner`: a name as it is; an import spec or a class
+    registered here first (a VPlaneError naming `option` when it is no valid planner)."""
+    try:
+        if isinstance(planner, type):
+            return register_planner(planner).name
+        return load_planner(planner).name if is_import_spec(planner) else planner
+    except PlannerError as exc:
+        raise VPlaneError(f"{option}: {exc}") from None
+
+
+def _plan(
+    scenarios: Iterable[Scenario | str | os.PathLike[str]],
+    planners: list[str],
+    seeds: list[int],
+    overrides: Sequence[str],
+) -> list[Job]:
+    """The jobs of every scenario in turn: files and names as `bench` plans them, scenarios
+    built in code from their TOML text, each validated with the planner, seed and overrides."""
+    jobs: list[Job] = []
+    for scenario in scenarios:
+        if isinstance(scenario, Scenario):
+            jobs += _jobs_of(scenario, planners, seeds, overrides)
+        else:
+            jobs += plan_jobs([os.fspath(scenario)], planners, seeds, overrides)
+    return jobs
+
+
+def _jobs_of(
+    scenario: Scenario, planners: list[str], seeds: list[int], overrides: Sequence[str]
+) -> list[Job]:
+    """The jobs of one Scenario object, validated as `plan_jobs` validates a file's."""
+    text, jobs, imports = scenario.to_toml(), [], worker_imports(planners)
+    for planner in planners:
+        for seed in seeds:
+            choice = [*overrides, f"planner.name={planner}", f"run.seed={seed}"]
+            resolved = parse_scenario(text, scenario.source, choice)
+            jobs.append(Job(resolved.name, planner, seed, resolved.to_toml(), imports))
+    return jobs
