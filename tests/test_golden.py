@@ -8,8 +8,10 @@ behaviour is recorded again, from the repository's root, with
 
     python -m tests.test_golden --record
 
-Floating-point results depend on the MuJoCo and numpy builds: the file keeps the versions it
-was recorded with, and the test is skipped under others (record again there to use it).
+Floating-point results depend on the MuJoCo and numpy builds and on the vector instructions
+numpy finds on the CPU (with AVX-512 it computes sines, arctangents and the like by other
+routines, which differ in the last bit): the file keeps the environment it was recorded in,
+and the test is skipped in others (record again there to use it).
 """
 
 from __future__ import annotations
@@ -43,7 +45,21 @@ RECORDED_KEYS = ("outcome", "trajectory_sha256", "collisions", "local_minima", "
 
 def environment() -> dict[str, str]:
     """What the digests depend on besides the code."""
-    return {"mujoco": mujoco.__version__, "numpy": np.__version__, "machine": platform.machine()}
+    return {
+        "mujoco": mujoco.__version__,
+        "numpy": np.__version__,
+        "machine": platform.machine(),
+        "numpy_simd": ",".join(numpy_dispatch_targets()),
+    }
+
+
+def numpy_dispatch_targets() -> list[str]:
+    """The optimised code paths numpy chose on this CPU (e.g. X86_V3, X86_V4, AVX512_SKX)."""
+    try:
+        from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+    except ImportError:  # numpy before 2.0 (another environment than the recorded one anyway)
+        return ["unknown"]
+    return [target for target in __cpu_dispatch__ if __cpu_features__.get(target)]
 
 
 def worlds() -> list[tuple[str, str]]:

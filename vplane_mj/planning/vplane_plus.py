@@ -489,10 +489,15 @@ class VPlanePlusPlanner(VPlanePlanner):
         if self.no_way_since is not None:
             decision.events.append(Event(EventKind.WAY_CHANGED, "the map shows a way to the goal again"))
         self.no_way_since = None
-        kept = self.sight.path_cost(np.array([obs.position, *self.follow_way])) if self.follow_way else np.inf
-        if kept > KEEP_WAY_RATIO * self.sight.path_cost(np.array([obs.position, *way])):
+        kept = self._way_cost(obs.position, self.follow_way, obs.goal) if self.follow_way else np.inf
+        if kept > KEEP_WAY_RATIO * self._way_cost(obs.position, way, obs.goal):
             self.follow_way = way  # else the current way stays: no flip-flop between similar ways
         return self._next_waypoint(obs.position, self.follow_way, obs.goal)
+
+    def _way_cost(self, position: np.ndarray, way: list[np.ndarray], goal: np.ndarray) -> float:
+        """What a way to the goal costs from `position`: along it on the map, then from its end to
+        the goal in a straight line (a way ends short of the goal where the goal lies off the map)."""
+        return self.sight.path_cost(np.array([position, *way])) + float(np.hypot(*(goal - way[-1])))
 
     def _way_to_goal(self, obs: Observation, decision: Decision) -> list[np.ndarray] | None:
         """The map's way to the goal with the planes as walls; planes that leave no way are
