@@ -99,8 +99,10 @@ class LocalMap:
         robot += math.floor(py / cell) - self.origin[1] + self._pad
         offsets, cone_only = cones.near(yaw + bearings[looked], reach)
         cand = offsets + robot
-        if not self.track_seen:
-            cand = cand[~cone_only | self._marked[cand]]  # a cone empties marked cells only
+        # Before its arc, a cone only empties marked cells, and shows unseen ones free: an
+        # unmarked cell already seen stays as it is.
+        changes = self._marked[cand] if not self.track_seen else self._marked[cand] | ~self._seen_flat[cand]
+        cand = cand[~cone_only | changes]
         rel_x = self._centre_x[cand] - px
         rel_y = self._centre_y[cand] - py
         distance = np.hypot(rel_x, rel_y)
