@@ -16,8 +16,9 @@ shown free, as opposed to merely unknown; with `silent_free_m`, a reading withou
 shows its cone free that far) and `sweep` (the cells the robot's own disc has covered, never
 obstacles in a static world).
 
-A scan changes only the cells near its echo arcs (hits) and the marked cells inside its
-cones (misses: an empty cell stays empty). So an update visits just those, from a table
+A scan changes only the cells near its echo arcs (hits), the marked cells inside its cones
+(misses: an empty cell stays empty) and, with `seen`, the cells of its cones not yet seen. So
+an update visits just those, from a table
 of grid offsets by sonar direction and range (`_ConeTable`), and classifies each by the
 rule above (nearest sonar, beam cone, distance to the echo), computed exactly as a pass
 over every cell within reach of the longest echo would: the grid is the same, bit for bit.
