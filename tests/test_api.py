@@ -114,7 +114,7 @@ def built_trap(**changes):
 def test_importing_the_package_loads_no_simulator_plotting_or_opengl():
     script = (
         "import sys, vplane_mj\n"
-        "heavy = ('mujoco', 'matplotlib', 'OpenGL', 'scipy', 'gymnasium')\n"
+        "heavy = ('mujoco', 'matplotlib', 'OpenGL', 'scipy', 'gymnasium', 'dm_control', 'dm_env')\n"
         "print(sorted(name for name in heavy if name in sys.modules))\n"
     )
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)

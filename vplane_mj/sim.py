@@ -3,9 +3,10 @@
 `Run` steps one control tick at a time (`step`) and decides in one place how the run ends
 (`_ending`: the six ways, in the order they are checked); `run_scenario` runs it to the end.
 A tick is two halves: `observe` (sense) and `apply` (a decision drives the wheels), so that
-a decision can also come from outside (the Gymnasium environment, `vplane_mj.gym_env`).
-The planner sees only an Observation (pose, goal, sonar ranges). The simulator's obstacle
-geometry is used only to score the run (clearance) and to draw it, never to plan.
+a decision can also come from outside (the reinforcement-learning environments, through
+`vplane_mj.navigation_task`). The planner sees only an Observation (pose, goal, sonar
+ranges). The simulator's obstacle geometry is used only to score the run (clearance) and to
+draw it, never to plan.
 """
 
 from __future__ import annotations
