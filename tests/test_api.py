@@ -352,3 +352,36 @@ def test_the_readme_examples_run(tmp_path, monkeypatch, readme_examples, capsys)
     assert (tmp_path / "logs" / "paper_c_escape-vplane-3.json").exists()
     assert json.loads((tmp_path / "results" / "bench.json").read_text())["table"][0]["runs"] == 6
     assert "paper_c_escape vplane 2 reached" in capsys.readouterr().out
+
+
+def test_the_drawing_helpers_draw_the_world_and_a_path_by_mode():
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import to_rgba
+
+    from vplane_mj.plots import draw_path, draw_world, label_modes
+    from vplane_mj.render import MODE_RGBA, OTHER_MODE_RGBA
+
+    scenario = load_scenario("paper_c_escape")
+    figure, axes = plt.subplots()
+    draw_world(axes, scenario, margin_m=0.5)
+    pieces = sum(len(obstacle.footprint()) for obstacle in scenario.world.obstacles)
+    assert len(axes.patches) == pieces + 4 + 1  # the cup's three walls, the border, the goal
+    width, height = scenario.world.size
+    assert axes.get_xlim() == (-0.5, width + 0.5) and axes.get_ylim() == (-0.5, height + 0.5)
+    assert axes.get_legend_handles_labels()[1] == ["start", "goal"]
+    positions = np.array([[1.0, 1.0], [2.0, 1.0], [2.0, 2.0], [3.0, 2.0]])
+    modes = ("normal", "escaping", "mine", "normal")
+    draw_path(axes, positions, modes)
+    (path,) = [c for c in axes.collections if isinstance(c, LineCollection)]
+    assert [tuple(c) for c in path.get_colors()] == [
+        MODE_RGBA["normal"],
+        MODE_RGBA["escaping"],
+        OTHER_MODE_RGBA,
+    ]
+    assert [segment.tolist() for segment in path.get_segments()][1] == [[2.0, 1.0], [2.0, 2.0]]
+    label_modes(axes, modes)
+    handles, labels = axes.get_legend_handles_labels()
+    assert labels == ["start", "goal", "path: normal", "path: escaping"]
+    assert to_rgba(handles[3].get_color()) == MODE_RGBA["escaping"]
+    plt.close(figure)

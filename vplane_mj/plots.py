@@ -1,10 +1,15 @@
-"""Matplotlib figure of a run from its MCAP log: the map, the potential field, time series."""
+"""Matplotlib figure of a run from its MCAP log: the map, the potential field, time series.
+
+`draw_world`, `draw_path` and `label_modes` are public: they draw a scenario's world and a
+path coloured by planner mode on any matplotlib axes (examples/paper_figures.py uses them).
+"""
 
 from __future__ import annotations
 
 import itertools
 import json
 import math
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 import matplotlib
@@ -28,6 +33,10 @@ FIELD_HALF_WIDTH_M = 2.0
 """Half the side of the square around the local minimum where the field is drawn."""
 BOUNDARY_STEP_M = 0.05
 """Spacing of the obstacle boundary points that stand in for sonar echoes in the field."""
+OBSTACLE_COLOUR = "#2a3f7f"
+PATH_ZORDER = 1.9
+"""A path lies above the obstacles and the goal (zorder 1), below the markers (2), whatever the
+order they are drawn in."""
 
 
 def plot_log(path: Path, contents: LogContents, scenario: Scenario, track: Track) -> plt.Figure:
@@ -46,25 +55,58 @@ def plot_log(path: Path, contents: LogContents, scenario: Scenario, track: Track
     return figure
 
 
+def draw_world(axes, scenario: Scenario, margin_m: float = 0.2) -> None:
+    """Draw a scenario's world on matplotlib `axes`, in metres: the obstacles and border walls
+    (dark blue), the start (green dot, label "start") and the goal (gold disc of the goal
+    tolerance, label "goal"); equal aspect, the arena and `margin_m` around it in view."""
+    _draw_obstacles(axes, scenario)
+    axes.plot(*scenario.robot.start, "o", color="green", ms=9, label="start")
+    axes.add_patch(Circle(scenario.robot.goal, scenario.robot.goal_tolerance, color="gold", label="goal"))
+    w, h = scenario.world.size
+    axes.set(
+        xlim=(-margin_m, w + margin_m),
+        ylim=(-margin_m, h + margin_m),
+        aspect="equal",
+        xlabel="x (m)",
+        ylabel="y (m)",
+    )
+
+
+def draw_path(axes, positions: np.ndarray, modes: Sequence[str], linewidth: float = 2.0) -> None:
+    """Draw a path, positions (n, 2) in m, each segment in the colour of the planner mode at its
+    start (`modes`, n of them), as the render colours them: red `normal`, orange `avoiding`,
+    blue `escaping`, purple `trapped`, green `following`, grey any other mode; above the world,
+    below markers."""
+    points = np.asarray(positions, float)
+    segments = np.stack([points[:-1], points[1:]], axis=1)
+    colours = [MODE_RGBA.get(mode, OTHER_MODE_RGBA) for mode in modes[: len(segments)]]
+    axes.add_collection(LineCollection(segments, colors=colours, linewidths=linewidth, zorder=PATH_ZORDER))
+
+
+def label_modes(axes, modes: Iterable[str]) -> None:
+    """Add a legend entry "path: MODE" for each of `modes` that draw_path has a colour for, in
+    the order normal, avoiding, escaping, trapped, following."""
+    present = set(modes)
+    for mode, rgba in MODE_RGBA.items():
+        if mode in present:
+            axes.plot([], [], color=rgba, lw=2, label=f"path: {mode}")
+
+
 def _draw_obstacles(axes, scenario: Scenario) -> None:
     pieces = [p for ob in scenario.world.obstacles for p in ob.footprint()]
     if scenario.world.border:
         pieces += list(shapes.border_footprint(scenario.world.size))
     for piece in pieces:
         if isinstance(piece, shapes.Disc):
-            axes.add_patch(Circle(piece.center, piece.radius, color="#2a3f7f"))
+            axes.add_patch(Circle(piece.center, piece.radius, color=OBSTACLE_COLOUR))
             continue
-        axes.add_patch(Polygon(piece.corners(), color="#2a3f7f"))
+        axes.add_patch(Polygon(piece.corners(), color=OBSTACLE_COLOUR))
 
 
 def _draw_map(axes, contents: LogContents, scenario: Scenario, track: Track) -> None:
-    _draw_obstacles(axes, scenario)
+    draw_world(axes, scenario)
     points = track.positions
-    segments = np.stack([points[:-1], points[1:]], axis=1)
-    colours = [MODE_RGBA.get(mode, OTHER_MODE_RGBA) for mode in track.modes[:-1]]
-    axes.add_collection(LineCollection(segments, colors=colours, linewidths=2))
-    axes.plot(*scenario.robot.start, "o", color="green", ms=9, label="start")
-    axes.add_patch(Circle(scenario.robot.goal, scenario.robot.goal_tolerance, color="gold", label="goal"))
+    draw_path(axes, points, track.modes)
     times = contents.times_ns / 1e9
     minima = [e.time_s for e in contents.events if e.kind is EventKind.LOCAL_MINIMUM]
     for k, t in enumerate(minima):
@@ -76,18 +118,8 @@ def _draw_map(axes, contents: LogContents, scenario: Scenario, track: Track) -> 
         axes.plot(*zip(e1, e2, strict=True), color="#8e24aa", lw=3, label="virtual plane" if k == 0 else None)
     for k, point in enumerate(track.collision_points):
         axes.plot(*point, "k+", ms=12, mew=2, label="collision" if k == 0 else None)
-    for mode, rgba in MODE_RGBA.items():
-        if mode in track.modes:
-            axes.plot([], [], color=rgba, lw=2, label=f"path: {mode}")
-    w, h = scenario.world.size
-    axes.set(
-        xlim=(-0.2, w + 0.2),
-        ylim=(-0.2, h + 0.2),
-        aspect="equal",
-        title="travelled path",
-        xlabel="x (m)",
-        ylabel="y (m)",
-    )
+    label_modes(axes, track.modes)
+    axes.set_title("travelled path")
     axes.legend(loc="upper left", fontsize=7)
 
 
