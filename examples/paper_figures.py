@@ -150,7 +150,7 @@ def main() -> None:
             legend.setdefault(label, handle)
     figure.legend(legend.values(), legend.keys(), loc="lower center", ncol=min(len(legend), 6), fontsize=10)
     figure.suptitle(f"The paper's scenarios (seed {args.seed}, sonar noise {args.noise:g} m)", fontsize=13)
-    figure.tight_layout(rect=(0, 0.06, 1, 1), w_pad=2.0)
+    figure.tight_layout(rect=(0, 0.06, 1, 1), w_pad=2.0, h_pad=2.0)
     path = args.out / "paper_figures.png"
     figure.savefig(path, dpi=110)
     print(f"wrote {path}")
