@@ -87,7 +87,7 @@ def parse_seeds(text: str) -> list[int]:
             low, high = (int(bounds[0]), int(bounds[-1])) if len(bounds) <= 2 else (None, None)
         except ValueError:
             low = high = None
-        if low is None or low < 0 or high < low or high >= 2**32:
+        if low is None or high is None or low < 0 or high < low or high >= 2**32:
             raise VPlaneError(f"--seeds: {part.strip()!r} is not a seed or a range like 0-19 (seeds < 2**32)")
         if len(seeds) + (high - low + 1) > MAX_SEEDS:
             raise VPlaneError(f"--seeds: more than {MAX_SEEDS} seeds in {text.strip()!r}")
@@ -341,7 +341,7 @@ def write_outputs(rows: list[dict], table: list[dict], out_dir: Path, jobs: list
         "bench-scenarios.png": bench_report.png_bytes(bench_report.scenario_figure(rows)),
     }
     for name, data in figures.items():
-        written.append(write_atomically(out_dir / name, lambda tmp, data=data: tmp.write_bytes(data)))
+        written.append(write_atomically(out_dir / name, partial(Path.write_bytes, data=data)))
     page = bench_report.write_html_text(
         rows,
         table,

@@ -6,6 +6,7 @@ import argparse
 import json
 import os
 import sys
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -291,7 +292,7 @@ def _generate(args: argparse.Namespace) -> int:
         lambda scenario, clearance: shortest_path_length(scenario, radius, clearance) is not None,
     )
     for case in cases:
-        path = write_atomically(out_dir / f"{case.name}.toml", lambda tmp, c=case: tmp.write_text(c.toml()))
+        path = write_atomically(out_dir / f"{case.name}.toml", partial(Path.write_text, data=case.toml()))
         print(f"wrote {path}")
     return 0
 

@@ -235,6 +235,7 @@ class Run:
 
     def _plan(self) -> None:
         """The planner's decision on this tick's observation, its events and its virtual objects."""
+        assert self._belief is not None, "planning before sensing"
         believed_xy, believed_yaw = self._belief
         observation = Observation(
             self.data.time,
@@ -264,6 +265,7 @@ class Run:
     def _report(self) -> None:
         """Record the tick and show it to the observers."""
         decision = self._decision
+        assert self._belief is not None and decision is not None, "reporting a tick not planned"
         believed_xy, believed_yaw = self._belief
         self.command = heading_command(
             float(decision.force[0]), float(decision.force[1]), believed_yaw, self.drive.gains
@@ -317,8 +319,6 @@ class Run:
     # -- the result -------------------------------------------------------------------------
     def result(self) -> RunResult:
         """The run's summary and path (call once it has ended)."""
-        if self.ending is None:
-            raise RuntimeError("the run has not ended")
         return RunResult(
             summary=self.summary(),
             times=np.array(self.times),
@@ -332,7 +332,10 @@ class Run:
         )
 
     def summary(self) -> RunSummary:
+        """The run's summary (call once it has ended)."""
         scenario, ending, clearance = self.scenario, self.ending, self.clearance
+        if ending is None:
+            raise RuntimeError("the run has not ended")
         reached = ending.outcome is Outcome.REACHED
         success = reached and not self.collisions.points
         cpu = self.planner_cpu
