@@ -87,14 +87,9 @@ def failure_of(
     return RunFailure(kind, message, "".join(traceback.format_exception(type(exc), exc, trace)))
 
 
-def worker_died(exit_code: int | None) -> RunFailure:
+def worker_died(exit_code: int) -> RunFailure:
     """The failure of a run whose worker process ended with `exit_code` (-N: killed by signal N)."""
-    if exit_code is None:
-        how = "it stopped answering"
-    elif exit_code < 0:
-        how = f"killed by {_signal_name(-exit_code)}"
-    else:
-        how = f"it exited with status {exit_code}"
+    how = f"killed by {_signal_name(-exit_code)}" if exit_code < 0 else f"it exited with status {exit_code}"
     return RunFailure(FailureKind.WORKER_DIED, f"the worker process running this run died: {how}")
 
 

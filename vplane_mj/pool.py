@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from functools import partial
 from multiprocessing.connection import Connection, wait
 from multiprocessing.process import BaseProcess
-from typing import Any, TypeVar
+from typing import Any, Generic, TypeVar
 
 from vplane_mj.failures import RunFailure, call_or_failure, worker_died
 
@@ -55,92 +55,99 @@ def run_in_pool(
     worker is left running.
     """
     queue = deque(items)
-    idle: list[_Worker] = []
-    busy: dict[_Worker, Item] = {}
+    pool = _Workers[Item](run, workers)
     finished_normally = False
     try:
-        while queue or busy:
-            _hand_out(queue, idle, busy, workers, run)
-            results = _collect(busy, idle)
-            _hand_out(queue, idle, busy, workers, run)  # before the caller takes its time
+        while queue or pool.busy:
+            pool.hand_out(queue)
+            results = pool.collect()
+            pool.hand_out(queue)  # before the caller takes its time over the results
             yield from results
         finished_normally = True
     finally:
-        _stop([*idle, *busy], at_once=not finished_normally)
+        pool.stop(at_once=not finished_normally)
 
 
-def _hand_out(
-    queue: deque[Item],
-    idle: list[_Worker],
-    busy: dict[_Worker, Item],
-    workers: int,
-    run: Callable[[Item], Any],
-) -> None:
-    """Give queued items to idle workers, starting new ones, until `workers` are busy."""
-    while queue and len(busy) < workers:
-        worker = idle.pop() if idle else _start_worker(run)
-        item = queue.popleft()
-        try:
-            worker.connection.send(item)
-        except OSError:  # the worker died while idle: the item waits for the next one
-            queue.appendleft(item)
-            _reap(worker)
-            continue
-        busy[worker] = item
+class _Workers(Generic[Item]):
+    """The worker processes: idle ones, busy ones with their items, and every one started and
+    not yet reaped (registered before it starts, so that an interruption, which may come
+    between any two steps here, still finds it)."""
 
+    def __init__(self, run: Callable[[Item], Any], size: int):
+        self._run = partial(call_or_failure, run)
+        self._size = size
+        self._started: list[_Worker] = []
+        self.idle: list[_Worker] = []
+        self.busy: dict[_Worker, Item] = {}
 
-def _collect(busy: dict[_Worker, Item], idle: list[_Worker]) -> list[tuple[Item, Any]]:
-    """Wait until busy workers answer or die; their items with the results or failures.
+    def hand_out(self, queue: deque[Item]) -> None:
+        """Give queued items to idle workers, starting new ones, until `size` are busy."""
+        while queue and len(self.busy) < self._size:
+            worker = self.idle.pop() if self.idle else self._start()
+            item = queue.popleft()
+            try:
+                worker.connection.send(item)
+            except OSError:  # the worker died while idle: the item waits for the next one
+                queue.appendleft(item)
+                self._reap(worker)
+                continue
+            self.busy[worker] = item
 
-    Workers that answered become idle; dead ones are reaped.
-    """
-    ready = set(wait([w.connection for w in busy] + [w.process.sentinel for w in busy]))
-    results: list[tuple[Item, Any]] = []
-    for worker in [w for w in busy if w.connection in ready or w.process.sentinel in ready]:
-        item = busy.pop(worker)
-        try:
-            # A worker that died is readable too (end of file), and may have answered first.
-            if not worker.connection.poll():
-                raise EOFError
-            result = worker.connection.recv()
-        except (EOFError, OSError):
-            result = worker_died(_reap(worker))
-        else:
-            idle.append(worker)
-        results.append((item, result))
-    return results
+    def collect(self) -> list[tuple[Item, Any]]:
+        """Wait until busy workers answer or die; their items with the results or failures.
 
+        Workers that answered become idle; dead ones are reaped.
+        """
+        busy = self.busy
+        ready = set(wait([w.connection for w in busy] + [w.process.sentinel for w in busy]))
+        results: list[tuple[Item, Any]] = []
+        for worker in [w for w in busy if w.connection in ready or w.process.sentinel in ready]:
+            item = busy.pop(worker)
+            try:
+                # A worker that died is readable too (end of file), and may have answered first.
+                if not worker.connection.poll():
+                    raise EOFError
+                result = worker.connection.recv()
+            except (EOFError, OSError):
+                result = worker_died(self._reap(worker))
+            else:
+                self.idle.append(worker)
+            results.append((item, result))
+        return results
 
-def _start_worker(run: Callable[[Any], Any]) -> _Worker:
-    ours, theirs = multiprocessing.Pipe()
-    guarded = partial(call_or_failure, run)
-    process = multiprocessing.Process(target=_serve, args=(theirs, guarded, os.getpid()))
-    process.start()
-    theirs.close()  # the worker holds the only copy: its death ends our end of the pipe
-    return _Worker(process, ours)
+    def stop(self, at_once: bool) -> None:
+        """End every worker: at once (SIGTERM), or by sending idle ones None (closing our end
+        of their pipes would not do: workers forked later hold copies of it)."""
+        started = [worker for worker in self._started if worker.process.pid is not None]
+        for worker in started:
+            if at_once:
+                worker.process.terminate()
+            else:
+                with contextlib.suppress(OSError):
+                    worker.connection.send(None)
+        for worker in started:
+            self._reap(worker)
 
+    def _start(self) -> _Worker:
+        ours, theirs = multiprocessing.Pipe()
+        process = multiprocessing.Process(target=_serve, args=(theirs, self._run, os.getpid()))
+        worker = _Worker(process, ours)
+        self._started.append(worker)
+        process.start()
+        theirs.close()  # the worker holds the only copy: its death ends our end of the pipe
+        return worker
 
-def _reap(worker: _Worker) -> int | None:
-    """Wait for a worker that is ending (terminate it if it does not); its exit code."""
-    worker.process.join(JOIN_TIMEOUT_S)
-    if worker.process.is_alive():
-        worker.process.terminate()
-        worker.process.join()
-    worker.connection.close()
-    return worker.process.exitcode
-
-
-def _stop(workers: list[_Worker], at_once: bool) -> None:
-    """End the workers: at once (SIGTERM), or by sending idle ones None (closing our end of
-    their pipes would not do: workers forked later hold copies of it)."""
-    for worker in workers:
-        if at_once:
+    def _reap(self, worker: _Worker) -> int:
+        """Wait for a worker that is ending (terminate it if it does not); its exit code."""
+        worker.process.join(JOIN_TIMEOUT_S)
+        if worker.process.is_alive():
             worker.process.terminate()
-        else:
-            with contextlib.suppress(OSError):
-                worker.connection.send(None)
-    for worker in workers:
-        _reap(worker)
+            worker.process.join()
+        worker.connection.close()
+        self._started.remove(worker)
+        exit_code = worker.process.exitcode
+        assert exit_code is not None, "a joined process has an exit code"
+        return exit_code
 
 
 def _serve(connection: Connection, run: Callable[[Any], Any], sweep_pid: int) -> None:
