@@ -17,16 +17,18 @@ seed so the soak is reproducible:
 | motor bias, per wheel | robot.motor_bias_nm | -0.05-0.05 N m |
 | dead-reckoned pose | sensors.pose = "odometry", sensors.odometry_noise | 0-0.02 per tick |
 
-Each run has the simulated time limit `--time-limit` (s) and runs in a pool of `--jobs`
-worker processes. An exception raised by a run is a crash: its traceback goes to
-`OUT/failed/<scenario>-<planner>-<seed>.traceback.txt`, and the soak goes on. A worker process
-that dies (segfault, out of memory) breaks the pool: the runs then in flight are retried one
-at a time, and one that kills its worker again is recorded as ended without a summary. The
-scenario of every crash, missing summary or `error` outcome is written beside it as
-`<...>.toml` (run it again with `vplane-mj run FILE`). The planned runs (scenario texts and
-faults; planning 1000 takes a few minutes) are saved in `OUT/plan.json` and the finished ones
-journaled in `OUT/soak.jsonl`, so the same command run again only does what is missing
-(delete both to start afresh, e.g. after a change to the scenario generators).
+Each run has the simulated time limit `--time-limit` (s). The runs go through the sweep of
+`vplane-mj bench` (`vplane_mj.bench.run_sweep`) with `--jobs` worker processes. A run that
+raises is a crash: its row has outcome `error` and the exception with where it was raised,
+its traceback goes to `OUT/failed/<scenario>-<planner>-<seed>.traceback.txt`, and the soak
+goes on. A worker process that dies (segfault, out of memory) fails only the run it had under
+way, which is recorded as ended without a summary; a new worker takes its place. The scenario
+of every crash, run without a summary or `error` outcome is written beside it as `<...>.toml`
+(run it again with `vplane-mj run FILE`). The planned runs (scenario texts and faults;
+planning 1000 takes a few minutes) are saved in `OUT/plan.json` and the finished ones
+journaled in `OUT/soak.jsonl`, so the same command run again (after Ctrl-C, say) only does
+what is missing (delete both to start afresh, e.g. after a change to the scenario
+generators).
 
 Prints and writes `OUT/soak.json` (runs, crashes, runs without a summary, outcomes per
 planner, success rate per planner and family, the `error` outcomes with their messages,
@@ -42,18 +44,16 @@ import argparse
 import json
 import sys
 import time
-import traceback
-from collections import deque
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
 
-from vplane_mj.bench import Job, Progress, family_of, read_journal, run_job
+from vplane_mj.bench import Job, family_of, run_sweep
 from vplane_mj.errors import VPlaneError
+from vplane_mj.failures import FAILURE_KEY, FailureKind
 from vplane_mj.families import generate
+from vplane_mj.interrupts import Interrupted, signals_raise_interrupted
 from vplane_mj.outputs import prepare_out_dir, write_atomically, write_json
 from vplane_mj.planning.registry import PLANNERS
 from vplane_mj.reference import shortest_path_length
@@ -137,69 +137,18 @@ def load_or_plan(path: Path, count: int, seed: int, time_limit: float) -> list[t
     return runs
 
 
-def guarded_run(job: Job) -> dict:
-    """One run's summary row, or a crash row with the traceback of the exception it raised."""
-    try:
-        return run_job(job)
-    except Exception:
-        return {"key": job.key, "crash": traceback.format_exc()}
-
-
-def run_pool(jobs: list[Job], workers: int, record) -> None:
-    """Run the jobs in a pool of `workers` processes and `record(job, row)` each as it finishes.
-
-    A worker process that dies breaks the pool: the jobs then in flight are retried one at a
-    time in a pool of their own, and one that kills that one too gets a row with `no_summary`.
-    """
-    queue = deque(jobs)
-    while queue:
-        for job in _run_batch(queue, workers, record):
-            if _run_batch(deque([job]), 1, record):
-                record(job, {"key": job.key, "no_summary": "its worker process died, twice"})
-
-
-def _run_batch(queue: deque[Job], workers: int, record) -> list[Job]:
-    """Run jobs off `queue`, at most `workers` at a time, until it is empty or the pool breaks;
-    the jobs in flight when it broke."""
-    lost: list[Job] = []
-    intact = True
-    with ProcessPoolExecutor(workers) as pool:
-        running = {}
-        while (intact and queue) or running:
-            while intact and queue and len(running) < workers:
-                try:
-                    running[pool.submit(guarded_run, queue[0])] = queue[0]
-                except BrokenProcessPool:
-                    intact = False
-                else:
-                    queue.popleft()
-            done, _ = wait(running, return_when=FIRST_COMPLETED)
-            for future in done:
-                job = running.pop(future)
-                try:
-                    row = future.result()
-                except BrokenProcessPool:
-                    intact = False
-                    lost.append(job)
-                else:
-                    record(job, row)
-    return lost
-
-
 def base_name(job: Job) -> str:
     return f"{job.scenario}-{job.planner}-{job.seed}"
 
 
 def report(runs: list[tuple[Job, list[str]]], rows: dict[str, dict], wall_s: float) -> dict:
-    """The soak's figures from the journal rows of its runs."""
+    """The soak's figures from the journal rows of its runs (by key)."""
     planners = sorted({job.planner for job, _ in runs})
     families = list(dict.fromkeys(family_of(job.scenario) for job, _ in runs))
-    finished = [(job, rows.get(job.key, {})) for job, _ in runs]
-    summaries = [(job, row) for job, row in finished if row.get("outcome") in OUTCOMES]
-    crashes = [(job, row) for job, row in finished if "crash" in row]
-    missing = [
-        (job, row) for job, row in finished if "crash" not in row and row.get("outcome") not in OUTCOMES
-    ]
+    finished = [(job, rows[job.key]) for job, _ in runs]
+    summaries = [(job, row) for job, row in finished if FAILURE_KEY not in row]
+    crashes = [(job, row) for job, row in finished if row.get(FAILURE_KEY) == FailureKind.EXCEPTION]
+    died = [(job, row) for job, row in finished if row.get(FAILURE_KEY) == FailureKind.WORKER_DIED]
     outcomes = {planner: dict.fromkeys(OUTCOMES, 0) for planner in planners}
     success: dict[str, dict] = {planner: {} for planner in planners}
     for planner in planners:
@@ -213,12 +162,10 @@ def report(runs: list[tuple[Job, list[str]]], rows: dict[str, dict], wall_s: flo
         "format": 1,
         "runs": len(runs),
         "crashes": [
-            {"run": base_name(j), "planner": j.planner, "exception": r["crash"].splitlines()[-1]}
-            for j, r in crashes
+            {"run": base_name(j), "planner": j.planner, "exception": r["message"]} for j, r in crashes
         ],
         "without_summary": [
-            {"run": base_name(j), "planner": j.planner, "reason": r.get("no_summary", "not run")}
-            for j, r in missing
+            {"run": base_name(j), "planner": j.planner, "reason": r["message"]} for j, r in died
         ],
         "outcomes_per_planner": outcomes,
         "success_rate_per_planner_and_family": success,
@@ -296,46 +243,18 @@ def main(argv: list[str] | None = None) -> int:
 
     started = time.monotonic()
     try:
-        failed_dir = prepare_out_dir(args.out / "failed")
+        prepare_out_dir(args.out)
     except VPlaneError as exc:
         parser.error(str(exc))
     runs = load_or_plan(args.out / PLAN, args.count, args.seed, args.time_limit)
-    faults = {job.key: overrides for job, overrides in runs}
-    journal_path = args.out / JOURNAL
-    rows = read_journal(journal_path)
-    pending = [job for job, _ in runs if job.key not in rows]
-    print(
-        f"{len(runs)} runs: {len(runs) - len(pending)} already done, {len(pending)} to run", file=sys.stderr
-    )
+    try:
+        with signals_raise_interrupted():
+            rows = run_sweep([job for job, _ in runs], args.out, args.jobs, journal_name=JOURNAL)
+    except Interrupted as exc:
+        print(f"\ninterrupted by {exc}: the same command goes on from here", file=sys.stderr)
+        return exc.exit_status
 
-    with open(journal_path, "a", encoding="utf-8") as journal:
-        if journal_path.read_bytes()[-1:] not in (b"", b"\n"):
-            journal.write("\n")  # keep a killed soak's torn last line apart from the new rows
-        progress = Progress(len(runs), len(runs) - len(pending))
-
-        def record(job: Job, row: dict) -> None:
-            try:
-                line = json.dumps({**row, "faults": faults[job.key]}, allow_nan=False)
-            except (TypeError, ValueError) as exc:  # a summary that is not valid JSON
-                line = json.dumps({"key": job.key, "no_summary": f"invalid summary: {exc}"})
-            row = rows[job.key] = json.loads(line)
-            if "outcome" not in row or row["outcome"] == "error":
-                base = failed_dir / base_name(job)
-                write_atomically(Path(f"{base}.toml"), lambda tmp: tmp.write_text(job.toml))
-                if "crash" in row:
-                    trace = Path(f"{base}.traceback.txt")
-                    write_atomically(trace, lambda tmp: tmp.write_text(row["crash"]))
-            journal.write(line + "\n")
-            journal.flush()
-            progress.advance()
-
-        try:
-            run_pool(pending, args.jobs, record)
-        except KeyboardInterrupt:
-            print("\ninterrupted: the same command goes on from here", file=sys.stderr)
-            return 130
-
-    figures = report(runs, rows, time.monotonic() - started)
+    figures = report(runs, {row["key"]: row for row in rows}, time.monotonic() - started)
     print_report(figures)
     print(f"\nwrote {write_json(args.out / 'soak.json', figures)}")
     print(f"wrote {plot(figures, args.out / 'soak.png')}")

@@ -2,20 +2,33 @@
 
 import contextlib
 import csv
+import dataclasses
 import json
 import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from vplane_mj.bench import JOURNAL, family_of, parse_seeds, read_journal
+from vplane_mj.bench import (
+    JOURNAL,
+    PATH_KEY,
+    error_lines,
+    family_of,
+    parse_seeds,
+    plan_jobs,
+    read_journal,
+    run_sweep,
+    summarize,
+)
 from vplane_mj.cli import main
 from vplane_mj.errors import VPlaneError
+from vplane_mj.failures import FAILED_SCENARIO_KEY
 from vplane_mj.scenario import load_scenario
 from vplane_mj.summary import TIMING_KEYS
 
@@ -284,3 +297,133 @@ def test_a_killed_sweep_leaves_a_journal_the_rerun_resumes_from(tmp_path):
     assert 1 <= done < len(SWEEP_KEYS)
     assert {path.name for path in tmp_path.iterdir()} == {JOURNAL}
     assert_the_rerun_completes_the_sweep(tmp_path, done)
+
+
+# ----------------------------------------------------------------- runs that fail, workers that die
+
+
+def planned_jobs(*overrides):
+    return plan_jobs(["open_field", "single_box"], ["apf"], range(4), overrides)
+
+
+def broken(job):
+    """The job with a scenario that no longer validates: its run raises in the worker."""
+    return dataclasses.replace(job, seed=7, toml=job.toml.replace('name = "apf"', 'name = "nope"'))
+
+
+def test_a_run_that_raises_is_an_error_row_with_its_scenario_saved_and_the_sweep_goes_on(tmp_path, capsys):
+    good = plan_jobs(["open_field"], ["apf"], [0, 1])
+    failing = broken(good[0])
+    jobs = [good[0], failing, good[1]]
+    rows = run_sweep(jobs, tmp_path, workers=2)
+    assert [row["key"] for row in rows] == [job.key for job in jobs]
+    assert [row["outcome"] for row in rows] == ["reached", "error", "reached"]
+    error = rows[1]
+    assert error["failure"] == "exception" and not error["success"] and not error["reached"]
+    assert error["collisions"] == 0 and error["path_length_m"] == 0 and error["score"] == 0
+    assert error["time_to_goal_s"] is None and (error["scenario"], error["seed"]) == ("open_field", 7)
+    assert set(rows[0]) - {PATH_KEY, FAILED_SCENARIO_KEY} <= set(error)  # every key of a summary row
+    # The exception's type and text, and where it was raised.
+    assert error["message"].startswith("vplane_mj.errors.ScenarioError: open_field (bench): planner.name: ")
+    assert "unknown planner 'nope'" in error["message"]
+    assert "(at vplane_mj/scenario/parse.py:" in error["message"] and "in run_job" in error["message"]
+    saved = tmp_path / "failed" / "open_field-apf-7.toml"
+    assert error["failed_scenario"] == str(saved) and saved.read_text() == failing.toml
+    trace = (tmp_path / "failed" / "open_field-apf-7.traceback.txt").read_text()
+    assert trace.startswith("Traceback (most recent call last):") and "ScenarioError" in trace
+    assert sorted(path.name for path in (tmp_path / "failed").iterdir()) == [
+        "open_field-apf-7.toml",
+        "open_field-apf-7.traceback.txt",
+    ]
+    [line] = summarize(rows)
+    assert (line["runs"], line["errors"], line["success_rate"]) == (3, 1, pytest.approx(2 / 3))
+    assert error_lines(rows, tmp_path)[0] == (
+        f"1 of 3 runs ended in error; their scenarios are in {tmp_path / 'failed'} "
+        "(vplane-mj run FILE runs one again):"
+    )
+    capsys.readouterr()
+
+    # The error row is a finished run: resuming runs nothing again.
+    assert run_sweep(jobs, tmp_path, workers=2) == rows
+    assert "3 runs: 3 already done, 0 to run" in capsys.readouterr().err
+    assert len((tmp_path / JOURNAL).read_text().splitlines()) == 3
+
+
+def test_a_worker_killed_mid_sweep_is_an_error_row_and_every_other_run_finishes(tmp_path):
+    process = start_bench(tmp_path)
+    try:
+        wait_for_a_finished_run(tmp_path, process)
+        workers = descendants(process.pid)
+        assert len(workers) == 2, "the sweep does not have its two worker processes"
+        os.kill(min(workers), signal.SIGKILL)
+        out, err = process.communicate(timeout=120)
+    finally:
+        end_session(process)
+    assert process.returncode == 0, err
+    rows = [json.loads(line) for line in (tmp_path / JOURNAL).read_text().splitlines()]
+    assert sorted((r["scenario"], r["planner"], r["seed"]) for r in rows) == sorted(SWEEP_KEYS)
+    [error] = [row for row in rows if row["outcome"] == "error"]
+    assert error["failure"] == "worker_died" and not error["success"] and error["collisions"] == 0
+    assert error["message"] == "the worker process running this run died: killed by SIGKILL"
+    assert all(row["steps"] > 0 for row in rows if row is not error)  # the queued runs were not lost
+    job = next(j for j in planned_jobs(*SLOW_RUNS[1::2]) if j.key == error["key"])
+    saved = tmp_path / "failed" / f"{job.scenario}-apf-{job.seed}.toml"
+    assert error["failed_scenario"] == str(saved) and saved.read_text() == job.toml
+    assert [path.name for path in (tmp_path / "failed").iterdir()] == [saved.name]
+    assert f"1 of 8 runs ended in error; their scenarios are in {tmp_path / 'failed'}" in out
+    assert f"  {saved}: the worker process running this run died: killed by SIGKILL" in out
+    assert json.loads((tmp_path / "bench.json").read_text())["table"][0]["errors"] == 1
+    with open(tmp_path / "bench.csv", newline="") as stream:
+        table = list(csv.DictReader(stream))
+    assert sorted(row["outcome"] == "error" for row in table) == [False] * 7 + [True]
+
+    # Resuming runs nothing again.
+    again = subprocess.run(bench_command(tmp_path), capture_output=True, text=True, timeout=120)
+    assert again.returncode == 0, again.stderr
+    assert "8 runs: 8 already done, 0 to run" in again.stderr
+    assert len((tmp_path / JOURNAL).read_text().splitlines()) == 8
+
+
+def test_a_failed_dask_task_is_the_same_error_row_as_in_the_local_pool(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    good = plan_jobs(["open_field"], ["apf"], [0])[0]
+    failing = broken(good)
+    (tmp_path / "local").mkdir()
+    local = run_sweep([failing], tmp_path / "local", workers=1)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True) as cluster:
+        rows = run_sweep([good, failing], tmp_path, 1, cluster.scheduler_address)
+    assert [row["outcome"] for row in rows] == ["reached", "error"]
+    saved = tmp_path / "failed" / "open_field-apf-7.toml"
+    assert rows[1]["failed_scenario"] == str(saved) and saved.read_text() == failing.toml
+    assert {**rows[1], "failed_scenario": ""} == {**local[0], "failed_scenario": ""}
+
+
+def test_a_dask_worker_that_dies_mid_run_is_an_error_row(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    import dask
+
+    [job] = planned_jobs(*SLOW_RUNS[1::2])[:1]
+    # No second attempt for a task whose worker died: the first death fails it (KilledWorker).
+    with (
+        dask.config.set({"distributed.scheduler.allowed-failures": 0}),
+        distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        [worker_pid] = client.run(os.getpid).values()
+
+        def kill_the_worker_mid_run():
+            deadline = time.monotonic() + 60
+            while not any(client.processing().values()) and time.monotonic() < deadline:
+                time.sleep(0.05)
+            time.sleep(0.3)
+            os.kill(worker_pid, signal.SIGKILL)
+
+        killer = threading.Thread(target=kill_the_worker_mid_run)
+        killer.start()
+        [row] = run_sweep([job], tmp_path, 1, cluster.scheduler_address)
+        killer.join()
+    assert row["outcome"] == "error" and row["failure"] == "worker_died"
+    assert row["message"].startswith("distributed.scheduler.KilledWorker: ")
+    assert "all those workers died while running it" in row["message"]
+    saved = tmp_path / "failed" / f"{job.scenario}-apf-{job.seed}.toml"
+    assert row["failed_scenario"] == str(saved) and saved.read_text() == job.toml

@@ -3,7 +3,9 @@
 Every finished run is appended at once to `bench.jsonl` in the output directory (one JSON
 summary per line), so an interrupted sweep loses nothing finished: the same command run
 again skips the runs whose rows exist (same scenario text, planner and seed) and does the
-rest. At the end `bench.csv`, `bench.json` (rows and table), `bench.png`,
+rest. A run that raises, or whose worker process dies, is a row too, with outcome `error`
+(see `failures`); the scenario of every run that ended in `error` is saved under
+`failed/` for replay. At the end `bench.csv`, `bench.json` (rows and table), `bench.png`,
 `bench-scenarios.png` and `bench.html` (see `bench_report`) are written (each atomically)
 and the table is printed. An interruption (SIGINT, SIGTERM) stops the
 workers at once: the runs they had under way are done again by the next invocation.
@@ -17,18 +19,26 @@ import hashlib
 import io
 import json
 import os
-import signal
 import statistics
 import sys
-import threading
 import time
-from collections.abc import Iterable, Iterator
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from collections.abc import Generator, Iterable
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 from vplane_mj.errors import VPlaneError
+from vplane_mj.failures import (
+    FAILED_DIR,
+    FAILED_SCENARIO_KEY,
+    FailureKind,
+    RunFailure,
+    call_or_failure,
+    failure_of,
+    finished_row,
+)
 from vplane_mj.outputs import write_atomically, write_json
+from vplane_mj.pool import run_in_pool
 from vplane_mj.scenario import load_scenario
 
 JOURNAL = "bench.jsonl"
@@ -83,7 +93,7 @@ def parse_seeds(text: str) -> list[int]:
             low, high = (int(bounds[0]), int(bounds[-1])) if len(bounds) <= 2 else (None, None)
         except ValueError:
             low = high = None
-        if low is None or low < 0 or high < low or high >= 2**32:
+        if low is None or high is None or low < 0 or high < low or high >= 2**32:
             raise VPlaneError(f"--seeds: {part.strip()!r} is not a seed or a range like 0-19 (seeds < 2**32)")
         if len(seeds) + (high - low + 1) > MAX_SEEDS:
             raise VPlaneError(f"--seeds: more than {MAX_SEEDS} seeds in {text.strip()!r}")
@@ -179,30 +189,38 @@ class Progress:
             print(line, file=sys.stderr, flush=True)
 
 
-def run_sweep(jobs: list[Job], out_dir: Path, workers: int, scheduler: str | None = None) -> list[dict]:
-    """Run the jobs not yet in the journal; return every row of the sweep, in job order.
+def run_sweep(
+    jobs: list[Job], out_dir: Path, workers: int, scheduler: str | None = None, journal_name: str = JOURNAL
+) -> list[dict]:
+    """Run the jobs not yet in the journal (`out_dir/journal_name`); return every row of the
+    sweep, in job order.
 
     Locally the jobs go to a pool of `workers` processes; with `scheduler` (an address)
     they go to that Dask distributed cluster instead. Each job is the same pure function
-    of its scenario text, so both engines give the same rows.
+    of its scenario text, so both engines give the same rows. A job that fails (it raises,
+    its worker dies) gives a row with outcome `error` and the sweep goes on.
     """
-    journal_path = out_dir / JOURNAL
+    journal_path = out_dir / journal_name
     finished = read_journal(journal_path)
     pending = [job for job in jobs if job.key not in finished]
-    rows = _dask_rows(pending, scheduler) if scheduler and pending else _local_rows(pending, workers)
+    if scheduler and pending:
+        results = _dask_results(pending, scheduler)
+    else:
+        results = run_in_pool(pending, run_job, workers)
     engine = f"on the Dask cluster at {scheduler}" if scheduler else f"with {workers} worker(s)"
     print(
         f"{len(jobs)} runs: {len(jobs) - len(pending)} already done, {len(pending)} to run {engine}",
         file=sys.stderr,
     )
-    # Closed explicitly, so that the workers stop however the loop ends (an interruption, a failed run).
-    with contextlib.closing(rows):
+    # Closed explicitly, so that the workers stop however the loop ends (an interruption, an error).
+    with contextlib.closing(results):
         if pending:
             progress = Progress(len(jobs), len(jobs) - len(pending))
             with open(journal_path, "a", encoding="utf-8") as journal:
                 if not _ends_with_a_newline(journal_path):
                     journal.write("\n")  # a killed sweep's torn line stays a line apart from the new rows
-                for row in rows:
+                for job, result in results:
+                    row = finished_row(job, result, out_dir)
                     journal.write(json.dumps(row, allow_nan=False) + "\n")
                     journal.flush()
                     finished[row["key"]] = row
@@ -219,52 +237,15 @@ def _ends_with_a_newline(path: Path) -> bool:
         return stream.read(1) == b"\n"
 
 
-def _local_rows(jobs: list[Job], workers: int) -> Iterator[dict]:
-    """Rows as the local process pool finishes them; on any early exit the workers are stopped."""
-    pool = ProcessPoolExecutor(workers, initializer=_start_worker, initargs=(os.getpid(),))
-    try:
-        for future in as_completed([pool.submit(run_job, job) for job in jobs]):
-            yield future.result()
-    except BaseException:  # an interruption, the generator closed early, a failed run
-        _stop_workers(pool)
-        raise
-    pool.shutdown()
+def _dask_results(jobs: list[Job], scheduler: str) -> Generator[tuple[Job, dict | RunFailure], None, None]:
+    """Jobs with their rows or failures as the workers of a Dask distributed cluster finish
+    them (the [dask] extra).
 
-
-def _start_worker(sweep_pid: int) -> None:
-    """Set up a worker process of the local pool.
-
-    Ctrl-C in a terminal reaches the whole process group: the workers ignore SIGINT and
-    leave it to the sweep, which stops them. A worker whose sweep was killed outright
-    exits instead of running on.
-    """
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    threading.Thread(target=_exit_when_orphaned, args=(sweep_pid,), daemon=True).start()
-
-
-def _exit_when_orphaned(sweep_pid: int) -> None:
-    """In a worker: exit as soon as its parent is no longer the sweep that started it."""
-    while os.getppid() == sweep_pid:
-        time.sleep(0.5)
-    os._exit(1)
-
-
-def _stop_workers(pool: ProcessPoolExecutor) -> None:
-    """Cancel the jobs not started and end the running ones now rather than wait for them."""
-    # The executor has no public way to end running workers before Python 3.14.
-    for process in list((pool._processes or {}).values()):
-        process.terminate()
-    pool.shutdown(wait=True, cancel_futures=True)
-
-
-def _dask_rows(jobs: list[Job], scheduler: str) -> Iterator[dict]:
-    """Rows as the workers of a Dask distributed cluster finish them (the [dask] extra).
-
-    Connects at once, so an unreachable scheduler is reported before anything is written.
+    Connects at once, so an unreachable scheduler is reported before anything is written. A
+    task that fails in Dask itself (its workers died, `KilledWorker`) is a failure too.
     """
     try:
-        from distributed import Client
+        from distributed import Client, KilledWorker
         from distributed import as_completed as dask_completed
     except ImportError as exc:
         raise VPlaneError("--scheduler needs Dask: pip install 'vplane-mj[dask]'") from exc
@@ -273,12 +254,19 @@ def _dask_rows(jobs: list[Job], scheduler: str) -> Iterator[dict]:
     except OSError as exc:
         raise VPlaneError(f"--scheduler: cannot reach a Dask scheduler at {scheduler}: {exc}") from exc
 
-    def rows() -> Iterator[dict]:
+    def results() -> Generator[tuple[Job, dict | RunFailure], None, None]:
         with client:
-            for future in dask_completed(client.map(run_job, jobs, pure=False)):
-                yield future.result()
+            futures = client.map(partial(call_or_failure, run_job), jobs, pure=False)
+            job_of = dict(zip(futures, jobs, strict=True))
+            for future in dask_completed(futures):
+                if future.status == "error":
+                    exc = future.exception()
+                    kind = FailureKind.WORKER_DIED if isinstance(exc, KilledWorker) else FailureKind.EXCEPTION
+                    yield job_of[future], failure_of(exc, future.traceback(), kind)
+                else:
+                    yield job_of[future], future.result()
 
-    return rows()
+    return results()
 
 
 def summarize(rows: list[dict]) -> list[dict]:
@@ -330,6 +318,28 @@ def format_table(table: list[dict]) -> str:
     return "\n".join(lines)
 
 
+MAX_ERRORS_LISTED = 10
+"""The most runs in `error` that `bench` lists one by one after its table."""
+
+
+def error_lines(rows: list[dict], out_dir: Path) -> list[str]:
+    """How many runs ended in `error` and where their scenarios are, then the first
+    MAX_ERRORS_LISTED of them with their messages; nothing when none did."""
+    errors = [row for row in rows if row["outcome"] == "error"]
+    if not errors:
+        return []
+    lines = [
+        f"{len(errors)} of {len(rows)} runs ended in error; their scenarios are in "
+        f"{out_dir / FAILED_DIR} (vplane-mj run FILE runs one again):"
+    ]
+    for row in errors[:MAX_ERRORS_LISTED]:
+        where = row.get(FAILED_SCENARIO_KEY) or f"{row['scenario']}, {row['planner']}, seed {row['seed']}"
+        lines.append(f"  {where}: {row['message']}")
+    if len(errors) > MAX_ERRORS_LISTED:
+        lines.append(f"  and {len(errors) - MAX_ERRORS_LISTED} more (bench.csv has them all)")
+    return lines
+
+
 def write_outputs(rows: list[dict], table: list[dict], out_dir: Path, jobs: list[Job]) -> list[Path]:
     """bench.csv (one row per run), bench.json (rows and table), the figures and bench.html."""
     from vplane_mj import bench_report
@@ -350,7 +360,7 @@ def write_outputs(rows: list[dict], table: list[dict], out_dir: Path, jobs: list
         "bench-scenarios.png": bench_report.png_bytes(bench_report.scenario_figure(rows)),
     }
     for name, data in figures.items():
-        written.append(write_atomically(out_dir / name, lambda tmp, data=data: tmp.write_bytes(data)))
+        written.append(write_atomically(out_dir / name, partial(Path.write_bytes, data=data)))
     page = bench_report.write_html_text(
         rows,
         table,

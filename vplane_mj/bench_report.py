@@ -30,6 +30,11 @@ from vplane_mj.scenario import parse_scenario
 _OUTCOME_COLOURS = {"reached": "#1f6fd1", "stuck": "#8e24aa", "timeout": "#e07b00", "error": "#222222"}
 PICTURE_MARGIN_M = 1.0
 """A run's picture shows its start, goal and path with this margin (m), within the arena."""
+Point = tuple[float, float]
+Box = tuple[float, float, float, float]
+"""x0, y0, x1, y1 (m)."""
+WorldSymbol = tuple[str, Box, tuple[Point, Point]]
+"""A scenario's world as drawn once in the page: its symbol id, its box, its start and goal."""
 _RUN_COLUMNS = (
     ("outcome", "outcome"),
     ("time_to_goal_s", "time to goal (s)"),
@@ -235,7 +240,7 @@ def _table_html(table: list[dict]) -> str:
     return f'<table class="planners"><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>'
 
 
-def _run_details(row: dict, symbol: str | None) -> str:
+def _run_details(row: dict, symbol: WorldSymbol | None) -> str:
     """One run: a summary line that opens to the picture and the run's summary."""
     cells = [row["scenario"], row["planner"], str(row["seed"])]
     cells += [_format(row.get(key)) for key, _ in _RUN_COLUMNS]
@@ -249,7 +254,7 @@ def _run_details(row: dict, symbol: str | None) -> str:
     )
 
 
-def _run_svg(row: dict, symbol: str | None) -> str:
+def _run_svg(row: dict, symbol: WorldSymbol | None) -> str:
     """The run's path over its world (a shared symbol per scenario); y points up."""
     if symbol is None:
         return "<p>no picture: the scenario is unknown</p>"
@@ -260,9 +265,9 @@ def _run_svg(row: dict, symbol: str | None) -> str:
     x0, y0 = np.maximum(points.min(axis=0) - PICTURE_MARGIN_M, (x0, y0))
     x1, y1 = np.minimum(points.max(axis=0) + PICTURE_MARGIN_M, (x1, y1))
     colour = _OUTCOME_COLOURS.get(row["outcome"], "#222222")
-    points = " ".join(f"{x:.2f},{-y:.2f}" for x, y in path)  # the path is simplified to 2 cm
+    coordinates = " ".join(f"{x:.2f},{-y:.2f}" for x, y in path)  # the path is simplified to 2 cm
     drawn = (
-        f'<polyline points="{points}" fill="none" stroke="{colour}" stroke-width="2.5" '
+        f'<polyline points="{coordinates}" fill="none" stroke="{colour}" stroke-width="2.5" '
         f'vector-effect="non-scaling-stroke" stroke-linejoin="round"/>'
         if len(path) > 1
         else ""
@@ -277,14 +282,17 @@ def _run_svg(row: dict, symbol: str | None) -> str:
     )
 
 
-def _scenario_symbols(rows: Iterable[dict], scenario_tomls: dict[str, str]) -> tuple[str, dict]:
+def _scenario_symbols(
+    rows: Iterable[dict], scenario_tomls: dict[str, str]
+) -> tuple[str, dict[str, WorldSymbol]]:
     """One SVG symbol per distinct scenario text: floor, obstacles, border, start, goal.
 
     Returns the symbols' markup and, per row key, (symbol id, the world's box in metres,
     (start, goal)).
     """
-    by_text: dict[str, tuple] = {}
-    markup, symbol_of = [], {}
+    by_text: dict[str, WorldSymbol] = {}
+    markup: list[str] = []
+    symbol_of: dict[str, WorldSymbol] = {}
     for row in rows:
         text = scenario_tomls.get(row["key"])
         if text is None:
@@ -298,7 +306,7 @@ def _scenario_symbols(rows: Iterable[dict], scenario_tomls: dict[str, str]) -> t
     return "".join(markup), symbol_of
 
 
-def _world_svg(toml_text: str) -> tuple[str, tuple[float, float, float, float], tuple]:
+def _world_svg(toml_text: str) -> tuple[str, Box, tuple[Point, Point]]:
     """SVG shapes of a scenario's world (y negated, so that it points up), its box (m) and
     its start and goal."""
     scenario = parse_scenario(toml_text, "bench scenario")

@@ -6,6 +6,7 @@ import argparse
 import json
 import os
 import sys
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -246,7 +247,7 @@ def _summary_line(scenario: Scenario, s: RunSummary) -> str:
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from vplane_mj.bench import format_table, parse_seeds
+    from vplane_mj.bench import error_lines, format_table, parse_seeds
     from vplane_mj.sweeps import sweep
 
     if args.jobs < 1:
@@ -269,6 +270,8 @@ def _bench(args: argparse.Namespace) -> int:
         )
         return exc.exit_status
     print(format_table(result.table))
+    for line in error_lines(result.rows, Path(out_dir)):
+        print(line)
     for path in result.files:
         print(f"wrote {path}")
     return 0
@@ -293,7 +296,7 @@ def _generate(args: argparse.Namespace) -> int:
         lambda scenario, clearance: shortest_path_length(scenario, radius, clearance) is not None,
     )
     for case in cases:
-        path = write_atomically(out_dir / f"{case.name}.toml", lambda tmp, c=case: tmp.write_text(c.toml()))
+        path = write_atomically(out_dir / f"{case.name}.toml", partial(Path.write_text, data=case.toml()))
         print(f"wrote {path}")
     return 0
 

@@ -8,7 +8,7 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import Any, BinaryIO, cast
 
 import numpy as np
 from mcap import records as mr
@@ -108,7 +108,8 @@ class _RecordScan:
         schemas: dict[int, Any] = {}
         channels: dict[int, Any] = {}
         with open(self.path, "rb") as raw:
-            reader = StreamReader(_StrictStream(raw), validate_crcs=True)
+            # The reader only calls read(), which is all a _StrictStream has.
+            reader = StreamReader(cast(BinaryIO, _StrictStream(raw)), validate_crcs=True)
             records = reader.records
             while True:
                 try:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+from typing import TypedDict
 
 import numpy as np
 
@@ -58,7 +59,22 @@ def travelled(start: np.ndarray, trace: np.ndarray) -> tuple[float, float]:
     return first, float(np.hypot(steps[:, 0], steps[:, 1]).sum())
 
 
-def motion_quality(yaws: np.ndarray, path_length: float) -> dict[str, float | None]:
+class MotionQuality(TypedDict):
+    """The summary's keys for how the robot moved (`motion_quality`)."""
+
+    smoothness_rad_per_m: float | None
+    oscillation_per_m: float | None
+
+
+class PathQuality(TypedDict):
+    """The summary's keys for the path against the reference path (`path_quality`)."""
+
+    optimal_length_m: float | None
+    path_ratio: float | None
+    score: float | None
+
+
+def motion_quality(yaws: np.ndarray, path_length: float) -> MotionQuality:
     """Smoothness: total absolute heading change per metre travelled (rad/m); oscillation:
     reversals of the turning direction per metre (1/m). None when the robot did not move."""
     if len(yaws) < 2 or path_length < 1e-6:
@@ -89,7 +105,7 @@ def path_quality(
     path_length: float,
     time_to_goal: float | None,
     top_speed_mps: float,
-) -> dict[str, float | None]:
+) -> PathQuality:
     """The reference shortest path to the goal tolerance disc, the path length over it, and the
     BARN score (`barn_score`)."""
     reference = shortest_path_length(scenario, radius)

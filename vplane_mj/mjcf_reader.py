@@ -45,7 +45,8 @@ class MjcfReader:
         for tag in UNSUPPORTED_ELEMENTS:
             if self.root.find(f".//{tag}") is not None:
                 raise ValueError(f"{path}: <{tag}> is not supported by this reader")
-        self._defaults = {}  # class -> (its <default> element, its parent class or None)
+        # class -> (its <default> element, its parent class or None)
+        self._defaults: dict[str, tuple[ET.Element, str | None]] = {}
         for top in self.root.findall("default"):
             self._collect_defaults(top, None)
         compiler = self.root.find("compiler")

@@ -52,8 +52,9 @@ def output_directory(path: Path) -> Iterator[Path]:
         raise
 
 
-def write_atomically(path: Path, write: Callable[[Path], None]) -> Path:
-    """Let `write` fill a temporary file beside `path`, then rename it into place."""
+def write_atomically(path: Path, write: Callable[[Path], object]) -> Path:
+    """Let `write` fill a temporary file beside `path`, then rename it into place (what
+    `write` returns is ignored)."""
     temporary = path.with_name(f".{path.name}.partial")
     try:
         write(temporary)

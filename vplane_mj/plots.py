@@ -110,7 +110,7 @@ def _draw_map(axes, contents: LogContents, scenario: Scenario, track: Track) -> 
     times = contents.times_ns / 1e9
     minima = [e.time_s for e in contents.events if e.kind is EventKind.LOCAL_MINIMUM]
     for k, t in enumerate(minima):
-        where = points[min(np.searchsorted(times, t), len(points) - 1)]
+        where = points[min(int(np.searchsorted(times, t)), len(points) - 1)]
         axes.plot(*where, "X", color="black", ms=10, label="local minimum" if k == 0 else None)
     for k, objective in enumerate(track.objectives):
         axes.plot(*objective, "*", color="#1a5ae6", ms=14, label="virtual objective" if k == 0 else None)
@@ -136,7 +136,7 @@ def _draw_field(axes, contents: LogContents, scenario: Scenario) -> None:
     times = contents.times_ns / 1e9
     minima = [e.time_s for e in contents.events if e.kind is EventKind.LOCAL_MINIMUM]
     if minima:
-        centre = contents.positions[min(np.searchsorted(times, minima[0]), len(times) - 1)]
+        centre = contents.positions[min(int(np.searchsorted(times, minima[0])), len(times) - 1)]
         title = f"APF force at the local minimum, t = {minima[0]:.1f} s"
     else:
         centre = np.asarray(scenario.robot.start, float)

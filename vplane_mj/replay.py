@@ -90,7 +90,7 @@ def summarize(contents: LogContents, scenario: Scenario) -> dict:
         "outcome": outcome,
         "reached": reached,
         "success": reached and collisions == 0,
-        "time_to_goal_s": ending.time_s if reached else None,
+        "time_to_goal_s": ending.time_s if reached and ending is not None else None,
         "sim_time_s": contents.times_ns[-1] / 1e9,
         "path_length_m": float(np.sum(np.hypot(steps[:, 0], steps[:, 1]))),
         "collisions": collisions,

@@ -316,6 +316,7 @@ class Run:
         """Record the tick (with its command: the given one, else the heading controller's) and
         show it to the observers."""
         decision = self._decision
+        assert self._belief is not None and decision is not None, "reporting a tick not planned"
         believed_xy, believed_yaw = self._belief
         if command is None:
             command = heading_command(
@@ -371,8 +372,6 @@ class Run:
     # -- the result -------------------------------------------------------------------------
     def result(self) -> RunResult:
         """The run's summary and path (call once it has ended)."""
-        if self.ending is None:
-            raise RuntimeError("the run has not ended")
         return RunResult(
             summary=self.summary(),
             times=np.array(self.times),
@@ -387,7 +386,10 @@ class Run:
         )
 
     def summary(self) -> RunSummary:
+        """The run's summary (call once it has ended)."""
         scenario, ending, clearance = self.scenario, self.ending, self.clearance
+        if ending is None:
+            raise RuntimeError("the run has not ended")
         reached = ending.outcome is Outcome.REACHED
         success = reached and not self.collisions.points
         cpu = self.planner_cpu

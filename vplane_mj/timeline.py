@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -98,7 +99,7 @@ def _arrows(message, state: dict) -> dict:
 
 def _virtual_states(path: Path, times_ns: np.ndarray) -> list[tuple]:
     """(objective, planes) at each tick, from the `/virtual` updates (entities and deletions)."""
-    entities: dict[str, object] = {}
+    entities: dict[str, Any] = {}  # foxglove.SceneEntity messages by id
 
     def apply(message, state):
         for deletion in message.deletions:

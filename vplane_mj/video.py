@@ -24,6 +24,8 @@ matplotlib.use("Agg")  # files only, never a window
 import imageio_ffmpeg
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.artist import Artist
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
 from matplotlib.patches import Circle, Polygon
 from matplotlib.transforms import Bbox
@@ -207,7 +209,7 @@ class FrameCanvas:
             fontsize=font,
             weight="bold",
         )
-        self._animated = []
+        self._animated: list[Artist] = []
         self.path = self._add(LineCollection([], linewidths=2.2, capstyle="round"))
         self.planes = self._add(LineCollection([], colors=_PLANE_COLOUR, linewidths=3))
         (self.objective,) = axes.plot([], [], "*", color="#1a5ae6", ms=font * 1.6, zorder=6)
@@ -244,6 +246,8 @@ class FrameCanvas:
             artist.set_animated(True)
         self.robot_radius_m = robot_radius_m
         canvas = self.figure.canvas
+        assert isinstance(canvas, FigureCanvasAgg)  # the backend chosen above: blitting, pixels
+        self.canvas = canvas
         canvas.draw()
         self._background = canvas.copy_from_bbox(self.figure.bbox)
         self._path_drawn = 0  # path segments already in the background
@@ -261,7 +265,7 @@ class FrameCanvas:
         """The RGBA frame (height x width x 4 bytes) at simulated time `time_s`."""
         tl = self.timeline
         k = tl.index_at(time_s)
-        canvas = self.figure.canvas
+        canvas = self.canvas
         canvas.restore_region(self._background)
         self._extend_path(k)
         x, y, yaw = tl.poses[k]
@@ -284,7 +288,7 @@ class FrameCanvas:
 
     def _draw_caption(self, text: str) -> None:
         """The caption strip: its pixels are kept while its text stays the same (text is slow)."""
-        canvas = self.figure.canvas
+        canvas = self.canvas
         if self._caption_shown is None or self._caption_shown[0] != text:
             self.caption.set_text(text)
             self.figure.draw_artist(self.caption)
@@ -301,7 +305,7 @@ class FrameCanvas:
         self.path.set_segments(np.stack([points[:-1], points[1:]], axis=1))
         self.path.set_color([MODE_RGBA.get(mode, OTHER_MODE_RGBA) for mode in modes])
         self.axes.draw_artist(self.path)
-        self._background = self.figure.canvas.copy_from_bbox(self.figure.bbox)
+        self._background = self.canvas.copy_from_bbox(self.figure.bbox)
         self._path_drawn = k
 
     def _caption(self, time_s: float) -> str:

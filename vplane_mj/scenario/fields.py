@@ -14,7 +14,7 @@ import re
 import sys
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeGuard
 
 
 class Invalid(Exception):
@@ -85,7 +85,7 @@ def _bounds_reason(value: float, field: Field) -> str | None:
     return None
 
 
-def is_number(value: object) -> bool:
+def is_number(value: object) -> TypeGuard[int | float]:
     """An int or a float, but not a bool (TOML booleans are not numbers)."""
     return isinstance(value, int | float) and not isinstance(value, bool)
 

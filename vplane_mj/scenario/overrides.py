@@ -70,7 +70,8 @@ def apply_override(doc: dict[str, Any], text: str) -> None:
     if not key:
         raise Invalid("", f"invalid --set {text!r}: the key before '=' is empty")
     tokens = _parse_key(key)
-    node, where = doc, ""
+    node: Any = doc  # a table or an array on the way down the key's path
+    where = ""
     for token in tokens[:-1]:
         slot, where = _slot(node, token, where, key)
         if isinstance(node, dict) and slot not in node:

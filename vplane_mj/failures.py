@@ -1,0 +1,146 @@
+"""Runs of a sweep that end without a summary: what went wrong, as a row with outcome `error`,
+and the scenario kept for replay.
+
+A run that raises gives a RunFailure with the exception's type and text and where it was
+raised (the innermost frames of its traceback), and the whole traceback; a run whose worker
+process died gives one that names the signal or the exit status. Either becomes a row with
+every key of a run's summary (outcome `error`, not reached, no collision, nothing travelled,
+score 0) and `failure` saying which of the two it was.
+"""
+
+from __future__ import annotations
+
+import re
+import signal
+import traceback
+from collections.abc import Callable
+from dataclasses import dataclass
+from enum import StrEnum
+from pathlib import Path
+from types import TracebackType
+from typing import TYPE_CHECKING, Any, TypeVar
+
+from vplane_mj import __version__
+from vplane_mj.outputs import write_atomically
+from vplane_mj.summary import Outcome, RunSummary
+
+if TYPE_CHECKING:
+    from vplane_mj.bench import Job
+
+FAILURE_KEY = "failure"
+"""The row key that says why a run has no summary of its own (a FailureKind)."""
+FAILED_SCENARIO_KEY = "failed_scenario"
+"""The row key of an `error` run's saved scenario: `vplane-mj run` on it runs it again."""
+FAILED_DIR = "failed"
+"""Where in a sweep's output directory the scenarios of its `error` runs are saved."""
+FRAMES_IN_MESSAGE = 3
+"""How many of the innermost frames of a traceback a failure's message names."""
+SOURCE_ROOT = Path(__file__).resolve().parent.parent
+"""Paths below this directory (the package's parent) are shown relative to it."""
+
+Item = TypeVar("Item")
+Result = TypeVar("Result")
+
+
+class FailureKind(StrEnum):
+    """Why a run of a sweep ended without a summary."""
+
+    EXCEPTION = "exception"
+    """The run raised an exception."""
+    WORKER_DIED = "worker_died"
+    """The process running it died (killed by a signal such as the OOM killer's, or exited)."""
+
+
+@dataclass(frozen=True)
+class RunFailure:
+    """A run that ended without a summary: one line for its row and, when it raised, the
+    whole traceback."""
+
+    kind: FailureKind
+    message: str
+    traceback: str = ""
+
+
+def call_or_failure(run: Callable[[Item], Result], item: Item) -> Result | RunFailure:
+    """`run(item)`, or the RunFailure of the exception it raised (made where it was raised:
+    an exception object may not survive being sent to another process)."""
+    try:
+        return run(item)
+    except Exception as exc:
+        trace = exc.__traceback__
+        return failure_of(exc, trace.tb_next if trace else None)  # without this frame
+
+
+def failure_of(
+    exc: BaseException, trace: TracebackType | None = None, kind: FailureKind = FailureKind.EXCEPTION
+) -> RunFailure:
+    """The failure of a run that raised `exc`; `trace` when it is not `exc.__traceback__`.
+
+    Its message, e.g. `ValueError: bad (at vplane_mj/sim.py:210 in run_tick, from
+    vplane_mj/sim.py:236 in run_scenario)`: the exception and the innermost frames.
+    """
+    trace = trace if trace is not None else exc.__traceback__
+    text = "".join(traceback.format_exception_only(type(exc), exc)).strip()
+    frames = traceback.extract_tb(trace)[-FRAMES_IN_MESSAGE:]
+    places = [f"{_shown(frame.filename)}:{frame.lineno} in {frame.name}" for frame in reversed(frames)]
+    message = f"{text} (at {', from '.join(places)})" if places else text
+    return RunFailure(kind, message, "".join(traceback.format_exception(type(exc), exc, trace)))
+
+
+def worker_died(exit_code: int) -> RunFailure:
+    """The failure of a run whose worker process ended with `exit_code` (-N: killed by signal N)."""
+    how = f"killed by {_signal_name(-exit_code)}" if exit_code < 0 else f"it exited with status {exit_code}"
+    return RunFailure(FailureKind.WORKER_DIED, f"the worker process running this run died: {how}")
+
+
+def _signal_name(number: int) -> str:
+    try:
+        return signal.Signals(number).name
+    except ValueError:
+        return f"signal {number}"
+
+
+def _shown(filename: str) -> str:
+    """A source file's path relative to SOURCE_ROOT when it lies below it."""
+    path = Path(filename)
+    return str(path.relative_to(SOURCE_ROOT)) if path.is_relative_to(SOURCE_ROOT) else filename
+
+
+def error_row(job: Job, failure: RunFailure) -> dict[str, Any]:
+    """The sweep's row for a job that ended in `failure`: a summary with outcome `error`."""
+    summary = RunSummary(
+        scenario=job.scenario,
+        planner=job.planner,
+        seed=job.seed,
+        outcome=Outcome.ERROR,
+        score=0.0,  # not a success: it counts against the planner's mean score
+        message=failure.message,
+        version=__version__,
+    )
+    return {"key": job.key, **summary.to_dict(), FAILURE_KEY: str(failure.kind)}
+
+
+def save_failed_scenario(out_dir: Path, job: Job, trace: str = "") -> Path:
+    """Write the job's scenario to `out_dir/failed/<scenario>-<planner>-<seed>.toml` (and a
+    non-empty traceback beside it as `.traceback.txt`), each atomically; the scenario's path."""
+    directory = out_dir / FAILED_DIR
+    directory.mkdir(exist_ok=True)
+    base = re.sub(r"[^\w.-]", "_", f"{job.scenario}-{job.planner}-{job.seed}")
+    if trace:
+        write_atomically(directory / f"{base}.traceback.txt", lambda tmp: tmp.write_text(trace, "utf-8"))
+    return write_atomically(directory / f"{base}.toml", lambda tmp: tmp.write_text(job.toml, "utf-8"))
+
+
+def finished_row(job: Job, result: dict[str, Any] | RunFailure, out_dir: Path) -> dict[str, Any]:
+    """A sweep's row for a finished job: its summary row, or the error row of its failure.
+
+    The scenario of every run that ended in `error` (a failure, or a run's own `error`
+    outcome) is saved for replay and named in the row under FAILED_SCENARIO_KEY.
+    """
+    if isinstance(result, RunFailure):
+        row, trace = error_row(job, result), result.traceback
+    else:
+        row, trace = result, ""
+    if row["outcome"] == Outcome.ERROR:
+        row[FAILED_SCENARIO_KEY] = str(save_failed_scenario(out_dir, job, trace))
+    return row
