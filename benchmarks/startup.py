@@ -45,7 +45,7 @@ def one_run(scenario: str, out: Path) -> tuple[float, float]:
     summary = json.loads(next(out.glob("*.json")).read_text())
     for path in out.glob("*.json"):
         path.unlink()
-    return wall, summary.wall_time_s
+    return wall, summary["wall_time_s"]
 
 
 def process_wall(arguments: list[str]) -> float:

@@ -1,0 +1,64 @@
+"""The benchmark scripts run: each, with the smallest arguments it takes, exits 0 and prints or
+writes its results (their numbers are the README's business, not the tests')."""
+
+from __future__ import annotations
+
+import csv
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+BENCHMARKS = Path(__file__).parents[1] / "benchmarks"
+
+
+def run_benchmark(script: str, *arguments: str, cwd: Path) -> str:
+    """The standard output of `python benchmarks/SCRIPT ARGUMENTS`, which must exit 0."""
+    done = subprocess.run(
+        [sys.executable, str(BENCHMARKS / script), *arguments],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    return done.stdout
+
+
+def table_rows(text: str, first_cell: str) -> list[list[str]]:
+    """The cells of the Markdown table rows of `text` whose first cell is `first_cell`."""
+    rows = [[cell.strip() for cell in line.strip().strip("|").split("|")] for line in text.splitlines()]
+    return [row for row in rows if row and row[0] == first_cell]
+
+
+@pytest.mark.parametrize(
+    ("script", "arguments", "first_cell", "number_column"),
+    [
+        ("overhead.py", ("open_field", "--planners", "apf", "--repeat", "1"), "open_field", 5),
+        ("planner_cost.py", ("open_field", "--driver", "apf", "--repeat", "1"), "open_field", 2),
+        ("startup.py", ("open_field", "--repeat", "1"), "open_field", 3),
+        ("video.py", ("open_field", "--repeat", "1"), "open_field", 3),
+    ],
+)
+def test_timing_benchmarks_print_their_table(tmp_path, script, arguments, first_cell, number_column):
+    (row,) = table_rows(run_benchmark(script, *arguments, cwd=tmp_path), first_cell)
+    number = row[number_column].split()[0]
+    assert float(number) > 0, row
+
+
+def test_sweep_benchmarks_write_their_results(tmp_path):
+    run_benchmark(
+        "clutter.py", "--barn", "1", "--count", "1", "--planners", "apf", "--out", "clutter", cwd=tmp_path
+    )
+    families = {row["family"]: row for row in csv.DictReader(open(tmp_path / "clutter" / "clutter.csv"))}
+    assert {"paper", "suite", "traps", "clutter", "corridors", "barn", "barn_noisy"} <= set(families)
+    assert int(families["suite"]["runs"]) == 34 and families["paper"]["success_rate"] == "0.0"  # apf
+    for script, arguments in (
+        ("degradation.py", ("--cases", "2", "--noise", "0", "--dropout", "0.1", "--planners", "apf")),
+        ("soak.py", ("--count", "3")),
+    ):
+        name = script.removesuffix(".py")
+        out = run_benchmark(script, *arguments, "--time-limit", "5", "--out", name, cwd=tmp_path)
+        assert f"wrote {name}/{name}.png" in out
+        assert (tmp_path / name / f"{name}.png").stat().st_size > 1000
