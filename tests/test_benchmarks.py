@@ -51,7 +51,8 @@ def test_sweep_benchmarks_write_their_results(tmp_path):
     run_benchmark(
         "clutter.py", "--barn", "1", "--count", "1", "--planners", "apf", "--out", "clutter", cwd=tmp_path
     )
-    families = {row["family"]: row for row in csv.DictReader(open(tmp_path / "clutter" / "clutter.csv"))}
+    table = (tmp_path / "clutter" / "clutter.csv").read_text(encoding="utf-8").splitlines()
+    families = {row["family"]: row for row in csv.DictReader(table)}
     assert {"paper", "suite", "traps", "clutter", "corridors", "barn", "barn_noisy"} <= set(families)
     assert int(families["suite"]["runs"]) == 34 and families["paper"]["success_rate"] == "0.0"  # apf
     for script, arguments in (
