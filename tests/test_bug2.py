@@ -61,6 +61,17 @@ def test_params_have_defaults_units_and_docs():
     assert info.name == "bug2" and "Lumelsky" in info.citation
 
 
+def test_the_m_line_runs_from_the_first_position_to_the_goal():
+    plan = planner()
+    with pytest.raises(RuntimeError, match="no m-line before its first step"):
+        plan.mline_offset(np.zeros(2))
+    plan.step(observe(shapes.scene_footprints([]), (1.0, 3.0), 0.0, (5.0, 3.0)))
+    assert plan.mline_offset(np.array([2.0, 3.5])) == pytest.approx(0.5)  # left of the line
+    assert plan.mline_offset(np.array([4.0, 2.0])) == pytest.approx(-1.0)
+    plan.step(observe(shapes.scene_footprints([]), (2.0, 3.5), 0.0, (5.0, 3.0), 0.1))
+    assert plan.mline_offset(np.array([2.0, 3.5])) == pytest.approx(0.5)  # the line stays
+
+
 def test_goes_to_goal_in_the_open_and_follows_near_a_wall():
     wall = shapes.scene_footprints([shapes.Wall((3.0, 1.0), (3.0, 5.0), 0.1)])
     plan = planner()

@@ -99,6 +99,18 @@ def test_extreme_points_of_an_obstacle_ahead():
     assert span == pytest.approx(2 * math.atan(0.5))
 
 
+def test_a_map_no_scan_has_placed_says_so_where_it_needs_its_origin():
+    grid = LocalMap(cell_m=0.1, size_m=8.0)
+    assert grid.origin is None and len(grid.cells()[0]) == 0
+    with pytest.raises(RuntimeError, match="no origin before its first update or sweep"):
+        grid.clearance_field(1, np.zeros(2), reach_m=1.0)
+    with pytest.raises(RuntimeError, match="no origin before its first update or sweep"):
+        grid.lookup(grid.grid, np.zeros((1, 2)))
+    grid.sweep(np.array([1.0, -2.0]), 0.2)
+    np.testing.assert_array_equal(grid.origin, [10 - grid.n // 2, -20 - grid.n // 2])
+    assert grid.lookup(grid.swept, np.array([[1.0, -2.0], [3.0, -2.0]])).tolist() == [True, False]
+
+
 def test_the_clearance_field_is_the_distance_to_the_nearest_obstacle_cell():
     rng = np.random.default_rng(0)
     grid = LocalMap(cell_m=0.1, size_m=8.0)

@@ -134,6 +134,10 @@ def test_the_command_line_imports_a_module_from_the_current_directory(tmp_path):
         ("side_effect:Missing", "side_effect has no Missing"),
         ("os:path", "path is not a subclass of vplane_mj.planning.Planner"),
         ("missing/file.py:Planner", "no such file"),
+        (
+            "./notes.txt:Planner",
+            "cannot import ./notes.txt: ImportError: notes.txt is not a Python source file",
+        ),
         ("bad_name:Bad", "its name must match [a-z0-9_]+ (it names output files), got 'Bad-Name'"),
         ("clash:Clash", "its name 'apf' is a built-in planner's"),
     ],
@@ -144,6 +148,7 @@ def test_a_bad_planner_class_on_the_command_line_is_exit_2_with_the_reason(tmp_p
         SIDE_EFFECT_MODULE.replace('"evil"', '"Bad-Name"').replace("Evil", "Bad")
     )
     (tmp_path / "clash.py").write_text(SIDE_EFFECT_MODULE.replace('"evil"', '"apf"').replace("Evil", "Clash"))
+    (tmp_path / "notes.txt").write_text(SIDE_EFFECT_MODULE)
     done = vplane_mj("run", "open_field", "--planner", spec, "--out", "out", cwd=tmp_path)
     assert done.returncode == 2, done.stderr
     assert done.stderr.startswith(f"error: --planner: {spec}: ") and reason in done.stderr, done.stderr

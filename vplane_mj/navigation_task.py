@@ -143,6 +143,14 @@ class NavigationTask:
         """No episode goes on: none has begun, the last one has ended, or the task was closed."""
         return self._observation is None
 
+    @property
+    def _episode_run(self) -> Run:
+        """The run of the episode that goes on or has just ended (RuntimeError when no episode
+        has begun since the task was made or closed)."""
+        if self.run is None:
+            raise RuntimeError("no episode has begun (or the task was closed): call reset")
+        return self.run
+
     # -- the episode -------------------------------------------------------------------------
     def episode_scenario(self, episode_seed: int) -> Scenario:
         """The scenario of an episode, with the overrides and `run.seed` set to the episode's seed:
@@ -166,10 +174,11 @@ class NavigationTask:
 
     def advance(self, action: np.ndarray) -> TaskStep:
         """One control tick with `action` in place of the planner's decision."""
-        if self.over:
+        observation = self._observation
+        if observation is None:  # the task is `over`
             raise RuntimeError("step: the episode is over (or never began): call reset")
-        run = self.run
-        decision, command = self._decision(np.asarray(action, dtype=float))
+        run = self._episode_run
+        decision, command = self._decision(np.asarray(action, dtype=float), observation.yaw)
         ending = run.apply(decision, command)
         self._observation = None if ending is not None else run.observe()
         reward = self._reward()
@@ -207,13 +216,14 @@ class NavigationTask:
         return Bounds.box((2,), np.float64, -high, high)
 
     # -- from an action to a decision --------------------------------------------------------
-    def _decision(self, action: np.ndarray) -> tuple[Decision, tuple[float, float] | None]:
-        """The tick's decision, and the command that replaces the heading controller's."""
+    def _decision(self, action: np.ndarray, yaw: float) -> tuple[Decision, tuple[float, float] | None]:
+        """The tick's decision, and the command that replaces the heading controller's, with the
+        robot at `yaw` (rad) as the planner sees it."""
         if action.shape != (2,):
             raise ValueError(f"step: an action is 2 numbers, got shape {action.shape}")
         if self.action == "force":
             return Decision(force=action.copy(), mode=AGENT_MODE), None
-        gains, yaw = self.gains, self._observation.yaw
+        gains = self.gains
         speed = float(np.clip(action[0], -gains.max_speed, gains.max_speed))
         turn = float(np.clip(action[1], -gains.max_turn_rate, gains.max_turn_rate))
         if not (math.isfinite(speed) and math.isfinite(turn)):
@@ -229,7 +239,7 @@ class NavigationTask:
         Within an episode the pose is the planner's (truth or odometry, as `sensors.pose`
         says); once the run is over, the simulator's.
         """
-        run = self.run
+        run = self._episode_run
         if self._observation is not None:
             position, yaw = self._observation.position, self._observation.yaw
         else:
@@ -248,7 +258,7 @@ class NavigationTask:
 
     def _reward(self) -> float:
         """Progress toward the goal, less new collisions and the time of the tick (no success bonus)."""
-        run, weights = self.run, self.reward_weights
+        run, weights = self._episode_run, self.reward_weights
         distance = self._true_distance()
         collisions = len(run.collisions.points)
         reward = (
@@ -260,11 +270,12 @@ class NavigationTask:
         return float(reward)
 
     def _true_distance(self) -> float:
-        position, goal = self.run.position, self.run.goal
+        run = self._episode_run
+        position, goal = run.position, run.goal
         return math.hypot(goal[0] - position[0], goal[1] - position[1])
 
     def _info(self) -> dict[str, Any]:
-        run = self.run
+        run = self._episode_run
         info: dict[str, Any] = {
             "time_s": float(run.data.time),
             "distance_to_goal_m": self._distance,

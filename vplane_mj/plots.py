@@ -78,7 +78,7 @@ def draw_path(axes, positions: np.ndarray, modes: Sequence[str], linewidth: floa
     blue `escaping`, purple `trapped`, green `following`, grey any other mode; above the world,
     below markers."""
     points = np.asarray(positions, float)
-    segments = np.stack([points[:-1], points[1:]], axis=1)
+    segments = list(np.stack([points[:-1], points[1:]], axis=1))  # (2, 2) arrays, as LineCollection takes
     colours = [MODE_RGBA.get(mode, OTHER_MODE_RGBA) for mode in modes[: len(segments)]]
     axes.add_collection(LineCollection(segments, colors=colours, linewidths=linewidth, zorder=PATH_ZORDER))
 

@@ -206,14 +206,16 @@ class Run:
             raise RuntimeError("observe: the decision of the current tick has not been applied")
         started = time.perf_counter()
         self._belief = self._decision = None
+        belief = None
         if (ending := self._ending()) is None:
-            self._sense()
+            belief = self._sense()
             ending = self._ending()
         self.wall_time_s += time.perf_counter() - started
         if ending is not None:
             self._finish(ending)
             return None
-        believed_xy, believed_yaw = self._belief
+        assert belief is not None, "the run goes on: the pose was sensed"
+        believed_xy, believed_yaw = belief
         self._observation = Observation(
             self.data.time,
             believed_xy,
@@ -287,8 +289,9 @@ class Run:
         return None
 
     # -- the stages of a tick ---------------------------------------------------------------
-    def _sense(self) -> None:
-        """The sonar's ranges (cast when it pings, at its rate) and the pose the planner uses."""
+    def _sense(self) -> tuple[np.ndarray, float]:
+        """Read the sonar's ranges (cast when it pings, at its rate) and the pose the planner uses:
+        that pose (position in m, yaw in rad), also kept for the rest of the tick."""
         time_s = self.data.time
         if time_s >= self.next_sonar_s - 1e-9:
             self.ranges = self.sonar.read(self.rays.cast())
@@ -297,6 +300,7 @@ class Run:
         self.yaw = self.drive.yaw()
         self.yaws.append(self.yaw)
         self._belief = self.localiser.pose(self.position, self.yaw)
+        return self._belief
 
     def _take(self, decision: Decision) -> None:
         """Keep the tick's decision: its events, its local minima and escapes, its virtual objects."""

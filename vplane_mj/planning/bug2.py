@@ -83,9 +83,15 @@ class Bug2Planner(Planner):
 
     # ------------------------------------------------------------------ geometry
 
+    def _mline_ends(self) -> tuple[np.ndarray, np.ndarray]:
+        """The m-line's start and goal (m), fixed at the first tick (RuntimeError before it)."""
+        if self.mline is None:
+            raise RuntimeError("bug2 has no m-line before its first step")
+        return self.mline
+
     def mline_offset(self, position: np.ndarray) -> float:
         """Signed distance (m) of `position` from the m-line (positive on its left)."""
-        start, goal = self.mline
+        start, goal = self._mline_ends()
         direction = unit(goal - start)
         rel = position - start
         return float(direction[0] * rel[1] - direction[1] * rel[0])
@@ -104,7 +110,7 @@ class Bug2Planner(Planner):
         distance = float(np.hypot(*to_goal))
         scale = max(0.3, min(1.0, distance / self.params.slow_radius_m))
         attract = unit(to_goal) * scale
-        start, goal = self.mline
+        start, goal = self._mline_ends()
         normal = _rotate(unit(goal - start), math.pi / 2)
         offset = self.mline_offset(obs.position)
         correction = -normal * float(np.clip(self.params.mline_gain * offset, -0.5, 0.5))
@@ -155,7 +161,7 @@ class Bug2Planner(Planner):
         position = np.asarray(obs.position, float)
         if self.mline is None:
             self.mline = (position.copy(), np.asarray(obs.goal, float).copy())
-        events: list[str] = []
+        events: list[Event] = []
         if self.gave_up:
             return Decision(force=np.zeros(2), mode="gave_up", gave_up=True)
 

@@ -78,7 +78,7 @@ class LocalMap:
         self, position: np.ndarray, yaw: float, bearings: np.ndarray, ranges: np.ndarray, beam: float
     ) -> None:
         """Fold one scan of the sonar ring (ranges in m from the robot's centre) into the grid."""
-        self._follow(position)
+        origin = self._follow(position)
         echoes = ranges == ranges  # not NaN
         silent = self.silent_free_m if not echoes.all() else 0.0
         looked = np.flatnonzero(echoes) if silent <= 0 else np.arange(len(ranges))
@@ -96,8 +96,8 @@ class LocalMap:
                     self._grid.copy(), self._seen.copy(), self._swept.copy(), radius - self.n // 4 + 1
                 )
             cones = self._cones = _cone_table(cell, beam / 2, radius, self._stride)
-        robot = (math.floor(px / cell) - self.origin[0] + self._pad) * self._stride
-        robot += math.floor(py / cell) - self.origin[1] + self._pad
+        robot = (math.floor(px / cell) - origin[0] + self._pad) * self._stride
+        robot += math.floor(py / cell) - origin[1] + self._pad
         offsets, cone_only = cones.near(yaw + bearings[looked], reach)
         cand = offsets + robot
         # Before its arc, a cone only empties marked cells, and shows unseen ones free: an
@@ -136,14 +136,14 @@ class LocalMap:
     def sweep(self, position: np.ndarray, radius_m: float) -> None:
         """Mark swept (and seen) the cells whose centre lies within `radius_m` of a point (m):
         the robot's own disc stands there, so no obstacle does."""
-        self._follow(position)
+        origin = self._follow(position)
         reach = math.ceil(radius_m / self.cell_m) + 1
-        centre = np.floor(np.asarray(position) / self.cell_m).astype(int) - self.origin
+        centre = np.floor(np.asarray(position) / self.cell_m).astype(int) - origin
         lo, hi = np.maximum(centre - reach, 0), np.minimum(centre + reach + 1, self.n)
         if np.any(hi <= lo):
             return
-        rel_x = (self.origin[0] + np.arange(lo[0], hi[0]) + 0.5) * self.cell_m - position[0]
-        rel_y = (self.origin[1] + np.arange(lo[1], hi[1]) + 0.5) * self.cell_m - position[1]
+        rel_x = (origin[0] + np.arange(lo[0], hi[0]) + 0.5) * self.cell_m - position[0]
+        rel_y = (origin[1] + np.arange(lo[1], hi[1]) + 0.5) * self.cell_m - position[1]
         inside = np.hypot(rel_x[:, None], rel_y[None, :]) <= radius_m
         self._swept[lo[0] : hi[0], lo[1] : hi[1]] |= inside
         self._seen[lo[0] : hi[0], lo[1] : hi[1]] |= inside
@@ -197,7 +197,7 @@ class LocalMap:
 
     def lookup(self, grid_values: np.ndarray, points: np.ndarray) -> np.ndarray:
         """The value of a grid-shaped array at world points (N, 2); 0 outside the grid."""
-        index = np.floor(np.asarray(points, float) / self.cell_m).astype(int) - self.origin
+        index = np.floor(np.asarray(points, float) / self.cell_m).astype(int) - self._placed_origin
         inside = np.all((index >= 0) & (index < self.n), axis=1)
         values = np.zeros(len(index), dtype=grid_values.dtype)
         values[inside] = grid_values[index[inside, 0], index[inside, 1]]
@@ -208,10 +208,11 @@ class LocalMap:
         `min_certainty`), over the square of cells within `reach_m` of `centre`: a Euclidean
         distance transform of that square alone. Obstacle cells outside it are not seen, so a
         distance d is exact for points at least d inside the square."""
+        origin = self._placed_origin
         reach = math.ceil(reach_m / self.cell_m)
         lo, hi = [], []
         for axis in range(2):
-            middle = math.floor(centre[axis] / self.cell_m) - int(self.origin[axis])
+            middle = math.floor(centre[axis] / self.cell_m) - int(origin[axis])
             lo.append(min(max(middle - reach, 0), self.n - 2))
             hi.append(min(max(middle + reach + 1, lo[axis] + 2), self.n))
         free = self.grid[lo[0] : hi[0], lo[1] : hi[1]] < min_certainty
@@ -221,7 +222,14 @@ class LocalMap:
             from scipy import ndimage  # only the planners that need it pay for scipy's import
 
             values = ndimage.distance_transform_edt(free) * self.cell_m
-        return ClearanceField(values, self.origin + np.array(lo), self.cell_m)
+        return ClearanceField(values, origin + np.array(lo), self.cell_m)
+
+    @property
+    def _placed_origin(self) -> np.ndarray:
+        """The origin, which the first `update` or `sweep` places (RuntimeError before that)."""
+        if self.origin is None:
+            raise RuntimeError("the local map has no origin before its first update or sweep")
+        return self.origin
 
     # -- storage ---------------------------------------------------------------------------
     def _allocate(self, grid: np.ndarray, seen: np.ndarray, swept: np.ndarray, pad: int) -> None:
@@ -251,26 +259,28 @@ class LocalMap:
         self._centre_x = np.repeat(rows, self._stride)
         self._centre_y = np.tile(cols, self._stride)
 
-    def _follow(self, position: np.ndarray) -> None:
-        """Keep the robot in the grid's middle half, shifting the grid by whole cells."""
+    def _follow(self, position: np.ndarray) -> np.ndarray:
+        """Keep the robot in the grid's middle half, shifting the grid by whole cells; the origin."""
         half = self.n // 2
         centre = (math.floor(position[0] / self.cell_m) - half, math.floor(position[1] / self.cell_m) - half)
         if self.origin is None:
             self.origin = np.array(centre)
             self._anchor()
-            return
+            return self.origin
         if max(abs(centre[0] - self.origin[0]), abs(centre[1] - self.origin[1])) < self.n // 4:
-            return
+            return self.origin
         centre_cell = np.array(centre)
         shift = centre_cell - self.origin
-        layers = [np.zeros_like(layer) for layer in (self._grid, self._seen, self._swept)]
+        layers = (self._grid, self._seen, self._swept)
+        grid, seen, swept = (np.zeros_like(layer) for layer in layers)
         if np.max(np.abs(shift)) < self.n:  # else nothing of the old grid remains in the new one
             src = [slice(max(0, s), self.n + min(0, s)) for s in shift]
             dst = [slice(max(0, -s), self.n + min(0, -s)) for s in shift]
-            for moved, layer in zip(layers, (self._grid, self._seen, self._swept), strict=True):
+            for moved, layer in zip((grid, seen, swept), layers, strict=True):
                 moved[dst[0], dst[1]] = layer[src[0], src[1]]
         self.origin = centre_cell
-        self._allocate(*layers, self._pad)
+        self._allocate(grid, seen, swept, self._pad)
+        return self.origin
 
 
 @dataclass(frozen=True)

@@ -114,6 +114,7 @@ class PlannerParams:
             reason = spec.check(value)
             if reason:
                 raise ParamError(key, reason)
+            assert isinstance(value, int | float), "check accepts numbers only"
             values[key] = value if spec.integer else float(value)
         return values
 

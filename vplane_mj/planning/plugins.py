@@ -17,6 +17,7 @@ import os
 import re
 import sys
 from pathlib import Path
+from types import ModuleType
 
 from vplane_mj.errors import VPlaneError
 from vplane_mj.planning.base import Planner
@@ -53,7 +54,8 @@ def planner_problem(cls: object) -> str | None:
     params = cls.Params
     if not (inspect.isclass(params) and issubclass(params, PlannerParams)):
         return "its Params is not a subclass of vplane_mj.planning.PlannerParams"
-    if "__dataclass_fields__" not in vars(params) or not params.__dataclass_params__.frozen:
+    own = vars(params)  # what @dataclass sets on the class itself, not inherited from a base
+    if "__dataclass_fields__" not in own or not getattr(own.get("__dataclass_params__"), "frozen", False):
         return "its Params is not a frozen dataclass (@dataclass(frozen=True))"
     for field in dataclasses.fields(params):
         spec = field.metadata.get(PARAM)
@@ -100,7 +102,7 @@ def _is_file(target: str) -> bool:
     return target.endswith(".py") or "/" in target or os.sep in target
 
 
-def _import_module(name: str):
+def _import_module(name: str) -> ModuleType:
     """Import a module as `python -m` finds it: the current directory first."""
     here = os.getcwd()
     if not sys.path or sys.path[0] not in (here, ""):
@@ -108,7 +110,7 @@ def _import_module(name: str):
     return importlib.import_module(name)
 
 
-def _import_file(path: Path):
+def _import_file(path: Path) -> ModuleType:
     """Import a Python file as a module of its own (see FILE_MODULE_PREFIX)."""
     path = path.resolve()
     name = FILE_MODULE_PREFIX + re.sub(r"\W", "_", path.stem)
@@ -118,6 +120,8 @@ def _import_file(path: Path):
             return loaded
         raise ImportError(f"another planner file named {path.name} is already loaded")
     spec = importlib.util.spec_from_file_location(name, path)
+    if spec is None or spec.loader is None:
+        raise ImportError(f"{path.name} is not a Python source file (.py)")
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module  # dataclasses look their module up while the class is made
     try:

@@ -145,7 +145,7 @@ class VPlanePlanner(Planner):
                 return decision
 
         if self.temp_goal is not None and np.hypot(*(obs.position - self.temp_goal)) <= p.vno_tolerance_m:
-            self._finish_escape(decision)
+            self._finish_escape(obs, decision)
 
         components = p.firas_components(obs)
         if p.goal_fade_m > 0:  # goals near obstacles stay reachable (GNRON)
@@ -194,11 +194,12 @@ class VPlanePlanner(Planner):
         decision.events.append(escape_started(e1, e2, self.temp_goal))
         return True
 
-    def _finish_escape(self, decision: Decision) -> None:
-        """Objective reached: re-activate the target and add the virtual plane to L."""
-        self.temp_goal = None
-        self.planes.append(self.pending_plane)
-        self.pending_plane = None
+    def _finish_escape(self, obs: Observation, decision: Decision) -> None:
+        """Objective reached (the robot as `obs` shows it): re-activate the target and add the
+        virtual plane to L."""
+        plane, self.temp_goal, self.pending_plane = self.pending_plane, None, None
+        assert plane is not None, "an escape places its plane together with its objective"
+        self.planes.append(plane)
         if len(self.planes) > self.params.max_planes:
             self.planes.pop(0)
             decision.events.append(Event(EventKind.PLANE_RETIRED, "oldest virtual plane retired"))

@@ -313,19 +313,20 @@ class VPlanePlusPlanner(VPlanePlanner):
         i1, i2, _ = angular_extremes(obs.position, cells)
         e1, e2 = cells[i1], cells[i2]
         # The map's sure cells place the trap's ends: the plane joins them as they are.
-        plane = make_plane(
+        mouth = make_plane(
             e1, e2, cells, obs.position, obs.goal, extend=self._link_m() / 2, to_outermost=False
         )
         clearance = self.radius + self.params.escape_margin_m
         window = self._window(obs.position, obs.goal, self.planes, margin=self.params.search_margin_m)
-        if self._spans_a_gap(plane, others):
+        plane: VirtualPlane | None = None
+        if self._spans_a_gap(mouth, others):
             decision.events.append(plane_refused(e1, e2, "would span a gap between obstacles"))
-            plane = None
-        elif self._find_way(obs.position, obs.goal, [*self.planes, plane]):
+        elif self._find_way(obs.position, obs.goal, [*self.planes, mouth]):
             decision.events.append(
                 plane_refused(e1, e2, "would close no trap (the map shows another way out)")
             )
-            plane = None
+        else:
+            plane = mouth
         frame = plane or make_plane(e1, e2, cells, obs.position, obs.goal)
         candidate = virtual_objective(obs.position, e1, e2, obs.goal, frame, clearance)
         objective, way = self._reachable_objective(obs.position, candidate, plane, clearance, window)
@@ -444,9 +445,12 @@ class VPlanePlusPlanner(VPlanePlanner):
             if not usable.any():
                 return None, []
             distance = np.hypot(*np.moveaxis(centres - candidate, -1, 0))
-            cell = np.unravel_index(int(np.argmin(np.where(usable, distance, np.inf))), distance.shape)
+            i, j = np.unravel_index(int(np.argmin(np.where(usable, distance, np.inf))), distance.shape)
+            cell = (int(i), int(j))
             candidate = window.centre(cell)
-        return candidate, self._way(window, robot, candidate)
+        # A usable cell is reachable from the robot's, so the map has a way there; an empty way
+        # (straight to the objective) only if not, as when an escape's way is searched again.
+        return candidate, self._way(window, robot, candidate) or []
 
     # -- following the map's way -------------------------------------------------------------
     def _start_following(self, obs: Observation, decision: Decision, why: str) -> None:
@@ -497,6 +501,7 @@ class VPlanePlusPlanner(VPlanePlanner):
     def _way_cost(self, position: np.ndarray, way: list[np.ndarray], goal: np.ndarray) -> float:
         """What a way to the goal costs from `position`: along it on the map, then from its end to
         the goal in a straight line (a way ends short of the goal where the goal lies off the map)."""
+        assert self.sight is not None, "the search that found a way keeps its window as the sight"
         return self.sight.path_cost(np.array([position, *way])) + float(np.hypot(*(goal - way[-1])))
 
     def _way_to_goal(self, obs: Observation, decision: Decision) -> list[np.ndarray] | None:
