@@ -33,8 +33,6 @@ from vplane_mj.errors import VPlaneError
 from vplane_mj.families import generate, trap_suite
 from vplane_mj.outputs import prepare_out_dir, write_atomically
 from vplane_mj.planning.registry import PLANNERS
-from vplane_mj.reference import shortest_path_length
-from vplane_mj.robot import robot_radius_m
 
 PAPER = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")
 NOISY_SUFFIX = "_noisy"
@@ -55,7 +53,6 @@ def write_cases(out: Path, barn: int, count: int, seed: int) -> dict[str, list[s
     """Scenario files per family, written under `out/cases/`; the paper's by name."""
     cases_dir = out / "cases"
     cases_dir.mkdir(parents=True, exist_ok=True)
-    radius = robot_radius_m()
     families = {"paper": list(PAPER), "suite": []}
     for case in trap_suite():
         path = cases_dir / f"{case.name}.toml"
@@ -69,12 +66,7 @@ def write_cases(out: Path, barn: int, count: int, seed: int) -> dict[str, list[s
     ):
         if number <= 0:
             continue
-        cases = generate(
-            family,
-            number,
-            family_seed,
-            lambda scenario, clearance: shortest_path_length(scenario, radius, clearance) is not None,
-        )
+        cases = generate(family, number, family_seed)
         paths = []
         for case in cases:
             path = cases_dir / f"{case.name}.toml"

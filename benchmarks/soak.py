@@ -56,8 +56,6 @@ from vplane_mj.families import generate
 from vplane_mj.interrupts import Interrupted, signals_raise_interrupted
 from vplane_mj.outputs import prepare_out_dir, write_atomically, write_json
 from vplane_mj.planning.registry import PLANNERS
-from vplane_mj.reference import shortest_path_length
-from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import SensorSpec, parse_scenario
 
 JOURNAL = "soak.jsonl"
@@ -98,13 +96,8 @@ def draw_faults(rng: np.random.Generator) -> list[str]:
 def plan_soak(count: int, seed: int, time_limit: float) -> list[tuple[Job, list[str]]]:
     """The runs, each with its fault overrides: families in turn, planners round-robin."""
     families = ["traps", "clutter", "corridors"]
-    radius = robot_radius_m()
-
-    def has_path(scenario, clearance_m: float) -> bool:
-        return shortest_path_length(scenario, radius, clearance_m) is not None
-
     cases = {
-        family: generate(family, len(range(k, count, len(families))), seed, has_path)
+        family: generate(family, len(range(k, count, len(families))), seed)
         for k, family in enumerate(families)
     }
     fault_rng = np.random.default_rng([seed, 1])  # a stream apart from the generators'

@@ -4,16 +4,22 @@ Property-based tests are derandomised: every run of the suite tries the same exa
 The on-disk cache is a fresh temporary directory for each run of the suite.
 """
 
+import json
+import math
 import os
 import re
 import shutil
 import tempfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import settings
 
 from vplane_mj.cache import CACHE_ENV
+from vplane_mj.cli import main
+from vplane_mj.planning.registry import make_planner
+from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import load_scenario, parse_scenario
 
 # The tests keep their cached reference paths apart from the user's (and start without any).
@@ -59,3 +65,38 @@ def readme_examples():
         return "\n".join(re.findall(r"```python\n(.*?)```", section, re.S))
 
     return blocks
+
+
+@pytest.fixture(
+    params=[
+        ("paper_c_escape", 3, ("sensors.noise_std=0.02", "sensors.dropout=0.1")),
+        (
+            "paper_h_escape",
+            2,
+            ("sensors.pose=odometry", "sensors.odometry_noise=0.01", "run.time_limit_s=40"),
+        ),
+    ],
+    ids=["noisy_sonar", "odometry"],
+)
+def vplane_run(request, tmp_path):
+    """A `vplane-mj run` of a built-in scenario with faults: (name, seed, overrides, its summary,
+    a fresh `vplane` planner of the same scenario), for environments driven by that planner."""
+    name, seed, overrides = request.param
+    sets = [arg for override in overrides for arg in ("--set", override)]
+    main(["run", name, "--seed", str(seed), *sets, "--no-log", "--no-render", "--out", str(tmp_path)])
+    expected = json.loads((tmp_path / f"{name}-vplane-{seed}.json").read_text())
+    scenario = load_scenario(name, list(overrides))
+    planner = make_planner(scenario.planner, scenario.planner_params, robot_radius_m())
+    return name, seed, list(overrides), expected, planner
+
+
+@pytest.fixture
+def steer_to_goal():
+    """A policy on an environment's observation alone: full speed, turning toward the goal in
+    the robot frame (body speed m/s, turn rate rad/s)."""
+
+    def policy(observation):
+        x, y = observation["goal"]
+        return np.array([0.5, 3.0 * math.atan2(y, x)])
+
+    return policy

@@ -30,7 +30,7 @@ from vplane_mj.cli import main
 from vplane_mj.errors import VPlaneError
 from vplane_mj.failures import FAILED_SCENARIO_KEY
 from vplane_mj.scenario import load_scenario
-from vplane_mj.summary import TIMING_KEYS
+from vplane_mj.summary import without_timing
 
 OUTPUTS = ("bench.csv", "bench.json", "bench.png", "bench-scenarios.png", "bench.html")
 ARGS = ["bench", "open_field", "paper_c_escape", "--planners", "apf,vplane", "--seeds", "0-1", "--jobs", "2"]
@@ -80,10 +80,7 @@ def test_a_sweep_writes_rows_table_and_plot_and_resumes(tmp_path, capsys):
     assert len(read_journal(tmp_path / "bench.jsonl")) == 8  # the torn line did not swallow a new row
     resumed = json.loads((tmp_path / "bench.json").read_text())["rows"]
 
-    def strip(table):
-        return [{k: v for k, v in r.items() if k not in TIMING_KEYS} for r in table]
-
-    assert strip(resumed) == strip(rows)
+    assert [without_timing(r) for r in resumed] == [without_timing(r) for r in rows]
 
 
 @pytest.mark.parametrize(
@@ -126,7 +123,7 @@ def test_a_dask_cluster_gives_the_same_rows_as_the_local_pool(tmp_path, capsys):
 
     def rows(directory):
         document = json.loads((directory / "bench.json").read_text())
-        return [{k: v for k, v in r.items() if k not in TIMING_KEYS} for r in document["rows"]]
+        return [without_timing(r) for r in document["rows"]]
 
     assert rows(remote) == rows(local)
 

@@ -11,7 +11,7 @@ import pytest
 from vplane_mj.cli import main
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim import run_scenario
-from vplane_mj.summary import TIMING_KEYS
+from vplane_mj.summary import without_timing
 
 EVERY_FAULT = [
     "sensors.noise_std=0.02",
@@ -25,10 +25,6 @@ EVERY_FAULT = [
     "sensors.odometry_noise=0.01",
 ]
 SETS = [arg for override in EVERY_FAULT for arg in ("--set", override)]
-
-
-def _without_timing(summary: dict) -> dict:
-    return {key: value for key, value in summary.items() if key not in TIMING_KEYS}
 
 
 def _run_in_new_process(out_dir, hash_seed: str) -> dict:
@@ -47,7 +43,7 @@ def test_two_processes_and_this_one_give_identical_runs(tmp_path):
     a, b = _run_in_new_process(first, "1"), _run_in_new_process(second, "2")
     here = run_scenario(load_scenario("paper_h_escape", [*EVERY_FAULT, "run.seed=3"])).summary
     here = json.loads(json.dumps(here.to_dict()))  # the JSON form the files hold
-    assert _without_timing(a) == _without_timing(b) == _without_timing(here)
+    assert without_timing(a) == without_timing(b) == without_timing(here)
     assert a["odometry_error_m"] > 0  # the faults were on
 
 
@@ -73,7 +69,7 @@ def test_dask_and_the_local_pool_give_identical_rows_with_every_fault_on(tmp_pat
     def rows(directory):
         document = json.loads((directory / "bench.json").read_text())
         return sorted(
-            (_without_timing(row) for row in document["rows"]),
+            (without_timing(row) for row in document["rows"]),
             key=lambda row: (row["scenario"], row["planner"], row["seed"]),
         )
 

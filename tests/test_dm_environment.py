@@ -3,7 +3,6 @@ determinism and its seeds, the step types and discounts of every ending, and the
 as `vplane-mj run` under the planner's own decisions."""
 
 import json
-import math
 import unittest
 
 import dm_env
@@ -11,13 +10,11 @@ import numpy as np
 import pytest
 from dm_env import test_utils
 
-from vplane_mj import ScenarioError, VPlaneError, build_scenario, load_scenario, wall
+from vplane_mj import ScenarioError, VPlaneError, build_scenario, wall
 from vplane_mj.cli import main
 from vplane_mj.dm_environment import VPlaneNavDmEnv
 from vplane_mj.gym_env import VPlaneNavEnv
-from vplane_mj.planning.registry import make_planner
-from vplane_mj.robot import robot_radius_m
-from vplane_mj.summary import TIMING_KEYS
+from vplane_mj.summary import without_timing
 
 
 class ForceActionsContract(test_utils.EnvironmentTestMixin, unittest.TestCase):
@@ -70,11 +67,6 @@ def test_the_specs_name_each_entry_with_its_bounds():
     assert env.discount_spec().minimum == 0.0 and env.discount_spec().maximum == 1.0
 
 
-def untimed(summary):
-    """A summary without its wall-clock keys (the only ones that differ between identical runs)."""
-    return {key: value for key, value in summary.items() if key not in TIMING_KEYS}
-
-
 def drive(env, actions):
     """Reset, then step through `actions` (past episode ends): the TimeSteps and, for each
     LAST step, the summary."""
@@ -82,7 +74,7 @@ def drive(env, actions):
     for action in actions:
         steps.append(env.step(action))
         if steps[-1].last():
-            summaries.append(untimed(env.info["summary"]))
+            summaries.append(without_timing(env.info["summary"]))
     return steps, summaries
 
 
@@ -117,29 +109,14 @@ def test_episodes_are_deterministic_and_episode_k_has_the_seed_plus_k():
         observation, reward, terminated, truncated, info = gym.step(action)
         assert all(np.array_equal(observation[key], step.observation[key]) for key in observation)
         assert reward == step.reward and truncated == step.last() and not terminated
-    assert untimed(info["summary"]) == first_summaries[1]
+    assert without_timing(info["summary"]) == first_summaries[1]
 
     other, _ = drive(VPlaneNavDmEnv(family="clutter", overrides=OVERRIDES, seed=13), actions[:1])
     assert not np.array_equal(other[0].observation["ranges"], first[0].observation["ranges"])
 
 
-@pytest.mark.parametrize(
-    "name, seed, overrides",
-    [
-        ("paper_c_escape", 3, ["sensors.noise_std=0.02", "sensors.dropout=0.1"]),
-        (
-            "paper_h_escape",
-            2,
-            ["sensors.pose=odometry", "sensors.odometry_noise=0.01", "run.time_limit_s=40"],
-        ),
-    ],
-)
-def test_the_planners_own_decisions_drive_the_trajectory_of_vplane_mj_run(tmp_path, name, seed, overrides):
-    sets = [arg for override in overrides for arg in ("--set", override)]
-    main(["run", name, "--seed", str(seed), *sets, "--no-log", "--no-render", "--out", str(tmp_path)])
-    expected = json.loads((tmp_path / f"{name}-vplane-{seed}.json").read_text())
-    scenario = load_scenario(name, overrides)
-    planner = make_planner(scenario.planner, scenario.planner_params, robot_radius_m())
+def test_the_planners_own_decisions_drive_the_trajectory_of_vplane_mj_run(vplane_run):
+    name, seed, overrides, expected, planner = vplane_run
     env = VPlaneNavDmEnv(name, overrides=overrides, expose_observation=True, seed=seed)
     time_step = env.reset()
     while not time_step.last():
@@ -152,13 +129,7 @@ def test_the_planners_own_decisions_drive_the_trajectory_of_vplane_mj_run(tmp_pa
     assert summary["planner"] == "external" and expected["planner"] == "vplane"
 
 
-def steer_to_goal(observation):
-    """A policy on the observation alone: full speed, turning toward the goal in the robot frame."""
-    x, y = observation["goal"]
-    return np.array([0.5, 3.0 * math.atan2(y, x)])
-
-
-def test_reaching_the_goal_is_a_last_step_with_discount_0_and_the_success_bonus():
+def test_reaching_the_goal_is_a_last_step_with_discount_0_and_the_success_bonus(steer_to_goal):
     env = VPlaneNavDmEnv("open_field", action="velocity")
     time_step = env.reset()
     assert time_step.first() and time_step.reward is None and time_step.discount is None

@@ -9,12 +9,10 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from vplane_mj import ScenarioError, VPlaneError, build_scenario, load_scenario, wall
+from vplane_mj import ScenarioError, VPlaneError, build_scenario, wall
 from vplane_mj.cli import main
 from vplane_mj.gym_env import ENV_ID, VPlaneNavEnv
-from vplane_mj.planning.registry import make_planner
-from vplane_mj.robot import robot_radius_m
-from vplane_mj.summary import TIMING_KEYS
+from vplane_mj.summary import without_timing
 
 
 def episode(env, actions, seed):
@@ -47,33 +45,13 @@ def test_an_episode_is_the_same_for_the_same_seed_and_actions():
     for (obs_a, reward_a, *end_a, _), (obs_b, reward_b, *end_b, _) in zip(first, again, strict=True):
         assert all(np.array_equal(obs_a[key], obs_b[key]) for key in obs_a)
         assert (reward_a, end_a) == (reward_b, end_b)
-    assert first[-1][3] and untimed(first[-1][4]["summary"]) == untimed(again[-1][4]["summary"])
+    assert first[-1][3] and without_timing(first[-1][4]["summary"]) == without_timing(again[-1][4]["summary"])
     other = episode(VPlaneNavEnv(family="clutter", overrides=overrides), actions[:1], 12)
     assert not np.array_equal(other[0][0]["ranges"], first[0][0]["ranges"])  # another world
 
 
-def untimed(summary):
-    """A summary without its wall-clock keys (the only ones that differ between identical runs)."""
-    return {key: value for key, value in summary.items() if key not in TIMING_KEYS}
-
-
-@pytest.mark.parametrize(
-    "name, seed, overrides",
-    [
-        ("paper_c_escape", 3, ["sensors.noise_std=0.02", "sensors.dropout=0.1"]),
-        (
-            "paper_h_escape",
-            2,
-            ["sensors.pose=odometry", "sensors.odometry_noise=0.01", "run.time_limit_s=40"],
-        ),
-    ],
-)
-def test_the_planners_own_decisions_drive_the_trajectory_of_vplane_mj_run(tmp_path, name, seed, overrides):
-    sets = [arg for override in overrides for arg in ("--set", override)]
-    main(["run", name, "--seed", str(seed), *sets, "--no-log", "--no-render", "--out", str(tmp_path)])
-    expected = json.loads((tmp_path / f"{name}-vplane-{seed}.json").read_text())
-    scenario = load_scenario(name, overrides)
-    planner = make_planner(scenario.planner, scenario.planner_params, robot_radius_m())
+def test_the_planners_own_decisions_drive_the_trajectory_of_vplane_mj_run(vplane_run):
+    name, seed, overrides, expected, planner = vplane_run
     env = VPlaneNavEnv(name, overrides=overrides, expose_observation=True)
     _, info = env.reset(seed=seed)
     while True:
@@ -85,13 +63,7 @@ def test_the_planners_own_decisions_drive_the_trajectory_of_vplane_mj_run(tmp_pa
     assert info["summary"]["planner"] == "external" and expected["planner"] == "vplane"
 
 
-def steer_to_goal(observation):
-    """A policy on the observation alone: full speed, turning toward the goal in the robot frame."""
-    x, y = observation["goal"]
-    return np.array([0.5, 3.0 * math.atan2(y, x)])
-
-
-def test_velocity_actions_reach_the_goal_and_the_rewards_add_up():
+def test_velocity_actions_reach_the_goal_and_the_rewards_add_up(steer_to_goal):
     env = VPlaneNavEnv("open_field", action="velocity")
     observation, info = env.reset(seed=0)
     assert observation["goal"] == pytest.approx([math.dist((1, 1), (5, 5)), 0.0], abs=1e-5)

@@ -13,9 +13,13 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import tomli_w
+
+if TYPE_CHECKING:
+    from vplane_mj.scenario import Scenario
 
 ARENA = 10.0
 CENTER = (ARENA / 2, ARENA / 2)
@@ -369,9 +373,23 @@ FAMILIES = {
 """The families of `vplane-mj generate`."""
 
 
-def generate(family: str, count: int, seed: int, has_path) -> list[Case]:
+def _robot_has_path(scenario: Scenario, clearance_m: float) -> bool:
+    """Whether the robot's disc plus `clearance_m` has a reference path to the goal."""
+    from vplane_mj.reference import shortest_path_length
+    from vplane_mj.robot import robot_radius_m
+
+    return shortest_path_length(scenario, robot_radius_m(), clearance_m) is not None
+
+
+def generate(
+    family: str,
+    count: int,
+    seed: int,
+    has_path: Callable[[Scenario, float], bool] | None = None,
+) -> list[Case]:
     """`count` valid cases of `family` from `seed`; `has_path(scenario, clearance_m)` rejects
-    the unsolvable ones.
+    the unsolvable ones (by default: those where the robot's disc plus the family's clearance
+    has no reference path to the goal, `vplane_mj.reference`).
 
     Candidates are drawn from one generator seeded with `seed`, so the same arguments always
     give the same files; a candidate that fails validation or has no path is drawn again.
@@ -379,6 +397,8 @@ def generate(family: str, count: int, seed: int, has_path) -> list[Case]:
     from vplane_mj.errors import ScenarioError
     from vplane_mj.scenario import parse_scenario
 
+    if has_path is None:
+        has_path = _robot_has_path
     rng = np.random.default_rng(seed)
     cases: list[Case] = []
     attempts = 0

@@ -4,6 +4,7 @@ loop, the command line, sweeps, the log and replays."""
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any
@@ -82,4 +83,9 @@ class RunSummary:
 
     def without_timing(self) -> dict[str, Any]:
         """The summary as a dict without the wall-clock keys: equal for identical runs."""
-        return {key: value for key, value in self.to_dict().items() if key not in TIMING_KEYS}
+        return without_timing(self.to_dict())
+
+
+def without_timing(summary: Mapping[str, Any]) -> dict[str, Any]:
+    """A summary's (or a bench row's) keys but the wall-clock ones: equal for identical runs."""
+    return {key: value for key, value in summary.items() if key not in TIMING_KEYS}
