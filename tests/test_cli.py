@@ -295,3 +295,12 @@ def test_a_reader_that_goes_away_does_not_turn_into_a_traceback(tmp_path, comman
     assert "Traceback" not in stderr and "BrokenPipe" not in stderr, stderr
     if command[0] == "run":
         assert json.loads((tmp_path / "open_field-vplane-0.json").read_text())["reached"]
+
+
+def test_a_run_with_its_render_and_log_loads_no_plotting_library(tmp_path):
+    args = ["run", "single_box", "--out", str(tmp_path)]
+    env = {**os.environ, CACHE_ENV: str(tmp_path / "cache")}
+    done = subprocess.run([sys.executable, "-c", LOADED, *args], capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split("\n")[-2] == "0 ['OpenGL', 'scipy']"  # the render needs OpenGL only
+    assert (tmp_path / "single_box-vplane-0.png").stat().st_size > 0

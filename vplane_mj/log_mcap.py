@@ -71,6 +71,7 @@ from vplane_mj.log_scene import (
     ARROW_M_PER_UNIT,
     ARROW_MAX_M,
     FOLLOW_FRAME,
+    FORCE_COLOURS,
     FORCE_STYLE,
     ROBOT_FRAME,
     WORLD_FRAME,
@@ -155,7 +156,7 @@ class McapLog:
         self.robot_radius_m = float(robot_radius_m)
         self.bearings = np.asarray(sonar_bearings, dtype=float)
         self.range_max = float(range_max)
-        self._goal = np.asarray(scenario.robot.goal, dtype=float)
+        self._goal = (float(scenario.robot.goal[0]), float(scenario.robot.goal[1]))
         self._closed = False
 
         self._context = foxglove.Context()
@@ -192,6 +193,10 @@ class McapLog:
         self._virtual_state: tuple[tuple[float, ...] | None, tuple[tuple[float, ...], ...]] = (None, ())
         self._shown_planes = 0
         self._path = PathSimplifier(PATH_TOLERANCE_M)
+        self._scan_pose = scene.pose(0.0, 0.0, SONAR_MOUNT_HEIGHT_M)
+        # Foxglove spaces the n readings by (end - start) / (n - 1).
+        n = len(self.bearings)
+        self._scan_angles = (float(self.bearings[0]), float(self.bearings[-1])) if n else (0.0, 0.0)
         self._path_dirty = False
         self._next_flush_s = 0.0  # the first tick flushes, so /path starts with the run
 
@@ -282,17 +287,19 @@ class McapLog:
 
     # -- per-tick topics ---------------------------------------------------------------------
     def _log_pose(self, ns: int, stamp: fm.Timestamp, x: float, y: float, yaw: float) -> None:
-        here = scene.pose(x, y, 0.0, yaw)
+        turn = scene.yaw_quaternion(yaw)
+        where = fm.Vector3(x=x, y=y, z=0.0)
+        here = fm.Pose(position=fm.Vector3(x=x, y=y, z=0.0), orientation=turn)
         self._pose_ch.log(fm.PoseInFrame(timestamp=stamp, frame_id=WORLD_FRAME, pose=here), log_time=ns)
         transforms = [
             fm.FrameTransform(
                 timestamp=stamp,
                 parent_frame_id=WORLD_FRAME,
                 child_frame_id=child,
-                translation=fm.Vector3(x=x, y=y, z=0.0),
-                rotation=scene.yaw_quaternion(rotation),
+                translation=where,
+                rotation=rotation,
             )
-            for child, rotation in ((ROBOT_FRAME, yaw), (FOLLOW_FRAME, 0.0))
+            for child, rotation in ((ROBOT_FRAME, turn), (FOLLOW_FRAME, scene.IDENTITY))
         ]
         self._tf_ch.log(fm.FrameTransforms(transforms=transforms), log_time=ns)
 
@@ -305,27 +312,26 @@ class McapLog:
         self._odometry_ch.log(message, log_time=ns)
 
     def _log_scan(self, ns: int, stamp: fm.Timestamp, ranges: np.ndarray) -> None:
-        values = np.asarray(ranges, dtype=float)
-        values = np.where(np.isfinite(values) & (values >= 0), values, np.nan)  # no echo -> NaN
-        n = len(self.bearings)
+        nan = math.nan
         scan = fm.LaserScan(
             timestamp=stamp,
             frame_id=ROBOT_FRAME,
-            pose=scene.pose(0.0, 0.0, SONAR_MOUNT_HEIGHT_M),
-            # Foxglove spaces the n readings by (end - start) / (n - 1).
-            start_angle=float(self.bearings[0]) if n else 0.0,
-            end_angle=float(self.bearings[-1]) if n else 0.0,
-            ranges=values.tolist(),
+            pose=self._scan_pose,
+            start_angle=self._scan_angles[0],
+            end_angle=self._scan_angles[1],
+            ranges=[r if 0.0 <= r < math.inf else nan for r in ranges.tolist()],  # no echo -> NaN
         )
         self._scan_ch.log(scan, log_time=ns)
 
     def _log_forces(self, ns: int, stamp: fm.Timestamp, x: float, y: float, tick: Tick) -> None:
-        vectors = {name: tick.decision.components.get(name) for name in FORCE_STYLE}
-        vectors["total"] = tick.decision.force
+        components = tick.decision.components
         entities = []
         shown = set()
-        for name, vector in vectors.items():
-            arrow = scene.force_arrow(x, y, vector, *FORCE_STYLE[name])
+        for name, (_, dz) in FORCE_STYLE.items():
+            vector = tick.decision.force if name == "total" else components.get(name)
+            if vector is None:
+                continue
+            arrow = scene.force_arrow(x, y, float(vector[0]), float(vector[1]), FORCE_COLOURS[name], dz)
             if arrow is None:
                 continue
             shown.add(name)
@@ -360,26 +366,25 @@ class McapLog:
 
     def _log_metrics(self, ns: int, tick: Tick) -> None:
         components = tick.decision.components
-        distance = math.hypot(
-            self._goal[0] - float(tick.position[0]), self._goal[1] - float(tick.position[1])
+        x, y = float(tick.position[0]), float(tick.position[1])
+        values = (
+            ("time_s", tick.time_s),
+            ("speed_mps", tick.speed),
+            ("distance_to_goal_m", math.hypot(self._goal[0] - x, self._goal[1] - y)),
+            ("force_attractive", _magnitude(components.get("attractive"))),
+            ("force_repulsive", _magnitude(components.get("repulsive"))),
+            ("force_virtual", _magnitude(components.get("virtual"))),
+            ("force_total", _magnitude(tick.decision.force)),
+            ("command_v_mps", tick.command[0]),
+            ("command_omega_radps", tick.command[1]),
         )
-        values = {
-            "time_s": tick.time_s,
-            "speed_mps": tick.speed,
-            "distance_to_goal_m": distance,
-            "force_attractive": _magnitude(components.get("attractive")),
-            "force_repulsive": _magnitude(components.get("repulsive")),
-            "force_virtual": _magnitude(components.get("virtual")),
-            "force_total": _magnitude(tick.decision.force),
-            "command_v_mps": tick.command[0],
-            "command_omega_radps": tick.command[1],
+        record: dict[str, float | str] = {
+            key: float(value) for key, value in values if value is not None and math.isfinite(value)
         }
         if tick.believed_pose is not None:
-            position = (float(tick.position[0]), float(tick.position[1]))
-            values["odometry_error_m"] = math.dist(tick.believed_pose[:2], position)
-        record: dict[str, float | str] = {
-            key: float(value) for key, value in values.items() if value is not None and math.isfinite(value)
-        }
+            error = math.dist(tick.believed_pose[:2], (x, y))
+            if math.isfinite(error):
+                record["odometry_error_m"] = error
         record["mode"] = tick.decision.mode
         self._metrics_ch.log(record, log_time=ns)
 

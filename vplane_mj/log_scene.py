@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from foxglove import messages as fm
 
 from vplane_mj import shapes
@@ -56,6 +55,10 @@ _COLOURS = {
     "robot": (0.20, 0.24, 0.32, 0.9),
     "heading": (1.00, 1.00, 1.00, 1.0),
 }
+
+
+IDENTITY = fm.Quaternion(x=0.0, y=0.0, z=0.0, w=1.0)
+"""No rotation (x, y, z, w)."""
 
 
 def stamp(ns: int) -> fm.Timestamp:
@@ -207,11 +210,14 @@ def _flat_disc(center, radius: float, rgba) -> fm.CylinderPrimitive:
     )
 
 
-def force_arrow(x: float, y: float, vector: np.ndarray | None, rgba, dz: float) -> fm.ArrowPrimitive | None:
-    """The arrow of one force at (x, y), or None when it is absent, ~zero or not finite."""
-    if vector is None:
-        return None
-    fx, fy = float(vector[0]), float(vector[1])
+FORCE_COLOURS: dict[str, fm.Color] = {name: _colour(rgba) for name, (rgba, _) in FORCE_STYLE.items()}
+"""The colour of each force arrow, made once (a message keeps a copy of what it is given)."""
+
+
+def force_arrow(
+    x: float, y: float, fx: float, fy: float, colour: fm.Color, dz: float
+) -> fm.ArrowPrimitive | None:
+    """The arrow of the force (fx, fy) at (x, y), or None when it is ~zero or not finite."""
     magnitude = math.hypot(fx, fy)
     if not math.isfinite(magnitude) or magnitude < ARROW_MIN_FORCE:
         return None
@@ -223,7 +229,7 @@ def force_arrow(x: float, y: float, vector: np.ndarray | None, rgba, dz: float) 
         shaft_diameter=0.025,
         head_length=head,
         head_diameter=0.07,
-        color=_colour(rgba),
+        color=colour,
     )
 
 

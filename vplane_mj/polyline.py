@@ -28,8 +28,13 @@ class PathSimplifier:
         self.tolerance_m = float(tolerance_m)
         self.max_pending = int(max_pending)
         self._vertices: list[tuple[float, float]] = []
-        self._pending = np.empty((self.max_pending, 2))
-        self._held = 0  # positions held back, in _pending[:_held]
+        # The positions held back, relative to the last vertex: _rel_x[:_held], _rel_y[:_held].
+        self._rel_x = np.empty(self.max_pending)
+        self._rel_y = np.empty(self.max_pending)
+        self._held = 0
+        self._newest = (0.0, 0.0)
+        self._t = np.empty(self.max_pending)
+        self._e = np.empty(self.max_pending)
 
     def add(self, x: float, y: float) -> None:
         """Append the position (x, y) (m)."""
@@ -38,28 +43,41 @@ class PathSimplifier:
             self._vertices.append(point)
             return
         held = self._held
-        if held:
-            pending = self._pending[:held]
-            if held >= self.max_pending or self._beyond_tolerance(pending, point):
-                self._vertices.append((float(pending[-1, 0]), float(pending[-1, 1])))
-                held = 0
-        self._pending[held] = point
+        if held and (held >= self.max_pending or self._beyond_tolerance(held, point)):
+            self._vertices.append(self._newest)
+            held = 0
+        ax, ay = self._vertices[-1]
+        self._rel_x[held] = point[0] - ax
+        self._rel_y[held] = point[1] - ay
+        self._newest = point
         self._held = held + 1
 
-    def _beyond_tolerance(self, pending: np.ndarray, point: tuple[float, float]) -> bool:
+    def _beyond_tolerance(self, held: int, point: tuple[float, float]) -> bool:
         """Whether a held-back position is farther than the tolerance from the edge from the
-        last vertex to `point` (the arithmetic of `distances_to_segment`, squared, in scalars)."""
+        last vertex to `point` (the arithmetic of `distances_to_segment`, squared, in place)."""
         ax, ay = self._vertices[-1]
         dx, dy = point[0] - ax, point[1] - ay
-        px, py = pending[:, 0] - ax, pending[:, 1] - ay
+        px, py = self._rel_x[:held], self._rel_y[:held]
         length2 = dx * dx + dy * dy
-        t = np.clip((px * dx + py * dy) / length2, 0.0, 1.0) if length2 > 0 else 0.0
-        ex, ey = px - t * dx, py - t * dy
-        return bool((ex * ex + ey * ey).max() > self.tolerance_m**2)
+        t, e = self._t[:held], self._e[:held]
+        if length2 > 0:
+            np.multiply(px, dx, out=t)
+            t += np.multiply(py, dy, out=e)
+            t /= length2
+            np.maximum(t, 0.0, out=t)  # np.clip to [0, 1], without its overhead
+            np.minimum(t, 1.0, out=t)
+        else:
+            t.fill(0.0)
+        ex = px - t * dx
+        np.multiply(t, dy, out=t)
+        np.subtract(py, t, out=e)  # ey
+        ex *= ex
+        e *= e
+        ex += e
+        return bool(ex.max() > self.tolerance_m**2)
 
     def polyline(self) -> list[tuple[float, float]]:
         """The vertices from the first position to the newest one."""
         if not self._held:
             return list(self._vertices)
-        newest = self._pending[self._held - 1]
-        return [*self._vertices, (float(newest[0]), float(newest[1]))]
+        return [*self._vertices, self._newest]

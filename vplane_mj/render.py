@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import itertools
 import math
+import struct
+import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -33,6 +35,9 @@ PLANE_RGBA = (0.5, 0.1, 0.7, 1.0)
 MAX_PATH_SEGMENTS = 3000
 MARKER_HEIGHT_M = 0.6
 """Markers and the path are drawn above the obstacles (0.5 m) so nothing hides them."""
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+PNG_FILTER_UP = 2
+"""PNG's row filter "Up": each byte minus the one above it."""
 
 
 @dataclass(frozen=True)
@@ -74,10 +79,35 @@ def render_top_view(scenario, track: Track) -> np.ndarray:
 
 
 def write_png(image: np.ndarray, path: Path) -> None:
-    """Save an RGB image as PNG."""
-    import matplotlib.image  # here: a run that writes no render does not load matplotlib
+    """Save an RGB image (H, W, 3) of uint8 as PNG: 8-bit truecolour, every row with PNG's
+    "Up" filter (its difference from the row above), deflated by zlib."""
+    path.write_bytes(png_bytes(image))
 
-    matplotlib.image.imsave(path, image, format="png")
+
+def png_bytes(image: np.ndarray) -> bytes:
+    """The PNG file of an RGB image (H, W, 3) of uint8 (the standard library's zlib, so that
+    writing a render loads no imaging library)."""
+    height, width, channels = image.shape
+    if channels != 3 or image.dtype != np.uint8:
+        raise ValueError(f"an RGB image of uint8 is needed, not {channels} channels of {image.dtype}")
+    rows = image.reshape(height, width * 3)
+    filtered = np.empty((height, 1 + width * 3), dtype=np.uint8)
+    filtered[:, 0] = PNG_FILTER_UP
+    filtered[0, 1:] = rows[0]
+    np.subtract(rows[1:], rows[:-1], out=filtered[1:, 1:])  # modulo 256, as PNG wants
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)  # 8 bits, RGB, no interlace
+    return b"".join(
+        (
+            PNG_SIGNATURE,
+            _png_chunk(b"IHDR", header),
+            _png_chunk(b"IDAT", zlib.compress(filtered.tobytes(), 6)),
+            _png_chunk(b"IEND", b""),
+        )
+    )
+
+
+def _png_chunk(kind: bytes, data: bytes) -> bytes:
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
 
 
 def _add_disc(scene: mujoco.MjvScene, center, radius: float, rgba) -> None:

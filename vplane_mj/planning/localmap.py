@@ -110,7 +110,8 @@ class LocalMap:
         axis = yaw + bearings[0]
         bearing = np.arctan2(rel_y, rel_x) - axis
         spacing = 2 * math.pi / len(bearings)
-        sonar = np.round(bearing / spacing).astype(int) % len(bearings)  # the nearest sonar
+        sonar = np.rint(bearing / spacing).astype(int)  # the nearest sonar (np.round's halves to even)
+        sonar %= len(bearings)
         offset = bearing - sonar * spacing + math.pi  # wrapped below: the angle from its axis
         if abs(axis) <= math.pi:  # offset in (-2 pi, 4 pi): the modulo is one conditional turn
             turn = 2 * math.pi
