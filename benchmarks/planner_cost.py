@@ -6,8 +6,11 @@ from a fresh state, `--repeat` times, in turn (a, b, c, a, b, c, ...). The time 
 process's CPU time, which a busy machine delays but does not inflate the way it does wall
 time; the median over the repeats of each planner's mean per tick is reported, and its
 ratio to `vfh`'s. The sonar map that vfh, vplane and dwa keep is the same code; its update
-alone is reported as `map`. The default scenarios are a generated BARN-like world (the one
-of tests/test_dwa.py), paper_c_escape and single_box.
+alone is reported as `map`. Last, what one numpy operation costs on this machine (CPU time
+of `a * b` on arrays of 16 and of 400 floats, the size of a sonar scan and of a map update's
+candidate cells), the unit in which the planners' ticks are spent. The default scenarios
+are a generated BARN-like world (the one of tests/test_dwa.py), paper_c_escape and
+single_box.
 
     python benchmarks/planner_cost.py [SCENARIO ...] [--driver dwa] [--repeat 5]
 """
@@ -97,6 +100,15 @@ def per_tick_ms(planners: list[str], observations: list[Observation], repeat: in
     return {name: statistics.median(values) for name, values in times.items()}
 
 
+def numpy_call_us(size: int, calls: int = 200_000) -> float:
+    """CPU time (us) of one numpy multiplication of two arrays of `size` floats."""
+    a, b = np.ones(size), np.full(size, 0.5)
+    start = time.process_time()
+    for _ in range(calls):
+        a * b
+    return 1e6 * (time.process_time() - start) / calls
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scenarios", nargs="*")
@@ -113,6 +125,8 @@ def main() -> None:
         cost = per_tick_ms(planners, recorder.observations, args.repeat)
         cells = " | ".join(f"{cost[p]:.3f} ({cost[p] / cost['vfh']:.2f})" for p in columns)
         print(f"| {scenario.name} | {len(recorder.observations)} | {cells} |", flush=True)
+    small, large = numpy_call_us(16), numpy_call_us(400)
+    print(f"\nOne numpy operation: {small:.2f} us on 16 floats, {large:.2f} us on 400 floats (CPU time).")
 
 
 if __name__ == "__main__":

@@ -5,7 +5,11 @@ several times; reported are the process's wall time (from launch to exit), the l
 wall time (the summary's `wall_time_s`) and their ratio, medians over the repeats. The
 first run of each scenario fills the reference-path cache and is not counted.
 
-Then the commands that simulate nothing, `vplane-mj check` of the first scenario and
+Then the main job, `vplane-mj run SCENARIO` of the first scenario as the set-up runs it
+(with its MCAP log and its render), against the same run without the render and without
+either: what the log and the render add to a run's wall time.
+
+Last, the commands that simulate nothing, `vplane-mj check` of the first scenario and
 `vplane-mj list`, against the floor every command pays: Python starting and importing
 numpy. Their processes alternate with the floor's, so a busy machine slows all alike.
 
@@ -55,6 +59,23 @@ def process_wall(arguments: list[str]) -> float:
     return time.perf_counter() - start
 
 
+def job_table(scenario: str, repeat: int, out: Path) -> None:
+    """`vplane-mj run` with its log and render, without the render, without either; medians
+    over `repeat` alternations."""
+    variants = {
+        "log and render": [],
+        "log, --no-render": ["--no-render"],
+        "--no-render --no-log": ["--no-render", "--no-log"],
+    }
+    walls: dict[str, list[float]] = {name: [] for name in variants}
+    for _ in range(repeat):
+        for name, flags in variants.items():
+            walls[name].append(process_wall(["-m", "vplane_mj", "run", scenario, *flags, "--out", str(out)]))
+    print(f"\n| `vplane-mj run {scenario}` | process wall s |\n|---|---:|")
+    for name in variants:
+        print(f"| {name} | {statistics.median(walls[name]):.3f} |")
+
+
 def command_table(scenario: str, repeat: int) -> None:
     """check and list processes against Python with numpy, medians over `repeat` alternations."""
     commands = {
@@ -87,6 +108,7 @@ def main(argv: list[str] | None = None) -> int:
             wall, loop = statistics.median(walls), statistics.median(loops)
             print(f"| {scenario} | {wall:.3f} | {loop:.3f} | {wall / loop:.2f} |")
             sys.stdout.flush()
+        job_table(args.scenarios[0], args.repeat, out)
     command_table(args.scenarios[0], args.repeat)
     return 0
 

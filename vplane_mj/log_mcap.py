@@ -289,7 +289,7 @@ class McapLog:
     def _log_pose(self, ns: int, stamp: fm.Timestamp, x: float, y: float, yaw: float) -> None:
         turn = scene.yaw_quaternion(yaw)
         where = fm.Vector3(x=x, y=y, z=0.0)
-        here = fm.Pose(position=fm.Vector3(x=x, y=y, z=0.0), orientation=turn)
+        here = fm.Pose(position=where, orientation=turn)
         self._pose_ch.log(fm.PoseInFrame(timestamp=stamp, frame_id=WORLD_FRAME, pose=here), log_time=ns)
         transforms = [
             fm.FrameTransform(
@@ -312,14 +312,13 @@ class McapLog:
         self._odometry_ch.log(message, log_time=ns)
 
     def _log_scan(self, ns: int, stamp: fm.Timestamp, ranges: np.ndarray) -> None:
-        nan = math.nan
         scan = fm.LaserScan(
             timestamp=stamp,
             frame_id=ROBOT_FRAME,
             pose=self._scan_pose,
             start_angle=self._scan_angles[0],
             end_angle=self._scan_angles[1],
-            ranges=[r if 0.0 <= r < math.inf else nan for r in ranges.tolist()],  # no echo -> NaN
+            ranges=[r if 0.0 <= r < math.inf else math.nan for r in ranges.tolist()],  # no echo: NaN
         )
         self._scan_ch.log(scan, log_time=ns)
 
@@ -366,25 +365,26 @@ class McapLog:
 
     def _log_metrics(self, ns: int, tick: Tick) -> None:
         components = tick.decision.components
-        x, y = float(tick.position[0]), float(tick.position[1])
-        values = (
-            ("time_s", tick.time_s),
-            ("speed_mps", tick.speed),
-            ("distance_to_goal_m", math.hypot(self._goal[0] - x, self._goal[1] - y)),
-            ("force_attractive", _magnitude(components.get("attractive"))),
-            ("force_repulsive", _magnitude(components.get("repulsive"))),
-            ("force_virtual", _magnitude(components.get("virtual"))),
-            ("force_total", _magnitude(tick.decision.force)),
-            ("command_v_mps", tick.command[0]),
-            ("command_omega_radps", tick.command[1]),
+        distance = math.hypot(
+            self._goal[0] - float(tick.position[0]), self._goal[1] - float(tick.position[1])
         )
-        record: dict[str, float | str] = {
-            key: float(value) for key, value in values if value is not None and math.isfinite(value)
+        values = {
+            "time_s": tick.time_s,
+            "speed_mps": tick.speed,
+            "distance_to_goal_m": distance,
+            "force_attractive": _magnitude(components.get("attractive")),
+            "force_repulsive": _magnitude(components.get("repulsive")),
+            "force_virtual": _magnitude(components.get("virtual")),
+            "force_total": _magnitude(tick.decision.force),
+            "command_v_mps": tick.command[0],
+            "command_omega_radps": tick.command[1],
         }
         if tick.believed_pose is not None:
-            error = math.dist(tick.believed_pose[:2], (x, y))
-            if math.isfinite(error):
-                record["odometry_error_m"] = error
+            position = (float(tick.position[0]), float(tick.position[1]))
+            values["odometry_error_m"] = math.dist(tick.believed_pose[:2], position)
+        record: dict[str, float | str] = {
+            key: float(value) for key, value in values.items() if value is not None and math.isfinite(value)
+        }
         record["mode"] = tick.decision.mode
         self._metrics_ch.log(record, log_time=ns)
 

@@ -33,8 +33,6 @@ class PathSimplifier:
         self._rel_y = np.empty(self.max_pending)
         self._held = 0
         self._newest = (0.0, 0.0)
-        self._t = np.empty(self.max_pending)
-        self._e = np.empty(self.max_pending)
 
     def add(self, x: float, y: float) -> None:
         """Append the position (x, y) (m)."""
@@ -54,27 +52,18 @@ class PathSimplifier:
 
     def _beyond_tolerance(self, held: int, point: tuple[float, float]) -> bool:
         """Whether a held-back position is farther than the tolerance from the edge from the
-        last vertex to `point` (the arithmetic of `distances_to_segment`, squared, in place)."""
+        last vertex to `point` (the arithmetic of `distances_to_segment`, squared)."""
         ax, ay = self._vertices[-1]
         dx, dy = point[0] - ax, point[1] - ay
         px, py = self._rel_x[:held], self._rel_y[:held]
         length2 = dx * dx + dy * dy
-        t, e = self._t[:held], self._e[:held]
         if length2 > 0:
-            np.multiply(px, dx, out=t)
-            t += np.multiply(py, dy, out=e)
-            t /= length2
-            np.maximum(t, 0.0, out=t)  # np.clip to [0, 1], without its overhead
-            np.minimum(t, 1.0, out=t)
+            t = (px * dx + py * dy) / length2
+            np.minimum(np.maximum(t, 0.0, out=t), 1.0, out=t)  # np.clip to [0, 1], without its overhead
         else:
-            t.fill(0.0)
-        ex = px - t * dx
-        np.multiply(t, dy, out=t)
-        np.subtract(py, t, out=e)  # ey
-        ex *= ex
-        e *= e
-        ex += e
-        return bool(ex.max() > self.tolerance_m**2)
+            t = np.zeros(held)
+        ex, ey = px - t * dx, py - t * dy
+        return bool((ex * ex + ey * ey).max() > self.tolerance_m**2)
 
     def polyline(self) -> list[tuple[float, float]]:
         """The vertices from the first position to the newest one."""
