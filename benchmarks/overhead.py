@@ -12,7 +12,8 @@ shared machine do not inflate; from a run's is subtracted that of a run of one c
 of the same scenario (building its models: what the loop's wall time in the summary leaves
 out too). Run over floor in wall-clock time (the summary's `wall_time_s`) is shown beside. Each measurement is
 repeated, interleaved, and the median kept. `--profile` prints, for the first scenario and
-planner, where a run's time goes.
+planner, where a run's time goes. Last, the run loop's own share: a run of `open_field` whose
+planner costs next to nothing (`straight_to_goal`, a unit force toward the goal), over its floor.
 
     python benchmarks/overhead.py [SCENARIO ...] [--planners vplane,apf] [--repeat 3] [--no-log] [--profile]
 
@@ -23,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import cProfile
+import math
 import pstats
 import statistics
 import sys
@@ -31,14 +33,34 @@ import time
 from pathlib import Path
 
 import mujoco
+import numpy as np
 
 from vplane_mj.log_mcap import McapLog
+from vplane_mj.planning import Decision, Observation, Planner, PlannerParams
+from vplane_mj.planning.registry import register_planner
 from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim import run_scenario
 from vplane_mj.world import SonarLayout, build_model
 
 DEFAULT_SCENARIOS = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")
+HARNESS_SCENARIO = "open_field"
+"""Where `straight_to_goal` reaches its goal: no obstacle between the start and the goal."""
+
+
+class StraightToGoal(Planner):
+    """A unit force toward the goal: a planner that costs next to nothing, so that a run of it
+    measures the run loop itself (sonar, wheel PI loops, bookkeeping)."""
+
+    name = "straight_to_goal"
+    summary = "a unit force toward the goal (the run loop's own cost, for this benchmark)"
+    citation = "-"
+    Params = PlannerParams
+
+    def step(self, obs: Observation) -> Decision:
+        dx, dy = obs.goal[0] - obs.position[0], obs.goal[1] - obs.position[1]
+        distance = max(math.hypot(dx, dy), 1e-9)
+        return Decision(force=np.array([dx / distance, dy / distance]), mode="normal")
 
 
 def replay_time(model: mujoco.MjModel, torques, steps: int, clock=time.process_time) -> float:
@@ -133,6 +155,12 @@ def main(argv: list[str] | None = None) -> int:
         report(args.scenarios, planners, args.repeat, None if args.no_log else Path(tmp))
     if args.profile:
         profile(args.scenarios[0], planners[0])
+    register_planner(StraightToGoal)
+    harness = measure(HARNESS_SCENARIO, StraightToGoal.name, args.repeat, None)
+    print(
+        f"\nThe run loop alone: `{StraightToGoal.name}` ({harness['planner_ms']:.3f} ms a tick) "
+        f"{harness['outcome']} on {HARNESS_SCENARIO} at {harness['run']:.2f} times the floor."
+    )
     return 0
 
 

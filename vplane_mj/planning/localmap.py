@@ -110,7 +110,7 @@ class LocalMap:
         axis = yaw + bearings[0]
         bearing = np.arctan2(rel_y, rel_x) - axis
         spacing = 2 * math.pi / len(bearings)
-        sonar = np.rint(bearing / spacing).astype(int)  # the nearest sonar (np.round's halves to even)
+        sonar = np.rint(bearing / spacing).astype(int)  # the nearest sonar (halves to even, as np.round)
         sonar %= len(bearings)
         offset = bearing - sonar * spacing + math.pi  # wrapped below: the angle from its axis
         if abs(axis) <= math.pi:  # offset in (-2 pi, 4 pi): the modulo is one conditional turn
