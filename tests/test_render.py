@@ -11,7 +11,7 @@ from vplane_mj.render import png_bytes, write_png
 def test_a_written_png_reads_back_pixel_for_pixel(tmp_path, shape):
     image = np.random.default_rng(sum(shape)).integers(0, 256, shape, dtype=np.uint8)
     path = tmp_path / "image.png"
-    write_png(image, path)
+    write_png(image, str(path))  # a str or a Path
     back = matplotlib.image.imread(path)  # floats in [0, 1] for an 8-bit PNG
     assert back.shape == shape
     np.testing.assert_array_equal(np.round(back * 255).astype(np.uint8), image)

@@ -78,10 +78,10 @@ def render_top_view(scenario, track: Track) -> np.ndarray:
         return renderer.render()
 
 
-def write_png(image: np.ndarray, path: Path) -> None:
+def write_png(image: np.ndarray, path: Path | str) -> None:
     """Save an RGB image (H, W, 3) of uint8 as PNG: 8-bit truecolour, every row with PNG's
     "Up" filter (its difference from the row above), deflated by zlib."""
-    path.write_bytes(png_bytes(image))
+    Path(path).write_bytes(png_bytes(image))
 
 
 def png_bytes(image: np.ndarray) -> bytes:
