@@ -22,7 +22,9 @@ def test_flat_colour_compresses_well():
     assert len(png_bytes(image)) < 2_000  # 480,000 bytes of pixels
 
 
-@pytest.mark.parametrize("image", [np.zeros((4, 4, 4), np.uint8), np.zeros((4, 4, 3), np.float32)])
+@pytest.mark.parametrize(
+    "image", [np.zeros((4, 4, 4), np.uint8), np.zeros((4, 4, 3), np.float32), np.zeros((4, 4), np.uint8)]
+)
 def test_anything_but_rgb_bytes_is_refused(image):
     with pytest.raises(ValueError, match="RGB image of uint8"):
         png_bytes(image)

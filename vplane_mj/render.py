@@ -87,9 +87,9 @@ def write_png(image: np.ndarray, path: Path | str) -> None:
 def png_bytes(image: np.ndarray) -> bytes:
     """The PNG file of an RGB image (H, W, 3) of uint8 (the standard library's zlib, so that
     writing a render loads no imaging library)."""
-    height, width, channels = image.shape
-    if channels != 3 or image.dtype != np.uint8:
-        raise ValueError(f"an RGB image of uint8 is needed, not {channels} channels of {image.dtype}")
+    if image.ndim != 3 or image.shape[2] != 3 or image.dtype != np.uint8:
+        raise ValueError(f"an RGB image of uint8 (H, W, 3) is needed, not {image.shape} of {image.dtype}")
+    height, width, _ = image.shape
     rows = image.reshape(height, width * 3)
     filtered = np.empty((height, 1 + width * 3), dtype=np.uint8)
     filtered[:, 0] = PNG_FILTER_UP
