@@ -20,7 +20,7 @@ from vplane_mj.cache import CACHE_ENV
 from vplane_mj.cli import main
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.robot import robot_radius_m
-from vplane_mj.scenario import load_scenario, parse_scenario
+from vplane_mj.scenario import build_scenario, load_scenario, parse_scenario, wall
 
 # The tests keep their cached reference paths apart from the user's (and start without any).
 _CACHE = tempfile.mkdtemp(prefix="vplane-mj-test-cache-")
@@ -100,3 +100,17 @@ def steer_to_goal():
         return np.array([0.5, 3.0 * math.atan2(y, x)])
 
     return policy
+
+
+@pytest.fixture
+def walled_off():
+    """A 4 x 3 m arena cut in two by a wall between the start and the goal: no way through,
+    so an episode ends at its 8 s time limit (the environments' truncation)."""
+    return build_scenario(
+        "blocked",
+        size=(4.0, 3.0),
+        start=(0.8, 1.5),
+        goal=(3.4, 1.5),
+        obstacles=[wall((2.0, 0.0), (2.0, 3.0), thickness=0.1)],
+        run={"time_limit_s": 8.0},
+    )

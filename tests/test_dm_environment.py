@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from dm_env import test_utils
 
-from vplane_mj import ScenarioError, VPlaneError, build_scenario, wall
+from vplane_mj import ScenarioError, VPlaneError
 from vplane_mj.cli import main
 from vplane_mj.dm_environment import VPlaneNavDmEnv
 from vplane_mj.gym_env import VPlaneNavEnv
@@ -147,16 +147,10 @@ def test_reaching_the_goal_is_a_last_step_with_discount_0_and_the_success_bonus(
     assert sum(rewards) == pytest.approx(progress + 10.0 - 0.01 * summary["sim_time_s"], abs=1e-9)
 
 
-def test_the_time_limit_is_a_last_step_with_discount_1_and_the_next_step_begins_the_next_episode():
-    blocked = build_scenario(
-        "blocked",
-        size=(4.0, 3.0),
-        start=(0.8, 1.5),
-        goal=(3.4, 1.5),
-        obstacles=[wall((2.0, 0.0), (2.0, 3.0), thickness=0.1)],
-        run={"time_limit_s": 8.0},
-    )
-    env = VPlaneNavDmEnv(blocked, action="velocity", seed=7)
+def test_the_time_limit_is_a_last_step_with_discount_1_and_the_next_step_begins_the_next_episode(
+    walled_off,
+):
+    env = VPlaneNavDmEnv(walled_off, action="velocity", seed=7)
     steps = [env.reset()]
     while not steps[-1].last():
         steps.append(env.step(np.array([0.3, 0.0])))

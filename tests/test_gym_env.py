@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from vplane_mj import ScenarioError, VPlaneError, build_scenario, wall
+from vplane_mj import ScenarioError, VPlaneError
 from vplane_mj.cli import main
 from vplane_mj.gym_env import ENV_ID, VPlaneNavEnv
 from vplane_mj.summary import without_timing
@@ -81,16 +81,8 @@ def test_velocity_actions_reach_the_goal_and_the_rewards_add_up(steer_to_goal):
     assert sum(rewards) == pytest.approx(progress + 10.0 - 0.01 * summary["sim_time_s"], abs=1e-9)
 
 
-def test_collisions_cost_and_the_time_limit_truncates():
-    blocked = build_scenario(
-        "blocked",
-        size=(4.0, 3.0),
-        start=(0.8, 1.5),
-        goal=(3.4, 1.5),
-        obstacles=[wall((2.0, 0.0), (2.0, 3.0), thickness=0.1)],
-        run={"time_limit_s": 8.0},
-    )
-    env = VPlaneNavEnv(blocked, action="velocity")
+def test_collisions_cost_and_the_time_limit_truncates(walled_off):
+    env = VPlaneNavEnv(walled_off, action="velocity")
     steps = episode(env, [np.array([0.3, 0.0])] * 1000, seed=0)
     collided = [i for i in range(1, len(steps)) if steps[i][4]["collisions"] > steps[i - 1][4]["collisions"]]
     assert collided and all(steps[i][1] < -0.9 for i in collided)
