@@ -77,3 +77,74 @@ def test_empty_scene_is_infinitely_far():
     field = shapes.scene_footprints([])
     assert len(field) == 0
     assert np.isinf(field.distance(np.zeros((3, 2)))).all()
+
+
+JACKAL_OUTLINE = np.array([(-0.254, -0.215), (0.254, -0.215), (0.254, 0.215), (-0.254, 0.215)])
+
+
+def _world_outline(outline, pose):
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    return outline @ np.array([[c, s], [-s, c]]) + pose[:2]
+
+
+def _inside_outline(polygon, points):
+    edges = np.roll(polygon, -1, axis=0) - polygon
+    rel = points[:, None, :] - polygon[None]
+    return ((edges[None, :, 0] * rel[..., 1] - edges[None, :, 1] * rel[..., 0]) >= 0).all(axis=1)
+
+
+def _random_pieces(rng, spread):
+    pieces = []
+    for _ in range(rng.integers(1, 5)):
+        centre = tuple(rng.uniform(-spread, spread, 2))
+        if rng.random() < 0.5:
+            pieces.append(shapes.Rect(centre, tuple(rng.uniform(0.02, 0.6, 2)), rng.uniform(-3, 3)))
+        else:
+            pieces.append(shapes.Disc(centre, rng.uniform(0.03, 0.4)))
+    return pieces
+
+
+def test_a_rectangle_beside_a_box_is_as_far_as_their_facing_sides():
+    footprints = shapes.Footprints([shapes.Rect((1.0, 0.0), (0.1, 0.5))])
+    # The outline's front side is at x = 0.254; the box's near side at x = 0.9.
+    at_rest = footprints.outline_distance(JACKAL_OUTLINE, np.array([[0.0, 0.0, 0.0]]))
+    assert at_rest[0] == pytest.approx(0.9 - 0.254)
+    # Turned 90 degrees, its side (0.215 from the centre) faces the box instead.
+    turned = footprints.outline_distance(JACKAL_OUTLINE, np.array([[0.0, 0.0, math.pi / 2]]))
+    assert turned[0] == pytest.approx(0.9 - 0.215)
+    # Pushed 0.1 m into the box, it overlaps by 0.1 m.
+    inside = footprints.outline_distance(JACKAL_OUTLINE, np.array([[0.746, 0.0, 0.0]]))
+    assert inside[0] == pytest.approx(-0.1)
+
+
+def test_a_disc_beside_a_rectangle_is_as_far_as_its_nearest_corner():
+    footprints = shapes.Footprints([shapes.Disc((1.0, 1.0), 0.2)])
+    corner = np.hypot(1.0 - 0.254, 1.0 - 0.215)
+    distance = footprints.outline_distance(JACKAL_OUTLINE, np.array([[0.0, 0.0, 0.0]]))
+    assert distance[0] == pytest.approx(corner - 0.2)
+
+
+def test_outline_distance_matches_the_sampled_boundary_on_random_scenes():
+    rng = np.random.default_rng(3)
+    side = np.linspace(0.0, 1.0, 300)[:, None]
+    for _ in range(200):
+        footprints = shapes.Footprints(_random_pieces(rng, 1.5))
+        pose = np.array([*rng.uniform(-0.5, 0.5, 2), rng.uniform(-3, 3)])
+        exact = footprints.outline_distance(JACKAL_OUTLINE, pose[None])[0]
+        world = _world_outline(JACKAL_OUTLINE, pose)
+        boundary = np.vstack([a + (b - a) * side for a, b in zip(world, np.roll(world, -1, 0), strict=True)])
+        sampled = footprints.distance(boundary).min()
+        if exact > 0:  # parted: the nearest outline point lies on the sampled boundary
+            assert exact == pytest.approx(sampled, abs=2e-3)
+        else:  # overlapping: some point of the outline's inside lies in an obstacle
+            grid = np.stack(np.meshgrid(*2 * [np.linspace(-0.4, 0.4, 161)]), -1).reshape(-1, 2) + pose[:2]
+            assert (_inside_outline(world, grid) & (footprints.distance(grid) < 0)).any()
+
+
+def test_outline_distance_of_many_poses_equals_each_pose_alone():
+    rng = np.random.default_rng(4)
+    footprints = shapes.Footprints(_random_pieces(rng, 2.0) + list(shapes.border_footprint((4.0, 4.0))))
+    poses = np.column_stack((rng.uniform(0, 4, 50), rng.uniform(0, 4, 50), rng.uniform(-3, 3, 50)))
+    together = footprints.outline_distance(JACKAL_OUTLINE, poses)
+    alone = [footprints.outline_distance(JACKAL_OUTLINE, pose[None])[0] for pose in poses]
+    np.testing.assert_allclose(together, alone)

@@ -201,22 +201,118 @@ class Footprints:
         Inside a piece the value is minus the depth to that piece's boundary; where
         pieces overlap this is exact outside and a lower bound on depth inside.
         """
-        pts = np.atleast_2d(np.asarray(points, dtype=float))
-        best = np.full(len(pts), np.inf)
-        if len(self._rect_center):
-            rel = pts[:, None, :] - self._rect_center[None, :, :]
-            lx = rel[..., 0] * self._rect_cos + rel[..., 1] * self._rect_sin
-            ly = -rel[..., 0] * self._rect_sin + rel[..., 1] * self._rect_cos
-            qx = np.abs(lx) - self._rect_half[:, 0]
-            qy = np.abs(ly) - self._rect_half[:, 1]
-            outside = np.hypot(np.maximum(qx, 0.0), np.maximum(qy, 0.0))
-            inside = np.minimum(np.maximum(qx, qy), 0.0)
-            best = np.minimum(best, (outside + inside).min(axis=1))
-        if len(self._disc_center):
-            rel = pts[:, None, :] - self._disc_center[None, :, :]
-            d = np.hypot(rel[..., 0], rel[..., 1]) - self._disc_radius
-            best = np.minimum(best, d.min(axis=1))
-        return best
+        rects, discs = self._piece_distances(np.atleast_2d(np.asarray(points, dtype=float)))
+        return np.minimum(rects.min(axis=1, initial=np.inf), discs.min(axis=1, initial=np.inf))
+
+    def outline_distance(self, outline: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        """Signed distance (m) from a robot's convex outline to the union at each pose; negative
+        when they overlap, then minus the depth of the overlap (the shortest move that parts them).
+
+        `outline` (k, 2) is the footprint polygon, counter-clockwise in the robot's frame, about
+        an origin inside it; `poses` (N, 3) are x, y (m) and yaw (rad). Only pieces that can be
+        the nearest are measured exactly: the outline lies within its circumradius R of the
+        origin, so piece p is at least d_p - R away when the origin is d_p away, and no farther
+        than the nearest d_p. Exact: separating axes for rectangles, the outline's distance to
+        the centre for discs.
+        """
+        poses = np.atleast_2d(np.asarray(poses, dtype=float))
+        result = np.full(len(poses), np.inf)
+        if not len(self.pieces):
+            return result
+        reach = float(np.max(np.hypot(outline[:, 0], outline[:, 1])))
+        rects, discs = self._piece_distances(poses[:, :2])
+        nearest = np.minimum(rects.min(axis=1, initial=np.inf), discs.min(axis=1, initial=np.inf))
+        for table, measure in ((rects, self._outline_to_rects), (discs, self._outline_to_discs)):
+            pose_index, piece_index = np.nonzero(table - reach <= nearest[:, None])
+            if len(pose_index):
+                distances = measure(outline, poses[pose_index], piece_index)
+                np.minimum.at(result, pose_index, distances)
+        return result
+
+    def _piece_distances(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Signed distances (m) from each point (N, 2) to each rectangle (N, R) and disc (N, D)."""
+        rel = points[:, None, :] - self._rect_center[None, :, :]
+        lx = rel[..., 0] * self._rect_cos + rel[..., 1] * self._rect_sin
+        ly = -rel[..., 0] * self._rect_sin + rel[..., 1] * self._rect_cos
+        qx = np.abs(lx) - self._rect_half[:, 0]
+        qy = np.abs(ly) - self._rect_half[:, 1]
+        rects = np.hypot(np.maximum(qx, 0.0), np.maximum(qy, 0.0)) + np.minimum(np.maximum(qx, qy), 0.0)
+        rel = points[:, None, :] - self._disc_center[None, :, :]
+        discs = np.hypot(rel[..., 0], rel[..., 1]) - self._disc_radius
+        return rects, discs
+
+    def _outline_to_discs(self, outline: np.ndarray, poses: np.ndarray, discs: np.ndarray) -> np.ndarray:
+        """Signed distance (m) from the outline at each pose (M, 3) to disc `discs[m]`."""
+        centres = _to_body(self._disc_center[discs], poses)
+        return _polygon_distance(outline, centres) - self._disc_radius[discs]
+
+    def _outline_to_rects(self, outline: np.ndarray, poses: np.ndarray, rects: np.ndarray) -> np.ndarray:
+        """Signed distance (m) from the outline at each pose (M, 3) to rectangle `rects[m]`."""
+        c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+        world = np.einsum("kj,mij->mki", outline, np.stack((np.stack((c, -s), -1), np.stack((s, c), -1)), 1))
+        world += poses[:, None, :2]  # (M, k, 2) the outline in the world
+        rc, rs = self._rect_cos[rects], self._rect_sin[rects]
+        half = self._rect_half[rects]
+        signs = np.array([(-1, -1), (1, -1), (1, 1), (-1, 1)], dtype=float)
+        local = signs[None] * half[:, None, :]
+        corners = (
+            np.stack(
+                (
+                    local[..., 0] * rc[:, None] - local[..., 1] * rs[:, None],
+                    local[..., 0] * rs[:, None] + local[..., 1] * rc[:, None],
+                ),
+                -1,
+            )
+            + self._rect_center[rects][:, None, :]
+        )  # (M, 4, 2)
+        edges = np.roll(outline, -1, axis=0) - outline
+        normals = np.column_stack((edges[:, 1], -edges[:, 0]))  # outward, counter-clockwise outline
+        outline_axes = np.stack(
+            (
+                normals[None, :, 0] * c[:, None] - normals[None, :, 1] * s[:, None],
+                normals[None, :, 0] * s[:, None] + normals[None, :, 1] * c[:, None],
+            ),
+            -1,
+        )
+        rect_axes = np.stack((np.column_stack((rc, rs)), np.column_stack((-rs, rc))), 1)
+        axes = np.concatenate((outline_axes, rect_axes), axis=1)
+        axes /= np.linalg.norm(axes, axis=-1, keepdims=True)  # (M, k + 2, 2)
+        along_outline = np.einsum("mad,mkd->mak", axes, world)
+        along_rect = np.einsum("mad,mkd->mak", axes, corners)
+        overlap = np.minimum(along_outline.max(-1), along_rect.max(-1)) - np.maximum(
+            along_outline.min(-1), along_rect.min(-1)
+        )
+        depth = overlap.min(axis=1)
+        # Parted: the nearest pair of features includes a vertex of one of the two (convex) shapes.
+        rel = world - self._rect_center[rects][:, None, :]
+        lx = rel[..., 0] * rc[:, None] + rel[..., 1] * rs[:, None]
+        ly = -rel[..., 0] * rs[:, None] + rel[..., 1] * rc[:, None]
+        qx, qy = np.abs(lx) - half[:, None, 0], np.abs(ly) - half[:, None, 1]
+        vertex_to_rect = np.hypot(np.maximum(qx, 0.0), np.maximum(qy, 0.0)).min(axis=1)
+        corner_to_outline = _polygon_distance(
+            outline, _to_body(corners.reshape(-1, 2), np.repeat(poses, 4, 0))
+        )
+        parted = np.minimum(vertex_to_rect, corner_to_outline.reshape(-1, 4).min(axis=1))
+        return np.where(depth < 0.0, parted, -depth)
+
+
+def _to_body(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """World points (M, 2) in the frame of the pose beside each (M, 3)."""
+    c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+    dx, dy = points[:, 0] - poses[:, 0], points[:, 1] - poses[:, 1]
+    return np.column_stack((c * dx + s * dy, -s * dx + c * dy))
+
+
+def _polygon_distance(polygon: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Signed distance (m) from each point (M, 2) to a convex counter-clockwise polygon (k, 2);
+    negative inside."""
+    start = polygon[None, :, :]
+    edge = (np.roll(polygon, -1, axis=0) - polygon)[None, :, :]
+    rel = points[:, None, :] - start
+    t = np.clip((rel * edge).sum(-1) / (edge * edge).sum(-1), 0.0, 1.0)
+    gap = np.hypot(*np.moveaxis(rel - t[..., None] * edge, -1, 0)).min(axis=1)
+    outside = (edge[..., 0] * rel[..., 1] - edge[..., 1] * rel[..., 0] < 0.0).any(axis=1)
+    return np.where(outside, gap, -gap)
 
 
 def scene_footprints(obstacles: Iterable[Obstacle], arena_size: Vec2 | None = None) -> Footprints:

@@ -3,6 +3,8 @@
 The names for writing a planner of one's own (README, "Your own planner"):
 
 - `Planner`: the base class (name, summary, citation, Params; `step(obs) -> Decision`);
+- `RobotBody`, `DriveLimits`, `HeadingGains`: the robot a planner is built for (footprint,
+  limits, the heading controller's gains, sensor kind);
 - `Observation`, `Decision`, `Event`, `EventKind`, `point`: what it receives and returns;
 - `PlannerParams`, `param`, `with_default`: its parameters as a frozen dataclass;
 - `FieldParams`, `DetectorParams`, `MinimumParams`, `LocalMapParams`, `SonarMapParams`: the
@@ -13,6 +15,7 @@ The names for writing a planner of one's own (README, "Your own planner"):
 """
 
 from vplane_mj.planning.base import Planner
+from vplane_mj.planning.body import DriveLimits, HeadingGains, RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.groups import (
     DetectorParams,
@@ -32,9 +35,11 @@ from vplane_mj.planning.vectors import unit, wrap_angle
 __all__ = [
     "Decision",
     "DetectorParams",
+    "DriveLimits",
     "Event",
     "EventKind",
     "FieldParams",
+    "HeadingGains",
     "LocalMap",
     "LocalMapParams",
     "LocalMinimumDetector",
@@ -45,6 +50,7 @@ __all__ = [
     "Planner",
     "PlannerError",
     "PlannerParams",
+    "RobotBody",
     "SonarMapParams",
     "load_planner",
     "param",

@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from vplane_mj.planning.base import Planner
+from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.groups import FieldParams, MinimumParams
 from vplane_mj.planning.minima import report_trap
 from vplane_mj.planning.types import Decision, Observation
@@ -29,8 +30,8 @@ class ApfPlanner(Planner):
     Params = ApfParams
     params: ApfParams
 
-    def __init__(self, params: ApfParams, robot_radius_m: float):
-        super().__init__(params, robot_radius_m)
+    def __init__(self, params: ApfParams, robot: RobotBody | float):
+        super().__init__(params, robot)
         self.detector = params.detector()
 
     def step(self, obs: Observation) -> Decision:

@@ -1,17 +1,24 @@
 """The base class of every planner: what it is given once, and what it answers each tick.
 
-A planner is built once per run from its checked parameters and the robot's radius, then
-called at the control rate (`run.control_hz`) with an `Observation` and answers a `Decision`
-(types.py). It sees only the pose it believes in, its goal and the sonar ring, never the
+A planner is built once per run from its checked parameters and the robot's body (footprint,
+limits, controller gains and sensor kind: body.py), then called at the control rate
+(`run.control_hz`) with an `Observation` and answers a `Decision` (types.py). It sees only the
+pose it believes in, its goal and its range sensor (a sonar ring or a laser), never the
 simulator's obstacles.
+
+Planners written when the protocol handed them only the robot's radius,
+`__init__(self, params, robot_radius_m)`, keep working: `build` gives them the radius, and
+the body as `self.robot` once they are made.
 """
 
 from __future__ import annotations
 
+import inspect
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from typing import ClassVar, Self
 
+from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.params import PlannerInfo, PlannerParams
 from vplane_mj.planning.types import Decision, Observation
 
@@ -29,15 +36,17 @@ class Planner(ABC):
     citation: ClassVar[str]
     Params: ClassVar[type[PlannerParams]] = PlannerParams
 
-    def __init__(self, params: PlannerParams, robot_radius_m: float):
-        """`params`: an instance of `Params`; `robot_radius_m`: the radius (m) of a disc about
-        the robot's centre that holds all of it."""
+    def __init__(self, params: PlannerParams, robot: RobotBody | float):
+        """`params`: an instance of `Params`; `robot`: the robot's body, or (as planners written
+        for the first protocol pass it) the radius (m) of a round robot."""
         if not isinstance(params, self.Params):
             raise TypeError(
                 f"planner {self.name!r} takes {self.Params.__name__}, got {type(params).__name__}"
             )
         self.params = params
-        self.radius = robot_radius_m
+        self.robot = robot if isinstance(robot, RobotBody) else RobotBody.round(float(robot))
+        self.radius = self.robot.radius_m
+        """Radius (m) of the disc about the robot's centre that holds all of it."""
 
     @abstractmethod
     def step(self, obs: Observation) -> Decision:
@@ -45,12 +54,28 @@ class Planner(ABC):
         planner is doing."""
 
     @classmethod
-    def build(cls, overrides: Mapping[str, object], robot_radius_m: float) -> Self:
-        """A fresh planner, its parameters the defaults updated with `overrides` (each key and
-        value checked: `ParamError`)."""
-        return cls(cls.Params.resolve(overrides, cls.name), robot_radius_m)
+    def build(cls, overrides: Mapping[str, object], robot: RobotBody | float) -> Self:
+        """A fresh planner for `robot` (a body, or a round robot's radius in m), its parameters
+        the defaults updated with `overrides` (each key and value checked: `ParamError`)."""
+        params = cls.Params.resolve(overrides, cls.name)
+        body = robot if isinstance(robot, RobotBody) else RobotBody.round(float(robot))
+        if not _takes_a_radius(cls):
+            return cls(params, body)
+        planner = cls(params, body.radius_m)
+        planner.robot = body
+        return planner
 
     @classmethod
     def info(cls) -> PlannerInfo:
         """Name, summary, citation and parameter table, as `vplane-mj list` shows them."""
         return PlannerInfo(cls.name, cls.summary, cls.citation, cls.Params.table())
+
+
+def _takes_a_radius(cls: type[Planner]) -> bool:
+    """Whether the class was written for the first protocol: its own `__init__` takes the robot's
+    radius as a parameter named `robot_radius_m`."""
+    init = cls.__init__
+    if init is Planner.__init__:
+        return False
+    parameters = list(inspect.signature(init).parameters)
+    return len(parameters) >= 3 and parameters[2] == "robot_radius_m"

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vplane_mj.planning.base import Planner
+from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.params import PlannerParams, param
 from vplane_mj.planning.types import Decision, Observation
@@ -70,8 +71,8 @@ class Bug2Planner(Planner):
     Params = Bug2Params
     params: Bug2Params
 
-    def __init__(self, params: Bug2Params, robot_radius_m: float):
-        super().__init__(params, robot_radius_m)
+    def __init__(self, params: Bug2Params, robot: RobotBody | float):
+        super().__init__(params, robot)
         self.mode = "go_to_goal"
         self.mline: tuple[np.ndarray, np.ndarray] | None = None
         self.hit_point: np.ndarray | None = None

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vplane_mj.planning.base import Planner
+from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind
 from vplane_mj.planning.groups import LocalMapParams, MinimumParams
 from vplane_mj.planning.minima import report_trap
@@ -152,8 +153,8 @@ class DwaPlanner(Planner):
     Params = DwaParams
     params: DwaParams
 
-    def __init__(self, params: DwaParams, robot_radius_m: float):
-        super().__init__(params, robot_radius_m)
+    def __init__(self, params: DwaParams, robot: RobotBody | float):
+        super().__init__(params, robot)
         p = params
         self.detector = p.detector()
         self.map = p.local_map()

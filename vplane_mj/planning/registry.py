@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from vplane_mj.planning.base import Planner
+from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.params import PlannerInfo
 from vplane_mj.planning.plugins import PlannerError, canonical_spec, import_planner, planner_problem
 
@@ -178,6 +179,7 @@ def planner_info(name: str) -> PlannerInfo:
     return PLANNERS[name].info()
 
 
-def make_planner(name: str, params: Mapping[str, object], robot_radius_m: float) -> Planner:
-    """A fresh planner `name`, its parameters resolved against the defaults (each checked)."""
-    return PLANNERS[name].build(params, robot_radius_m)
+def make_planner(name: str, params: Mapping[str, object], robot: RobotBody | float) -> Planner:
+    """A fresh planner `name` for `robot` (a body, or a round robot's radius in m), its parameters
+    resolved against the defaults (each checked)."""
+    return PLANNERS[name].build(params, robot)

@@ -19,6 +19,7 @@ import numpy as np
 
 from vplane_mj.planning import histogram
 from vplane_mj.planning.base import Planner
+from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.groups import MinimumParams, SonarMapParams
 from vplane_mj.planning.minima import report_trap
 from vplane_mj.planning.params import param
@@ -53,8 +54,8 @@ class VfhPlanner(Planner):
     Params = VfhParams
     params: VfhParams
 
-    def __init__(self, params: VfhParams, robot_radius_m: float):
-        super().__init__(params, robot_radius_m)
+    def __init__(self, params: VfhParams, robot: RobotBody | float):
+        super().__init__(params, robot)
         self.detector = params.detector()
         self.map = params.local_map()
         self.n_sectors = params.sector_count()

@@ -15,6 +15,7 @@ import numpy as np
 
 from vplane_mj.planning import fields
 from vplane_mj.planning.base import Planner
+from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.groups import DetectorParams, FieldParams
 from vplane_mj.planning.params import param
@@ -43,8 +44,8 @@ class VobsPlanner(Planner):
     Params = VobsParams
     params: VobsParams
 
-    def __init__(self, params: VobsParams, robot_radius_m: float):
-        super().__init__(params, robot_radius_m)
+    def __init__(self, params: VobsParams, robot: RobotBody | float):
+        super().__init__(params, robot)
         self.detector = params.detector()
         self.virtual: list[tuple[float, np.ndarray]] = []  # (time placed, position)
         self.placed = 0

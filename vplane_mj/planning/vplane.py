@@ -31,6 +31,7 @@ import numpy as np
 
 from vplane_mj.planning import fields, histogram
 from vplane_mj.planning.base import Planner
+from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.groups import DetectorParams, FieldParams, SonarMapParams
 from vplane_mj.planning.localmap import angular_extremes
@@ -108,8 +109,8 @@ class VPlanePlanner(Planner):
     Params = VPlaneParams
     params: VPlaneParams
 
-    def __init__(self, params: VPlaneParams, robot_radius_m: float):
-        super().__init__(params, robot_radius_m)
+    def __init__(self, params: VPlaneParams, robot: RobotBody | float):
+        super().__init__(params, robot)
         p = params
         self.detector = p.detector()
         self.map = p.local_map()

@@ -32,6 +32,7 @@ import numpy as np
 from scipy import ndimage
 
 from vplane_mj.planning import fields, gridsearch
+from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.localmap import LocalMap, angular_extremes
 from vplane_mj.planning.params import param, with_default
@@ -123,8 +124,8 @@ class VPlanePlusPlanner(VPlanePlanner):
     Params = VPlanePlusParams
     params: VPlanePlusParams
 
-    def __init__(self, params: VPlanePlusParams, robot_radius_m: float):
-        super().__init__(params, robot_radius_m)
+    def __init__(self, params: VPlanePlusParams, robot: RobotBody | float):
+        super().__init__(params, robot)
         p = params
         self.map = LocalMap(
             p.map_cell_m,
