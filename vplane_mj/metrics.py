@@ -69,6 +69,7 @@ class MotionQuality(TypedDict):
 class PathQuality(TypedDict):
     """The summary's keys for the path against the reference path (`path_quality`)."""
 
+    reference_length_m: float | None
     optimal_length_m: float | None
     path_ratio: float | None
     score: float | None
@@ -106,29 +107,32 @@ def path_quality(
     time_to_goal: float | None,
     top_speed_mps: float,
 ) -> PathQuality:
-    """The reference shortest path to the goal tolerance disc, the path length over it, and the
-    BARN score (`barn_score`)."""
+    """The reference shortest path to the goal (for a robot that needs `radius`, m, of room on
+    each side), the part of it to the goal tolerance disc, the path length over that part, and
+    the BARN score (`barn_score`), whose OT is the whole reference path over the top speed, as
+    BARN's own OT runs to the goal point."""
     reference = shortest_path_length(scenario, radius)
     optimal = None if reference is None else max(reference - scenario.robot.goal_tolerance, 0.0)
     ratio = path_length / optimal if time_to_goal is not None and optimal else None
     return {
+        "reference_length_m": reference,
         "optimal_length_m": optimal,
         "path_ratio": ratio,
-        "score": barn_score(success, optimal, time_to_goal, top_speed_mps),
+        "score": barn_score(success, reference, time_to_goal, top_speed_mps),
     }
 
 
 def barn_score(
-    success: bool, optimal_length_m: float | None, time_to_goal_s: float | None, top_speed_mps: float
+    success: bool, reference_length_m: float | None, time_to_goal_s: float | None, top_speed_mps: float
 ) -> float | None:
     """The BARN benchmark's score (Perille et al. 2020; Xiao et al. 2022): success x OT / clip(T,
-    2 OT, 8 OT), with OT the reference path length over the top speed (s) and T the time to goal
-    (s). In [1/8, 1/2] for a success, 0 otherwise; None when no reference path exists."""
-    if optimal_length_m is None:
+    2 OT, 8 OT), with OT the reference path length (m) over the top speed (m/s) and T the time to
+    goal (s). In [1/8, 1/2] for a success, 0 otherwise; None when no reference path exists."""
+    if reference_length_m is None:
         return None
     if not success or time_to_goal_s is None:
         return 0.0
-    optimal_time = optimal_length_m / top_speed_mps
+    optimal_time = reference_length_m / top_speed_mps
     if optimal_time <= 0:
         return 0.5  # the run began within the goal tolerance
     return optimal_time / min(max(time_to_goal_s, 2 * optimal_time), 8 * optimal_time)

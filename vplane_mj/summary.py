@@ -55,6 +55,7 @@ class RunSummary:
     local_minima: int = 0
     escapes: int = 0
     robot_radius_m: float | None = None
+    reference_length_m: float | None = None
     optimal_length_m: float | None = None
     path_ratio: float | None = None
     score: float | None = None
