@@ -63,6 +63,19 @@ def test_startup_times_runs_against_their_loop_and_the_main_job_with_its_log_and
     assert job["log and render"] > job["--no-render --no-log"] > 0
 
 
+def test_laser_cast_times_both_casters_on_both_worlds_and_the_first_calls(tmp_path):
+    text = run_benchmark("laser_cast.py", "--origins", "2", "--repeat", "1", cwd=tmp_path)
+    for world in ("BARN-size", "paper-size"):
+        rows = table_rows(text, world)
+        assert len(rows) == 2, text  # the Jackal's scan and the Burger's
+        for row in rows:
+            ours_us, theirs_us, _, diff_mm = map(float, row[3:7])
+            assert ours_us > 0 and theirs_us > 0 and diff_mm <= 1.0
+    first = re.search(r"First cast in a new process: ([0-9.]+) s .* cache \(compile\), ([0-9.]+) s", text)
+    assert first is not None, text
+    assert float(first.group(1)) > 0 and float(first.group(2)) > 0
+
+
 def test_sweep_benchmarks_write_their_results(tmp_path):
     run_benchmark(
         "clutter.py", "--barn", "1", "--count", "1", "--planners", "apf", "--out", "clutter", cwd=tmp_path
