@@ -140,7 +140,20 @@ def _parser() -> argparse.ArgumentParser:
     gen.add_argument("--count", type=int, default=10)
     gen.add_argument("--seed", type=int, default=0)
     gen.add_argument("--out", type=Path, required=True, metavar="DIR")
+    gen.add_argument(
+        "--protocol",
+        action="store_true",
+        help="barn only: the BARN challenge's layout (4.2 x 14 m, the Jackal), passable for the Jackal",
+    )
     gen.set_defaults(handler=_generate, draws=False)
+
+    imports = commands.add_parser("import", help="convert worlds of another simulator into scenario files")
+    imports.add_argument("source", choices=["barn"], metavar="SOURCE", help="barn: BARN's Gazebo worlds")
+    imports.add_argument(
+        "paths", nargs="+", type=Path, metavar="PATH", help="a world file, or a directory of world_N.world"
+    )
+    imports.add_argument("--out", type=Path, required=True, metavar="DIR")
+    imports.set_defaults(handler=_import, draws=False)
 
     check = commands.add_parser("check", help="validate scenarios only")
     check.add_argument("scenarios", nargs="+", metavar="SCENARIO")
@@ -285,10 +298,32 @@ def _generate(args: argparse.Namespace) -> int:
         raise VPlaneError(f"--count: must be at least 1, got {args.count}")
     if args.seed < 0:
         raise VPlaneError(f"--seed: must be at least 0, got {args.seed}")
+    if args.protocol and args.family != "barn":
+        raise VPlaneError(f"--protocol: only the barn family has the challenge's layout, not {args.family}")
     out_dir = prepare_out_dir(args.out)
-    cases = generate(args.family, args.count, args.seed)
+    if args.protocol:
+        from vplane_mj.barn_protocol import generate_protocol
+
+        cases = generate_protocol(args.count, args.seed)
+    else:
+        cases = generate(args.family, args.count, args.seed)
     for case in cases:
         path = write_atomically(out_dir / f"{case.name}.toml", partial(Path.write_text, data=case.toml()))
+        print(f"wrote {path}")
+    return 0
+
+
+def _import(args: argparse.Namespace) -> int:
+    """Convert BARN's world files into scenario files of the challenge's layout: every file is
+    read and converted before anything is written."""
+    from vplane_mj.barn_import import import_worlds, report_line
+
+    imported = import_worlds(args.paths)
+    out_dir = prepare_out_dir(args.out)
+    for world in imported:
+        print(report_line(world))
+        toml = world.case.toml()
+        path = write_atomically(out_dir / f"{world.case.name}.toml", partial(Path.write_text, data=toml))
         print(f"wrote {path}")
     return 0
 

@@ -15,3 +15,14 @@ class ScenarioError(VPlaneError):
         self.key = key
         self.reason = reason
         super().__init__(f"{source}: {key}: {reason}" if key else f"{source}: {reason}")
+
+
+class WorldFileError(VPlaneError):
+    """An imported world file (SDF) that cannot be converted: names the file, the element and
+    the reason."""
+
+    def __init__(self, source: str, element: str, reason: str):
+        self.source = source
+        self.element = element
+        self.reason = reason
+        super().__init__(f"{source}: {element}: {reason}" if element else f"{source}: {reason}")

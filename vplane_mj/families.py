@@ -286,19 +286,26 @@ def barn_cells(rng: np.random.Generator) -> np.ndarray:
     """An occupancy grid (BARN_ROWS, BARN_COLUMNS) drawn by a cellular automaton (Perille et al.).
 
     Cells are filled at random with a probability drawn from BARN_FILL, then smoothed by 0-4
-    passes (drawn from BARN_SMOOTHING_PASSES) of BARN's rule: a cell fills when more than 4 of
-    its 8 neighbours are filled and empties when fewer than 2 are. Beyond the side columns
-    stand the arena's walls (they count as filled); before and after the field is open floor.
-    Few passes leave scattered cells; more passes grow them into blobs with narrow, winding
-    passages.
+    passes (drawn from BARN_SMOOTHING_PASSES) of BARN's rule (`smooth_cells`).
     """
     fill = rng.uniform(*BARN_FILL)
     grid = rng.random((BARN_ROWS, BARN_COLUMNS)) < fill
-    for _ in range(int(rng.integers(BARN_SMOOTHING_PASSES[0], BARN_SMOOTHING_PASSES[1] + 1))):
+    return smooth_cells(grid, int(rng.integers(BARN_SMOOTHING_PASSES[0], BARN_SMOOTHING_PASSES[1] + 1)))
+
+
+def smooth_cells(grid: np.ndarray, passes: int) -> np.ndarray:
+    """`passes` passes of BARN's cellular-automaton rule over an occupancy grid (rows along y,
+    columns across x): a cell fills when more than 4 of its 8 neighbours are filled and empties
+    when fewer than 2 are. Beyond the side columns stand the arena's walls (they count as
+    filled); before and after the field is open floor. Few passes leave scattered cells; more
+    passes grow them into blobs with narrow, winding passages.
+    """
+    rows, columns = grid.shape
+    for _ in range(passes):
         padded = np.pad(grid, ((1, 1), (0, 0)), constant_values=False)
         padded = np.pad(padded, ((0, 0), (1, 1)), constant_values=True).astype(int)
         neighbours = sum(
-            padded[1 + dy : 1 + dy + BARN_ROWS, 1 + dx : 1 + dx + BARN_COLUMNS]
+            padded[1 + dy : 1 + dy + rows, 1 + dx : 1 + dx + columns]
             for dy in (-1, 0, 1)
             for dx in (-1, 0, 1)
             if dy or dx

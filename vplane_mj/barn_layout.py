@@ -1,0 +1,94 @@
+"""The BARN challenge's layout in arena coordinates (docs/barn.md, docs/interface.md section 6).
+
+What `vplane-mj generate barn --protocol` writes and what `vplane-mj import barn` turns BARN's
+Gazebo worlds into: a 4.2 x 14 m arena with its border, an obstacle field of 0.15 m cells
+filling y in [4.95, 9.6], the start 2.85 m up facing +y, the goal 10 m ahead of it, the Jackal
+robot profile. Worlds of this layout are kept only when the Jackal can get through, checked with
+the project's reference path (`vplane_mj.reference`) for a disc of the Jackal's half diagonal.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from vplane_mj.scenario import Scenario
+
+ARENA_SIZE_M = (4.2, 14.0)
+"""The free arena [0, W] x [0, H] (m), with border walls just outside it."""
+CELL_M = 0.15
+"""Side of one obstacle cell (m); a cell's cylinder has radius CELL_M / 2 (0.075 m)."""
+FIELD_Y_M = (4.95, 9.6)
+"""The obstacle field spans the arena's whole width and y in this range (m)."""
+FIELD_COLUMNS = round(ARENA_SIZE_M[0] / CELL_M)
+"""Cells across the field (28)."""
+FIELD_ROWS = round((FIELD_Y_M[1] - FIELD_Y_M[0]) / CELL_M)
+"""Cells along the field (31)."""
+START_M, START_YAW_DEG = (2.1, 2.85), 90.0
+GOAL_M, GOAL_TOLERANCE_M = (2.1, 12.85), 1.0
+TIME_LIMIT_S = 100.0
+PROFILE = "jackal"
+"""The robot profile of the challenge's robot, a Clearpath Jackal."""
+
+JACKAL_OUTLINE_M = (0.508, 0.430)
+"""The Jackal's outline, length x width (m)."""
+JACKAL_RADIUS_M = math.hypot(*JACKAL_OUTLINE_M) / 2
+"""Half the Jackal's diagonal (0.333 m): the disc that covers it at any heading, the size
+a world of this layout must let through."""
+
+GAZEBO_START_M, GAZEBO_GOAL_M = (-2.25, 3.0), (-2.25, 13.0)
+"""Where BARN's Gazebo worlds place the start and the goal (m)."""
+GAZEBO_TO_ARENA_M = (START_M[0] - GAZEBO_START_M[0], START_M[1] - GAZEBO_START_M[1])
+"""Gazebo (x, y) + this = arena (x, y): the translation (4.35, -0.15) m that takes BARN's start
+to START_M, and its goal, 10 m straight ahead of it as GOAL_M is of START_M, to GOAL_M."""
+
+
+def to_arena(x: float, y: float) -> tuple[float, float]:
+    """A Gazebo point of a BARN world in arena coordinates (m), rounded to the micrometre."""
+    return round(x + GAZEBO_TO_ARENA_M[0], 6), round(y + GAZEBO_TO_ARENA_M[1], 6)
+
+
+def cell_center(row: int, column: int) -> list[float]:
+    """Centre (m) of the field's cell `row` along y (0 nearest the start), `column` across x."""
+    return [round((column + 0.5) * CELL_M, 6), round(FIELD_Y_M[0] + (row + 0.5) * CELL_M, 6)]
+
+
+def layout_document(name: str, description: str, obstacles: list[dict]) -> dict:
+    """A scenario document of the challenge's layout with these obstacles."""
+    return {
+        "format": 1,
+        "name": name,
+        "description": description,
+        "world": {"size": list(ARENA_SIZE_M), "border": True, "obstacles": obstacles},
+        "robot": {
+            "profile": PROFILE,
+            "start": list(START_M),
+            "start_yaw_deg": START_YAW_DEG,
+            "goal": list(GOAL_M),
+            "goal_tolerance": GOAL_TOLERANCE_M,
+        },
+        "run": {"time_limit_s": TIME_LIMIT_S},
+    }
+
+
+def parse_layout(document: dict[str, Any], source: str) -> Scenario:
+    """Validate a document of this layout with the scenario parser (a ScenarioError if invalid).
+
+    `robot.profile` is dropped before validating, as this version of the parser does not know
+    the key yet; when robot profiles land, this function becomes `parse_document` itself.
+    """
+    from vplane_mj.scenario import parse_document
+
+    checked = copy.deepcopy(document)
+    checked.get("robot", {}).pop("profile", None)  # goes when `[robot] profile` lands
+    return parse_document(checked, source)
+
+
+def jackal_reference_length(scenario: Scenario) -> float | None:
+    """The reference path length (m) from start to goal for a disc of JACKAL_RADIUS_M, or None
+    when the Jackal cannot get through."""
+    from vplane_mj.reference import shortest_path_length
+
+    return shortest_path_length(scenario, JACKAL_RADIUS_M)

@@ -1,0 +1,201 @@
+"""A Gazebo world file (SDF) read into the footprints of its static, upright cylinders and boxes.
+
+What `vplane-mj import barn` needs from BARN's worlds, read strictly: every `<model>` of the
+`<world>` must be static, and every collision geometry must be a `<cylinder>` or a `<box>`
+standing upright (roll and pitch 0); a horizontal `<plane>` (the ground) is skipped. A model's
+pose is the one the world's `<state>` block gives for it, where it gives one (the pose Gazebo
+uses), else the model's own `<pose>`; it is composed with the link's and the collision's poses.
+Anything else (a mesh, a sphere, a non-static model, an `<include>`, a pose relative to another
+frame, a malformed file or number) is a WorldFileError naming the file and the element, as an
+XPath below `<world>`, e.g. `model[@name='m']/link[@name='link']/collision[@name='c']/geometry`.
+
+The file is parsed with xml.etree.ElementTree: it never fetches external entities or DTDs, and
+its expat (2.4.1 or later) refuses the exponential entity expansion of a "billion laughs" file.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+from vplane_mj.errors import WorldFileError
+
+_TILT_TOLERANCE_RAD = 1e-6
+"""Largest roll or pitch (rad) of a pose that still counts as upright."""
+_UNSUPPORTED_WORLD_CHILDREN = frozenset({"include", "actor", "population", "road", "frame", "joint"})
+"""Children of `<world>` that may hold or move obstacles this reader cannot take."""
+
+
+@dataclass(frozen=True)
+class WorldShape:
+    """One collision shape in Gazebo's world frame: `kind` "cylinder" (with `radius`) or "box"
+    (with `size`, x and y), its centre (m) and yaw (rad), and the element it came from."""
+
+    kind: str
+    x: float
+    y: float
+    yaw: float
+    element: str
+    radius: float = 0.0
+    size: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class _Pose:
+    """A planar pose (m, rad)."""
+
+    x: float = 0.0
+    y: float = 0.0
+    yaw: float = 0.0
+
+    def then(self, inner: _Pose) -> _Pose:
+        """This pose composed with `inner`, a pose given in this pose's frame."""
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        x, y = self.x + c * inner.x - s * inner.y, self.y + s * inner.x + c * inner.y
+        return _Pose(x, y, self.yaw + inner.yaw)
+
+
+class _Reader:
+    """Reads one file; every error names `source` and the element."""
+
+    def __init__(self, source: str):
+        self.source = source
+
+    def fail(self, element: str, reason: str) -> WorldFileError:
+        return WorldFileError(self.source, element, reason)
+
+    def numbers(self, node: ET.Element, where: str, count: int, meaning: str) -> list[float]:
+        """The `count` finite numbers of an element's text."""
+        text = (node.text or "").strip()
+        try:
+            values = [float(token) for token in text.split()]
+        except ValueError:
+            values = []
+        if len(values) != count or not all(math.isfinite(v) for v in values):
+            raise self.fail(where, f"must be {count} finite numbers ({meaning}), got {text!r}")
+        return values
+
+    def positive(self, parent: ET.Element, tag: str, where: str, count: int, meaning: str) -> list[float]:
+        """The `count` numbers of the required child `tag`, each greater than 0."""
+        node = parent.find(tag)
+        if node is None:
+            raise self.fail(where, f"has no <{tag}>")
+        values = self.numbers(node, f"{where}/{tag}", count, meaning)
+        if min(values) <= 0:
+            raise self.fail(f"{where}/{tag}", f"must be greater than 0, got {(node.text or '').strip()!r}")
+        return values
+
+    def pose(self, owner: ET.Element, where: str) -> _Pose:
+        """The planar pose of `owner`'s `<pose>` child (none: the identity); it must be upright
+        and relative to its parent's frame."""
+        node = owner.find("pose")
+        if node is None:
+            return _Pose()
+        where = f"{where}/pose"
+        frame = node.get("relative_to") or node.get("frame")
+        if frame:
+            raise self.fail(where, f"is relative to the frame {frame!r}: only poses in the parent's frame")
+        x, y, _, roll, pitch, yaw = self.numbers(node, where, 6, "x y z roll pitch yaw")
+        if max(abs(roll), abs(pitch)) > _TILT_TOLERANCE_RAD:
+            raise self.fail(where, f"is tilted (roll {roll:g}, pitch {pitch:g} rad): only upright shapes")
+        return _Pose(x, y, yaw)
+
+    def static(self, model: ET.Element, where: str) -> None:
+        """The model must be `<static>`."""
+        node = model.find("static")
+        text = "" if node is None else (node.text or "").strip().lower()
+        if text not in ("1", "true"):
+            if text not in ("", "0", "false"):
+                raise self.fail(f"{where}/static", f"must be true, false, 1 or 0, got {text!r}")
+            raise self.fail(where, "is not static: only static models can be imported")
+
+    def state_poses(self, world: ET.Element) -> dict[str, _Pose]:
+        """The model poses the `<state>` block gives, by model name (unscaled models only)."""
+        poses: dict[str, _Pose] = {}
+        for state in world.findall("state"):
+            for model in state.findall("model"):
+                where = f"state/model[@name={model.get('name', '')!r}]"
+                scale = model.find("scale")
+                if scale is not None and self.numbers(scale, f"{where}/scale", 3, "x y z") != [1, 1, 1]:
+                    raise self.fail(f"{where}/scale", "scaled models are not supported")
+                if model.find("pose") is not None:
+                    poses[model.get("name", "")] = self.pose(model, where)
+        return poses
+
+    def geometry(self, collision: ET.Element, where: str, pose: _Pose) -> WorldShape | None:
+        """The shape of one collision (None for a horizontal plane, the ground)."""
+        node = collision.find("geometry")
+        where = f"{where}/geometry"
+        shapes = [] if node is None else list(node)
+        if len(shapes) != 1:
+            raise self.fail(where, f"must hold exactly one shape, got {len(shapes)}")
+        shape = shapes[0]
+        where_shape = f"{where}/{shape.tag}"
+        if shape.tag == "cylinder":
+            (radius,) = self.positive(shape, "radius", where_shape, 1, "metres")
+            return WorldShape("cylinder", pose.x, pose.y, pose.yaw, where_shape, radius=radius)
+        if shape.tag == "box":
+            sx, sy, _ = self.positive(shape, "size", where_shape, 3, "x y z, metres")
+            return WorldShape("box", pose.x, pose.y, pose.yaw, where_shape, size=(sx, sy))
+        if shape.tag == "plane":
+            normal = shape.find("normal")
+            if normal is None or self.numbers(normal, f"{where_shape}/normal", 3, "x y z")[:2] == [0, 0]:
+                return None
+            raise self.fail(f"{where_shape}/normal", "a plane that is not horizontal is not supported")
+        raise self.fail(where_shape, f"<{shape.tag}> is not supported: only <cylinder> and <box>")
+
+    def model(self, model: ET.Element, state_pose: _Pose | None) -> list[WorldShape]:
+        """The shapes of one static model's collisions."""
+        name = model.get("name")
+        if not name:
+            raise self.fail("model", "has no name")
+        where = f"model[@name={name!r}]"
+        self.static(model, where)
+        for tag in ("model", "include"):
+            if model.find(tag) is not None:
+                raise self.fail(f"{where}/{tag}", f"<{tag}> inside a model is not supported")
+        model_pose = state_pose if state_pose is not None else self.pose(model, where)
+        shapes = []
+        for link in model.findall("link"):
+            where_link = f"{where}/link[@name={link.get('name', '')!r}]"
+            link_pose = model_pose.then(self.pose(link, where_link))
+            for collision in link.findall("collision"):
+                where_collision = f"{where_link}/collision[@name={collision.get('name', '')!r}]"
+                pose = link_pose.then(self.pose(collision, where_collision))
+                shape = self.geometry(collision, where_collision, pose)
+                if shape is not None:
+                    shapes.append(shape)
+        return shapes
+
+    def world(self, root: ET.Element) -> list[WorldShape]:
+        """Every shape of the file's one world."""
+        if root.tag != "sdf":
+            raise self.fail(root.tag, "the root element must be <sdf>")
+        worlds = root.findall("world")
+        if len(worlds) != 1:
+            raise self.fail("sdf", f"must hold exactly one <world>, got {len(worlds)}")
+        world = worlds[0]
+        for child in world:
+            if child.tag in _UNSUPPORTED_WORLD_CHILDREN:
+                raise self.fail(child.tag, f"<{child.tag}> is not supported: only <model> elements")
+        poses = self.state_poses(world)
+        shapes = []
+        for model in world.findall("model"):
+            shapes.extend(self.model(model, poses.get(model.get("name", ""))))
+        return shapes
+
+
+def read_world_shapes(path: Path, source: str | None = None) -> list[WorldShape]:
+    """The collision shapes of the static models of a Gazebo world file, in Gazebo's world frame.
+
+    `source` names the file in errors (default: the path)."""
+    reader = _Reader(source or str(path))
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise reader.fail("", f"not well-formed XML: {exc}") from None
+    except OSError as exc:
+        raise reader.fail("", f"cannot read the file: {exc.strerror or exc}") from None
+    return reader.world(root)
