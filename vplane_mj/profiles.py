@@ -27,13 +27,19 @@ Point = tuple[float, float]
 
 @dataclass(frozen=True)
 class DriveLimits:
-    """Top speed (m/s) and turn rate (rad/s), and the accelerations (m/s^2, rad/s^2) the
-    drive may command: the model's motors deliver at least these without wheel spin-out."""
+    """Top speed (m/s) and turn rate (rad/s), and the accelerations (m/s^2, rad/s^2).
+
+    With `ramped`, the drive ramps its speed and turn commands at these accelerations, and
+    the model's motors deliver them with margin, without wheel spin-out. Without (the
+    default robot, whose runs stay exactly as they were), the commands step and these are
+    what the motors deliver from standing.
+    """
 
     max_speed_mps: float
     max_turn_rate_radps: float
     max_accel_mps2: float
     max_turn_accel_radps2: float
+    ramped: bool = True
 
 
 @dataclass(frozen=True)
@@ -97,11 +103,22 @@ DEFAULT = RobotProfile(
     track_scale=1.0,
     wheel_friction=1.0,
     limits=DriveLimits(
-        max_speed_mps=0.5, max_turn_rate_radps=2.5, max_accel_mps2=4.4, max_turn_accel_radps2=21.0
+        max_speed_mps=0.5,
+        max_turn_rate_radps=2.5,
+        max_accel_mps2=4.0,
+        max_turn_accel_radps2=16.5,
+        ramped=False,
     ),
     gains=ControllerGains(),
     sensors=_frozen(
-        {"kind": "sonar", "count": 16, "rays_per_sonar": 3, "beam_deg": 20.0, "range_max": 3.0, "rate_hz": 20.0}
+        {
+            "kind": "sonar",
+            "count": 16,
+            "rays_per_sonar": 3,
+            "beam_deg": 20.0,
+            "range_max": 3.0,
+            "rate_hz": 20.0,
+        }
     ),
     sonar_mounts=None,
     sensor_height_m=0.07,
@@ -109,8 +126,8 @@ DEFAULT = RobotProfile(
         {
             "model": "models/robot.xml",
             "limits": "vplane_mj/control.py ControllerGains (max_speed, max_turn_rate)",
-            "accelerations": "measured: what the 0.3 N m motors deliver from standing "
-            "(tests/test_profiles.py); the controller itself does not ramp",
+            "accelerations": "measured: what the 0.3 N m motors deliver from standing, the commands "
+            "stepped as today (tests/test_profiles.py)",
             "gains": "vplane_mj/control.py ControllerGains",
             "sensors": "vplane_mj/scenario/spec.py SensorSpec",
         }
@@ -142,7 +159,14 @@ JACKAL = RobotProfile(
         motor_rate_hz=100.0,
     ),
     sensors=_frozen(
-        {"kind": "laser", "fov_deg": 270.0, "beams": 720, "range_min": 0.1, "range_max": 30.0, "rate_hz": 50.0}
+        {
+            "kind": "laser",
+            "fov_deg": 270.0,
+            "beams": 720,
+            "range_min": 0.1,
+            "range_max": 30.0,
+            "rate_hz": 50.0,
+        }
     ),
     sonar_mounts=None,
     sensor_height_m=0.199,
@@ -172,7 +196,8 @@ JACKAL = RobotProfile(
             "straight without spin-out, and turn in place at 4 rad/s against the tyres' skid",
             "gains": "chosen: speed_gain = top speed per unit force and turn_gain 3.0, as the default "
             "robot; wheel PI of the default's bandwidth (kp over the side's inertia about 24 /s, "
-            "ki = 10 kp); max_wheel_speed 1.2 x the faster wheel speed of the top speed and the top turn rate, as the default (15 rad/s)",
+            "ki = 10 kp); max_wheel_speed 1.2 x the faster wheel speed of the top speed and the top "
+            "turn rate, as the default's 15 rad/s",
         }
     ),
 )
@@ -237,7 +262,14 @@ PIONEER_3DX = RobotProfile(
         motor_rate_hz=100.0,
     ),
     sensors=_frozen(
-        {"kind": "sonar", "count": 16, "rays_per_sonar": 3, "beam_deg": 30.0, "range_max": 5.0, "rate_hz": 10.0}
+        {
+            "kind": "sonar",
+            "count": 16,
+            "rays_per_sonar": 3,
+            "beam_deg": 30.0,
+            "range_max": 5.0,
+            "rate_hz": 10.0,
+        }
     ),
     sonar_mounts=tuple((x / 1000, y / 1000, float(heading)) for x, y, heading in _PIONEER_SONARS_MM),
     sensor_height_m=0.114,
@@ -253,8 +285,7 @@ PIONEER_3DX = RobotProfile(
             "sonar mounts": "ARIA params/p3dx.p (https://github.com/reedhedges/AriaCoda): SonarUnit "
             "0-15, front array +-90, +-50, +-30, +-10 deg, rear array mirrored",
             "sonar beam and range": "Stage worlds/pioneer.inc p3dx sonar: view 0.1-5.0 m, 30 deg",
-            "sonar rate": "chosen: 10 Hz for the whole ring (the firing cycle is not in the sources "
-            "checked)",
+            "sonar rate": "chosen: 10 Hz for the whole ring (the firing cycle is not in the sources checked)",
             "caster": "p2os_urdf/defs/pioneer3dx_body.xacro (https://github.com/allenh1/p2os): swivel "
             "wheel r = 0.0375 m at x = -0.211 m; wheel mass 0.5 kg",
             "inertia": "chosen: 8 kg body as a uniform 0.44 x 0.38 x 0.18 m box centred 0.045 m behind "
@@ -262,7 +293,8 @@ PIONEER_3DX = RobotProfile(
             "accelerations": "chosen: top speed and top turn rate in 1 s; the 0.85 N m motors deliver "
             "1.7 m/s^2 without spin-out",
             "gains": "chosen as the Jackal's: speed_gain = top speed, turn_gain 3.0, wheel PI of the "
-            "default's bandwidth, max_wheel_speed 1.2 x the faster wheel speed of the top speed and the top turn rate",
+            "default's bandwidth, max_wheel_speed 1.2 x the faster wheel speed of the top speed and "
+            "the top turn rate",
         }
     ),
 )
@@ -288,7 +320,7 @@ TURTLEBOT3_BURGER = RobotProfile(
     track_scale=1.0,
     wheel_friction=1.0,
     limits=DriveLimits(
-        max_speed_mps=0.22, max_turn_rate_radps=2.84, max_accel_mps2=2.5, max_turn_accel_radps2=3.2
+        max_speed_mps=0.22, max_turn_rate_radps=2.84, max_accel_mps2=2.0, max_turn_accel_radps2=3.2
     ),
     gains=ControllerGains(
         speed_gain=0.22,
@@ -319,13 +351,16 @@ TURTLEBOT3_BURGER = RobotProfile(
             "floor, 0.149 m above the axle; the real scanner sits 0.032 m behind it",
             "navigation footprint": "turtlebot3_navigation/param/costmap_common_params_burger.yaml: "
             "[[-0.105, -0.105], [-0.105, 0.105], [0.041, 0.105], [0.041, -0.105]]",
-            "accelerations": "turtlebot3_navigation/param/dwa_local_planner_params_burger.yaml: "
-            "acc_lim_x 2.5 m/s^2, acc_lim_theta 3.2 rad/s^2; the 0.05 N m motors deliver about "
-            "3 m/s^2 without spin-out",
+            "turn acceleration": "turtlebot3_navigation/param/dwa_local_planner_params_burger.yaml: "
+            "acc_lim_theta 3.2 rad/s^2",
+            "acceleration": "chosen: 2.0 m/s^2, what the 0.05 N m motors deliver on rolling tyres; "
+            "the navigation stack's acc_lim_x of 2.5 m/s^2 (same file) spins the model's tyres, which "
+            "carry 60 % of the weight (the rear caster the rest)",
             "centre of mass": "chosen: the centre of the plate stack (the description puts it at "
             "base_link on the floor)",
             "gains": "chosen as the Jackal's: speed_gain = top speed, turn_gain 3.0, wheel PI of the "
-            "default's bandwidth, max_wheel_speed 1.2 x the faster wheel speed of the top speed and the top turn rate",
+            "default's bandwidth, max_wheel_speed 1.2 x the faster wheel speed of the top speed and "
+            "the top turn rate",
         }
     ),
 )
