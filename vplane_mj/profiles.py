@@ -85,8 +85,8 @@ def _frozen(mapping: dict) -> Mapping:
 
 
 def _mirrored(front_to_rear_left: list[Point]) -> tuple[Point, ...]:
-    """A polygon symmetric about the x axis, CCW, from its left half listed front to rear
-    (its first and last points on the axis or not)."""
+    """A polygon symmetric about the x axis, CCW, from its left half listed front to rear;
+    points on the axis are not repeated."""
     right = [(x, -y) for x, y in reversed(front_to_rear_left) if y != 0.0]
     return tuple(front_to_rear_left) + tuple(right)
 
