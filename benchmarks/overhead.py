@@ -38,7 +38,6 @@ import numpy as np
 from vplane_mj.log_mcap import McapLog
 from vplane_mj.planning import Decision, Observation, Planner, PlannerParams
 from vplane_mj.planning.registry import register_planner
-from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim import run_scenario
 from vplane_mj.world import SonarLayout, build_model
@@ -79,7 +78,7 @@ def logged_run(scenario, log_dir: Path) -> tuple[float, int]:
     path = log_dir / f"{scenario.name}-{scenario.planner}.mcap"
     bearings = SonarLayout.from_spec(scenario.sensors).bearings
     start = time.process_time()
-    log = McapLog(path, scenario, robot_radius_m(), bearings, scenario.sensors.range_max, {})
+    log = McapLog(path, scenario, bearings, {})
     result = run_scenario(scenario, observers=(log,))
     log.close(result.summary.to_dict())
     return time.process_time() - start, path.stat().st_size

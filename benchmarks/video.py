@@ -20,7 +20,6 @@ from pathlib import Path
 
 from vplane_mj.log_mcap import McapLog
 from vplane_mj.log_read import read_log
-from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim import run_scenario
 from vplane_mj.video import FORMATS, frame_count, write_video
@@ -34,7 +33,7 @@ def logged_run(scenario, path: Path) -> float:
     """Wall seconds of one run writing its MCAP log to `path`."""
     started = time.perf_counter()
     bearings = SonarLayout.from_spec(scenario.sensors).bearings
-    log = McapLog(path, scenario, robot_radius_m(), bearings, scenario.sensors.range_max, {})
+    log = McapLog(path, scenario, bearings, {})
     result = run_scenario(scenario, observers=(log,))
     log.close(result.summary.to_dict())
     return time.perf_counter() - started

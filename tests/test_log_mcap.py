@@ -69,7 +69,7 @@ class Recorder:
 
 def make_log(path: Path, scenario, metadata=None) -> McapLog:
     bearings = SonarLayout.from_spec(scenario.sensors).bearings
-    return McapLog(path, scenario, robot_radius_m(), bearings, scenario.sensors.range_max, metadata or {})
+    return McapLog(path, scenario, bearings, metadata or {})
 
 
 @pytest.fixture(scope="module")
@@ -395,7 +395,7 @@ _CHILD = textwrap.dedent(
 
     scenario = load_scenario("paper_c_escape", ["run.time_limit_s=300"])
     bearings = SonarLayout.from_spec(scenario.sensors).bearings
-    log = McapLog(Path(sys.argv[1]), scenario, robot_radius_m(), bearings, 3.0, {})
+    log = McapLog(Path(sys.argv[1]), scenario, bearings, {})
     run_scenario(scenario, observers=(log, Slow()))
     log.close()
     """

@@ -7,9 +7,12 @@ import numpy as np
 import pytest
 
 from vplane_mj.resources import data_dir
-from vplane_mj.robot import robot_geometry
+from vplane_mj.robot import SONAR_MOUNT_RADIUS_M, robot_geometry
 from vplane_mj.sonar import SonarRays, SonarRing
 from vplane_mj.world import BUMP_SENSOR, ROBOT_PREFIX, SonarLayout, build_model, standalone_xml
+
+RING_16 = np.full(16, SONAR_MOUNT_RADIUS_M)
+"""Each sonar of the default ring reaches this far along its bearing (m)."""
 
 SHIPPED = sorted(p.stem for p in data_dir("scenarios").glob("*.toml"))
 
@@ -106,7 +109,13 @@ def test_the_sonar_casts_exactly_what_the_rangefinders_read(scenario_from):
     sonar = SonarRays(build_model(scenario), reference.sensor(ROBOT_PREFIX + "sonar0_ray0").id, rays, data)
     faults = {"noise_std": 0.03, "dropout": 0.1, "crosstalk": 0.05, "dead": (3,)}
     rings = [
-        SonarRing(sensors.count, sensors.rays_per_sonar, 2.5, np.random.default_rng(5), **faults)
+        SonarRing(
+            SonarLayout.from_spec(sensors).reach,
+            sensors.rays_per_sonar,
+            2.5,
+            np.random.default_rng(5),
+            **faults,
+        )
         for _ in "ab"
     ]
     rng = np.random.default_rng(0)
@@ -147,7 +156,7 @@ def test_sonar_ring_measures_a_wall_from_the_robot_centre(scenario_from):
     mujoco.mj_forward(model, data)
     first = model.sensor_adr[model.sensor(ROBOT_PREFIX + "sonar0_ray0").id]
     rays = data.sensordata[first : first + 48]
-    ring = SonarRing(16, 3, 3.0, np.random.default_rng(0))
+    ring = SonarRing(RING_16, 3, 3.0, np.random.default_rng(0))
     ranges = ring.read(rays)
     # The wall's near face is at x = 2.95, 1.45 m ahead of the centre.
     assert ranges[0] == pytest.approx(1.45, abs=0.01)
@@ -158,7 +167,7 @@ def test_sonar_ring_measures_a_wall_from_the_robot_centre(scenario_from):
 
 
 def test_sonar_reports_no_echo_as_nan_never_as_a_distance():
-    ring = SonarRing(2, 3, 3.0, np.random.default_rng(0))
+    ring = SonarRing(RING_16[:2], 3, 3.0, np.random.default_rng(0))
     ranges = ring.read(np.array([-1.0, 3.0, 3.0, 2.0, -1.0, 1.5]))
     assert math.isnan(ranges[0])
     assert ranges[1] == pytest.approx(1.5 + 0.10)  # shortest ray wins, measured from the centre
@@ -166,15 +175,15 @@ def test_sonar_reports_no_echo_as_nan_never_as_a_distance():
 
 def test_sonar_noise_and_dropout_follow_the_seed():
     rays = np.full(48, 1.0)
-    a = SonarRing(16, 3, 3.0, np.random.default_rng(7), noise_std=0.05, dropout=0.3).read(rays)
-    b = SonarRing(16, 3, 3.0, np.random.default_rng(7), noise_std=0.05, dropout=0.3).read(rays)
+    a = SonarRing(RING_16, 3, 3.0, np.random.default_rng(7), noise_std=0.05, dropout=0.3).read(rays)
+    b = SonarRing(RING_16, 3, 3.0, np.random.default_rng(7), noise_std=0.05, dropout=0.3).read(rays)
     np.testing.assert_array_equal(a, b)
     assert np.isnan(a).any() and np.nanstd(a) > 0
 
 
 def test_sonar_crosstalk_gives_short_echoes_and_dead_sonars_stay_silent():
     rays = np.tile([2.0, 2.0, 2.0, -1.0, -1.0, -1.0], 8)  # even sonars see a wall at 2 m, odd ones nothing
-    ring = SonarRing(16, 3, 3.0, np.random.default_rng(3), crosstalk=0.3, dead=(0, 5))
+    ring = SonarRing(RING_16, 3, 3.0, np.random.default_rng(3), crosstalk=0.3, dead=(0, 5))
     scans = np.array([ring.read(rays) for _ in range(400)])
     assert np.isnan(scans[:, [0, 5]]).all()
     live = np.delete(scans, [0, 5], axis=1)

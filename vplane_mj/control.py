@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from vplane_mj.planning.body import DriveLimits
 from vplane_mj.planning.vectors import wrap_angle
 
 
@@ -55,6 +56,24 @@ def wheel_targets(
     if excess > 1.0:
         left, right = left / excess, right / excess
     return left, right
+
+
+class CommandRamp:
+    """The (speed, turn rate) command driven, moved toward the one asked for at most by the
+    drive's accelerations (m/s^2, rad/s^2) per motor period; braking as fast as accelerating."""
+
+    def __init__(self, limits: DriveLimits):
+        self.limits = limits
+        self.speed = 0.0
+        self.turn = 0.0
+
+    def toward(self, command: tuple[float, float], dt: float) -> tuple[float, float]:
+        """The command to drive for the next `dt` seconds on the way to `command`."""
+        dv = self.limits.max_accel_mps2 * dt
+        dw = self.limits.max_turn_accel_radps2 * dt
+        self.speed = min(self.speed + dv, max(self.speed - dv, command[0]))
+        self.turn = min(self.turn + dw, max(self.turn - dw, command[1]))
+        return self.speed, self.turn
 
 
 class WheelPI:

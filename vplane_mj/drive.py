@@ -8,8 +8,9 @@ import math
 import mujoco
 import numpy as np
 
-from vplane_mj.control import ControllerGains, WheelPI, wheel_targets
+from vplane_mj.control import CommandRamp, WheelPI, wheel_targets
 from vplane_mj.odometry import WheelOdometry
+from vplane_mj.profiles import PROFILES
 from vplane_mj.robot import BASE_BODY, WHEEL_JOINTS, WHEEL_MOTORS, robot_geometry
 from vplane_mj.scenario import Scenario
 from vplane_mj.world import BUMP_SENSOR, OBSTACLES_BODY, ROBOT_PREFIX
@@ -34,13 +35,21 @@ class Drive:
     """The robot in MuJoCo: its pose, and its wheels driven by PI loops at the motor rate.
 
     One control tick is `chunks_per_tick` motor periods of `motor_steps` physics steps;
-    every wheel torque applied is recorded (for replay by the overhead benchmark).
+    every wheel torque applied is recorded (for replay by the overhead benchmark). The gains,
+    limits and wheel geometry are the robot profile's; the wheel targets use its track times
+    its `track_scale` (a skid-steer robot turns slower than its wheels' track predicts), and
+    a profile with `ramped` commands has them ramped at its accelerations every motor period.
     """
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, control_hz: float):
+    def __init__(
+        self, model: mujoco.MjModel, data: mujoco.MjData, control_hz: float, profile: str = "default"
+    ):
         self.model, self.data = model, data
-        self.gains = ControllerGains()
-        self.geometry = robot_geometry()
+        robot = PROFILES[profile]
+        self.gains = robot.gains
+        self.geometry = robot_geometry(profile)
+        self.track_m = self.geometry["track_m"] * robot.track_scale
+        self.ramp = CommandRamp(robot.limits) if robot.ramped else None
         dt = model.opt.timestep
         self.motor_steps = max(1, round(1.0 / (self.gains.motor_rate_hz * dt)))
         self.motor_dt = self.motor_steps * dt
@@ -80,29 +89,34 @@ class Drive:
         return float(self.data.qpos[self.wheel_qpos[0]]), float(self.data.qpos[self.wheel_qpos[1]])
 
     def run_tick(self, command: tuple[float, float], after_step) -> np.ndarray:
-        """Drive one control tick; return base_link's xy after every motor period (chunks, 2)."""
-        target_left, target_right = wheel_targets(
-            *command,
-            self.geometry["track_m"],
-            self.geometry["wheel_radius_m"],
-            self.gains.max_wheel_speed,
-        )
+        """Drive one control tick; return base_link's x, y (m) and yaw (rad) after every motor
+        period (chunks, 3)."""
+        target_left, target_right = self._wheel_targets(command)
         (left_pi, right_pi), (left_dof, right_dof) = self.wheels, self.wheel_dofs
         left_motor, right_motor = self.motors
         model, data, steps, dt = self.model, self.data, self.motor_steps, self.motor_dt
-        qvel, ctrl, xpos, torques = data.qvel, data.ctrl, self.xpos, self.torques
-        trace = np.empty((self.chunks_per_tick, 2))
+        qvel, ctrl, xpos, xmat, torques = data.qvel, data.ctrl, self.xpos, self.xmat, self.torques
+        trace = np.empty((self.chunks_per_tick, 3))
         for chunk in range(self.chunks_per_tick):
+            if self.ramp is not None:
+                target_left, target_right = self._wheel_targets(self.ramp.toward(command, dt))
             left = left_pi.torque(target_left, float(qvel[left_dof]), dt)
             right = right_pi.torque(target_right, float(qvel[right_dof]), dt)
             ctrl[left_motor] = left
             ctrl[right_motor] = right
             torques.append((left, right))
             mujoco.mj_step(model, data, steps)
-            trace[chunk] = xpos[:2]
+            trace[chunk, :2] = xpos[:2]
+            trace[chunk, 2] = math.atan2(xmat[3], xmat[0])
             after_step()
         self.steps += self.motor_steps * self.chunks_per_tick
         return trace
+
+    def _wheel_targets(self, command: tuple[float, float]) -> tuple[float, float]:
+        """Left and right wheel speeds (rad/s) for a body speed (m/s) and turn rate (rad/s)."""
+        return wheel_targets(
+            *command, self.track_m, self.geometry["wheel_radius_m"], self.gains.max_wheel_speed
+        )
 
     def fatal_warning(self) -> str | None:
         """Why the simulation cannot go on (a fatal MuJoCo warning, a non-finite state), or None."""

@@ -204,6 +204,15 @@ def _cast_fan(
                 ranges[k] = t
 
 
+def laser_bearings(fov_deg: float, beams: int) -> tuple[np.ndarray, float]:
+    """The bearings (rad, robot frame) of `beams` beams evenly spaced over `fov_deg` (degrees)
+    about the heading, and the step (rad) between two: the ends at +-fov/2 below 360 degrees;
+    all round without a repeated beam at 360 degrees."""
+    fov = math.radians(fov_deg)
+    step = fov / beams if fov_deg == 360.0 else fov / (beams - 1)
+    return (np.arange(beams) - (beams - 1) / 2) * step, step
+
+
 class LaserScanner:
     """A laser rangefinder on the robot's vertical axis: `beams` beams evenly spaced over `fov_deg`
     (degrees, (0, 360]), centred on the heading; returns between `range_min` and `range_max` (m).
@@ -257,11 +266,14 @@ class LaserScanner:
         self.rng = rng
         self.noise_std = noise_std
         self.dropout = dropout
-        fov = math.radians(fov_deg)
-        self.angle_step = fov / self.beams if fov_deg == 360.0 else fov / (self.beams - 1)
-        """Angle (rad) between neighbouring beams."""
-        self.bearings = (np.arange(self.beams) - (self.beams - 1) / 2) * self.angle_step
-        """Each beam's bearing (rad) in the robot's frame, counter-clockwise from the heading."""
+        self.bearings, self.angle_step = laser_bearings(fov_deg, self.beams)
+        """Each beam's bearing (rad) in the robot's frame, counter-clockwise from the heading, and
+        the angle (rad) between neighbouring beams."""
+
+    @property
+    def beam_width(self) -> float:
+        """The angle (rad) each beam stands for: the step between two beams."""
+        return self.angle_step
 
     def read(self, x: float, y: float, yaw: float) -> np.ndarray:
         """Ranges (beams,) in m from the robot's centre at (x, y) (m) heading `yaw` (rad); NaN

@@ -11,7 +11,7 @@ messages' own `timestamp` fields, is the integer nanosecond of *simulated* time,
 |---|---|---|
 | `/robot/pose` | `foxglove.PoseInFrame` | every control tick, frame `world`, z = 0 |
 | `/tf` | `foxglove.FrameTransforms` | every tick, `world` -> `base_link` and `base_link_xy` |
-| `/scan` | `foxglove.LaserScan` | every tick, frame `base_link`, NaN where no echo |
+| `/scan` | `foxglove.LaserScan` | every tick, frame `base_link`, NaN where no echo (see below) |
 | `/world` | `foxglove.SceneUpdate` | once at time 0: arena, obstacles, border, start, goal, robot |
 | `/forces` | `foxglove.SceneUpdate` | every tick: force arrows at the robot |
 | `/virtual` | `foxglove.SceneUpdate` | at time 0 (empty), then when the objective or planes change |
@@ -29,8 +29,14 @@ by every message, so that the latest message before any time, all a viewer keeps
 scene topic after a seek, shows the whole path up to then; simplified to within
 `PATH_TOLERANCE_M` of every logged pose, which keeps it a few hundred points long);
 `/world` `arena`, `border`, `obstacle_<i>`, `start`, `goal` (frame `world`) and `robot`
-(a disc of `robot_radius_m` with a heading arrow in frame `base_link`, frame-locked, so
-it moves with `/tf`). Entities that vanish are removed with `SceneUpdate.deletions`.
+(a round robot as a disc of `robot_radius_m`, another as its footprint polygon, with a
+heading arrow, in frame `base_link`, frame-locked, so it moves with `/tf`). Entities that
+vanish are removed with `SceneUpdate.deletions`.
+
+`/scan` holds the sensor's ranges from the robot's centre at the sensor's height: a laser's
+beams or a sonar ring as they are; sonars at uneven bearings (the pioneer3dx) on a scan of
+one-degree steps, each reading at its bearing's degree (the nearer of two that share one),
+NaN elsewhere.
 
 `/metrics` and `/run/events` use only plain JSON schema types (`number`, `string`, arrays
 of numbers), as viewers require: a value that is missing (`force_virtual` without a
@@ -78,7 +84,8 @@ from vplane_mj.log_scene import (
 )
 from vplane_mj.planning.events import EVENT_POINTS, Event, EventKind
 from vplane_mj.polyline import PathSimplifier
-from vplane_mj.robot import SONAR_MOUNT_HEIGHT_M
+from vplane_mj.profiles import PROFILES
+from vplane_mj.robot import robot_body
 from vplane_mj.scenario import Scenario
 from vplane_mj.sim import Tick
 
@@ -133,29 +140,27 @@ WARNING_EVENTS = {EventKind.COLLISION, EventKind.GAVE_UP, EventKind.ERROR, Event
 class McapLog:
     """Observer writing one run to an MCAP file; see the module docstring for the topics.
 
-    `sonar_bearings` (rad, robot frame, evenly spaced from 0) and `range_max` (m)
-    describe the sonar ring for `/scan`; `robot_radius_m` sizes the start marker.
-    The file is created (an existing file is replaced unless `allow_overwrite` is
-    False). Call `close` at the end; it is idempotent, and ticks or events after it
-    are ignored.
+    `bearings` (rad, robot frame) are the sensor's; the robot's body and the sensor's
+    range and height are the scenario's profile's. The file is created (an existing file is
+    replaced unless `allow_overwrite` is False). Call `close` at the end; it is idempotent,
+    and ticks or events after it are ignored.
     """
 
     def __init__(
         self,
         path: Path,
         scenario: Scenario,
-        robot_radius_m: float,
-        sonar_bearings: np.ndarray,
-        range_max: float,
+        bearings: np.ndarray,
         metadata: dict[str, str],
         *,
         allow_overwrite: bool = True,
     ):
         self.path = Path(path)
         self.scenario = scenario
-        self.robot_radius_m = float(robot_radius_m)
-        self.bearings = np.asarray(sonar_bearings, dtype=float)
-        self.range_max = float(range_max)
+        self.body = robot_body(scenario.robot.profile, scenario.sensors.kind)
+        self.robot_radius_m = self.body.radius_m
+        self.bearings = np.asarray(bearings, dtype=float)
+        self.range_max = scenario.sensors.range_max
         self._goal = (float(scenario.robot.goal[0]), float(scenario.robot.goal[1]))
         self._closed = False
 
@@ -180,9 +185,7 @@ class McapLog:
             self._odometry_ch = fc.PoseInFrameChannel("/robot/odometry", context=ctx)
 
         self._writer.write_metadata(METADATA_NAME, self._run_metadata(metadata))
-        self._world_ch.log(
-            fm.SceneUpdate(entities=scene.world_entities(scenario, self.robot_radius_m)), log_time=0
-        )
+        self._world_ch.log(fm.SceneUpdate(entities=scene.world_entities(scenario, self.body)), log_time=0)
         # An empty /virtual update at time 0 keeps the topic in every file, even without escapes.
         self._virtual_ch.log(fm.SceneUpdate(), log_time=0)
 
@@ -193,10 +196,8 @@ class McapLog:
         self._virtual_state: tuple[tuple[float, ...] | None, tuple[tuple[float, ...], ...]] = (None, ())
         self._shown_planes = 0
         self._path = PathSimplifier(PATH_TOLERANCE_M)
-        self._scan_pose = scene.pose(0.0, 0.0, SONAR_MOUNT_HEIGHT_M)
-        # Foxglove spaces the n readings by (end - start) / (n - 1).
-        n = len(self.bearings)
-        self._scan_angles = (float(self.bearings[0]), float(self.bearings[-1])) if n else (0.0, 0.0)
+        self._scan_pose = scene.pose(0.0, 0.0, PROFILES[scenario.robot.profile].sensor_height_m)
+        self._scan_slots, self._scan_angles = scan_slots(self.bearings)
         self._path_dirty = False
         self._next_flush_s = 0.0  # the first tick flushes, so /path starts with the run
 
@@ -213,6 +214,9 @@ class McapLog:
             "planner_params": json.dumps(dict(s.planner_params), sort_keys=True),
             "time_base": "simulated time, integer nanoseconds from the start of the run",
             "robot_radius_m": repr(self.robot_radius_m),
+            "robot_profile": s.robot.profile,
+            "footprint_m": json.dumps(self.body.footprint.tolist()),
+            "sensor_kind": s.sensors.kind,
             "sonar_count": str(len(self.bearings)),
             "sonar_range_max_m": repr(self.range_max),
             "arrow_m_per_unit_force": repr(ARROW_M_PER_UNIT),
@@ -312,6 +316,8 @@ class McapLog:
         self._odometry_ch.log(message, log_time=ns)
 
     def _log_scan(self, ns: int, stamp: fm.Timestamp, ranges: np.ndarray) -> None:
+        if self._scan_slots is not None:
+            ranges = on_slots(ranges, self._scan_slots)
         scan = fm.LaserScan(
             timestamp=stamp,
             frame_id=ROBOT_FRAME,
@@ -398,6 +404,32 @@ class McapLog:
         entity = scene.path_entity(scene.stamp(ns), self._path.polyline())
         self._path_ch.log(fm.SceneUpdate(entities=[entity]), log_time=ns)
         self._path_dirty = False
+
+
+SCAN_SLOT_RAD = math.radians(1.0)
+"""The step of the scan that shows sonars at uneven bearings."""
+
+
+def scan_slots(bearings: np.ndarray) -> tuple[np.ndarray | None, tuple[float, float]]:
+    """How `/scan` shows readings at these bearings (rad): evenly spaced ones as they are (None),
+    others on one-degree slots from -180 degrees (each reading's slot); and the scan's first and
+    last angles (rad). Foxglove spaces n readings by (end - start) / (n - 1)."""
+    n = len(bearings)
+    if n < 2:
+        return None, (float(bearings[0]) if n else 0.0,) * 2
+    steps = np.diff(bearings)
+    if np.allclose(steps, steps[0], rtol=0.0, atol=1e-9):
+        return None, (float(bearings[0]), float(bearings[-1]))
+    slots = np.rint((np.mod(bearings + math.pi, 2 * math.pi)) / SCAN_SLOT_RAD).astype(int) % 360
+    return slots, (-math.pi, math.pi - SCAN_SLOT_RAD)
+
+
+def on_slots(ranges: np.ndarray, slots: np.ndarray) -> np.ndarray:
+    """The readings on a scan of one-degree slots: NaN where no reading falls, the nearest
+    where two do."""
+    scan = np.full(360, np.inf)
+    np.minimum.at(scan, slots, np.where(np.isnan(ranges), np.inf, ranges))
+    return scan
 
 
 def time_ns(time_s: float) -> int:

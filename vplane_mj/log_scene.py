@@ -11,9 +11,11 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from foxglove import messages as fm
 
 from vplane_mj import shapes
+from vplane_mj.planning.body import RobotBody
 from vplane_mj.scenario import Scenario
 from vplane_mj.world import OBSTACLE_HEIGHT_M
 
@@ -54,6 +56,7 @@ _COLOURS = {
     "path": (0.10, 0.35, 0.95, 1.0),
     "robot": (0.20, 0.24, 0.32, 0.9),
     "heading": (1.00, 1.00, 1.00, 1.0),
+    "outline": (1.00, 0.55, 0.10, 1.0),
 }
 
 
@@ -84,8 +87,9 @@ def _colour(rgba: tuple[float, float, float, float]) -> fm.Color:
     return fm.Color(r=rgba[0], g=rgba[1], b=rgba[2], a=rgba[3])
 
 
-def world_entities(scenario: Scenario, robot_radius_m: float) -> list[fm.SceneEntity]:
+def world_entities(scenario: Scenario, body: RobotBody) -> list[fm.SceneEntity]:
     """The static scene at time 0: arena, obstacles, border, start, goal and the robot's body."""
+    robot_radius_m = body.radius_m
     when = stamp(0)
     world = scenario.world
     w, h = world.size
@@ -137,18 +141,17 @@ def world_entities(scenario: Scenario, robot_radius_m: float) -> list[fm.SceneEn
             cylinders=[_flat_disc(robot.goal, robot.goal_tolerance, _COLOURS["goal"])],
         )
     )
-    entities.append(_robot_body(when, robot_radius_m))
+    entities.append(_robot_body(when, body))
     return entities
 
 
-def _robot_body(when: fm.Timestamp, radius: float) -> fm.SceneEntity:
-    """The robot as a disc of its radius with a heading arrow, locked to base_link."""
-    return fm.SceneEntity(
-        timestamp=when,
-        frame_id=ROBOT_FRAME,
-        id="robot",
-        frame_locked=True,
-        cylinders=[
+def _robot_body(when: fm.Timestamp, body: RobotBody) -> fm.SceneEntity:
+    """The robot locked to base_link: a round robot as a disc of its radius, another as its
+    footprint polygon (filled, and outlined at the floor); with a heading arrow."""
+    radius = body.radius_m
+    cylinders, triangles, lines = [], [], []
+    if body.disc:
+        cylinders.append(
             fm.CylinderPrimitive(
                 pose=pose(0.0, 0.0, ROBOT_BODY_HEIGHT_M / 2),
                 size=fm.Vector3(x=2 * radius, y=2 * radius, z=ROBOT_BODY_HEIGHT_M),
@@ -156,17 +159,47 @@ def _robot_body(when: fm.Timestamp, radius: float) -> fm.SceneEntity:
                 top_scale=1.0,
                 color=_colour(_COLOURS["robot"]),
             )
-        ],
+        )
+    else:
+        triangles.append(_polygon_fill(body.footprint, ROBOT_BODY_HEIGHT_M, _COLOURS["robot"]))
+        lines.append(_polygon_outline(body.footprint, 0.01, _COLOURS["outline"]))
+    return fm.SceneEntity(
+        timestamp=when,
+        frame_id=ROBOT_FRAME,
+        id="robot",
+        frame_locked=True,
+        cylinders=cylinders,
+        triangles=triangles,
+        lines=lines,
         arrows=[
             fm.ArrowPrimitive(
                 pose=pose(0.0, 0.0, ROBOT_BODY_HEIGHT_M + 0.01),
-                shaft_length=0.7 * radius,
+                shaft_length=0.7 * body.front_m,
                 shaft_diameter=0.03,
-                head_length=0.3 * radius + 0.03,
+                head_length=0.3 * body.front_m + 0.03,
                 head_diameter=0.08,
                 color=_colour(_COLOURS["heading"]),
             )
         ],
+    )
+
+
+def _polygon_fill(polygon: np.ndarray, z: float, rgba) -> fm.TriangleListPrimitive:
+    """A convex polygon (k, 2) as a fan of triangles at height z (m)."""
+    corners = [fm.Point3(x=float(x), y=float(y), z=z) for x, y in polygon]
+    points = [p for i in range(1, len(corners) - 1) for p in (corners[0], corners[i], corners[i + 1])]
+    return fm.TriangleListPrimitive(pose=pose(0.0, 0.0), points=points, color=_colour(rgba))
+
+
+def _polygon_outline(polygon: np.ndarray, z: float, rgba) -> fm.LinePrimitive:
+    """A polygon (k, 2) as a closed line at height z (m)."""
+    return fm.LinePrimitive(
+        type=fm.LinePrimitiveLineType.LineLoop,
+        pose=pose(0.0, 0.0),
+        thickness=0.02,
+        scale_invariant=False,
+        points=[fm.Point3(x=float(x), y=float(y), z=z) for x, y in polygon],
+        color=_colour(rgba),
     )
 
 

@@ -21,10 +21,13 @@ TURN_NOISE_RAD = 1e-3
 
 
 class Clearance:
-    """Smallest and mean distance from base_link's centre to any obstacle or border (m), batched."""
+    """Smallest and mean distance (m) to any obstacle or border, batched over poses (x, y in m,
+    yaw in rad): from base_link's centre, or with `outline` (the robot's footprint polygon in
+    base_link, m) from the outline (negative: it overlaps)."""
 
-    def __init__(self, footprints: shapes.Footprints):
+    def __init__(self, footprints: shapes.Footprints, outline: np.ndarray | None = None):
         self._footprints = footprints
+        self._outline = outline
         self._pending: list[np.ndarray] = []
         self._pending_count = 0
         self.minimum = math.inf
@@ -35,15 +38,20 @@ class Clearance:
     def mean(self) -> float:
         return self._total / self._count if self._count else math.inf
 
-    def add(self, positions: np.ndarray) -> None:
-        self._pending.append(positions)
-        self._pending_count += len(positions)
+    def add(self, poses: np.ndarray) -> None:
+        """Poses (N, 3) of the robot, or positions (N, 2) of a robot measured from its centre."""
+        self._pending.append(poses)
+        self._pending_count += len(poses)
         if self._pending_count >= CLEARANCE_BATCH:
             self.flush()
 
     def flush(self) -> None:
         if self._pending and len(self._footprints):
-            distances = self._footprints.distance(np.vstack(self._pending))
+            poses = np.vstack(self._pending)
+            if self._outline is None:
+                distances = self._footprints.distance(poses[:, :2])
+            else:
+                distances = self._footprints.outline_distance(self._outline, poses)
             self.minimum = min(self.minimum, float(distances.min()))
             self._total += float(distances.sum())
             self._count += len(distances)

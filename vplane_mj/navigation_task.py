@@ -23,9 +23,9 @@ from vplane_mj.control import ControllerGains
 from vplane_mj.errors import VPlaneError
 from vplane_mj.families import FAMILIES, Case, generate
 from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.robot import SONAR_MOUNT_RADIUS_M
 from vplane_mj.scenario import MAX_ARENA_M, Scenario, load_scenario, parse_scenario
 from vplane_mj.sim import Run
-from vplane_mj.sonar import SONAR_MOUNT_RADIUS_M
 from vplane_mj.summary import Outcome
 
 ACTIONS = ("force", "velocity")

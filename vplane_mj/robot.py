@@ -1,8 +1,10 @@
-"""Facts about the robot model in models/robot.xml that the rest of the code relies on.
+"""Facts about each robot profile's MJCF model that the rest of the code relies on, and the
+robot as its planner sees it.
 
-They are read from the XML itself (`vplane_mj.mjcf_reader`), not from a compiled model, so
-validating a scenario or listing the planners never loads MuJoCo; tests/test_robot.py
-checks them against the model MuJoCo compiles from the same file.
+The facts are read from the XML itself (`vplane_mj.mjcf_reader`), not from a compiled model,
+so validating a scenario or listing the planners never loads MuJoCo; tests/test_robot.py
+checks them against the model MuJoCo compiles from the same file. Every model follows the
+conventions below (base_link, the driven wheels' joints and motors).
 """
 
 from __future__ import annotations
@@ -16,6 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from vplane_mj.mjcf_reader import MjcfReader, PosedGeom
+from vplane_mj.planning.body import HeadingGains, RobotBody
+from vplane_mj.profiles import PROFILES
 from vplane_mj.resources import model_path
 
 BASE_BODY = "base_link"
@@ -86,16 +90,33 @@ def footprint_radius(geoms: list[PosedGeom], origin: np.ndarray) -> float:
 
 
 @functools.cache
-def robot_facts() -> RobotFacts:
-    """The facts of the shipped robot, models/robot.xml."""
-    return read_robot_facts(model_path("robot.xml"))
+def robot_facts(profile: str = "default") -> RobotFacts:
+    """The facts of a profile's model (models/robot.xml for the default robot)."""
+    return read_robot_facts(model_path(PROFILES[profile].model_file))
 
 
-def robot_geometry() -> dict[str, float]:
-    """The shipped robot's facts by name: wheel_radius_m, track_m, torque_limit_nm, radius_m."""
-    return dataclasses.asdict(robot_facts())
+def robot_geometry(profile: str = "default") -> dict[str, float]:
+    """A profile's facts by name: wheel_radius_m, track_m, torque_limit_nm, radius_m."""
+    return dataclasses.asdict(robot_facts(profile))
 
 
-def robot_radius_m() -> float:
-    """Radius (m) of a disc around base_link's centre that contains every robot geom."""
-    return robot_facts().radius_m
+def robot_radius_m(profile: str = "default") -> float:
+    """Radius (m) of a disc around base_link's centre that contains every geom of the profile's robot."""
+    return robot_facts(profile).radius_m
+
+
+@functools.cache
+def robot_body(profile: str = "default", sensor_kind: str | None = None) -> RobotBody:
+    """The robot as its planner sees it (`vplane_mj.planning.RobotBody`): the profile's outline
+    (the model's disc for a round robot), limits, heading gains and sensor kind (default: the
+    profile's own)."""
+    chosen = PROFILES[profile]
+    details = {
+        "limits": chosen.limits,
+        "gains": HeadingGains(chosen.gains.speed_gain, chosen.gains.turn_gain),
+        "sensor_kind": sensor_kind or str(chosen.sensors["kind"]),
+        "profile": profile,
+    }
+    if chosen.footprint_m is None:
+        return RobotBody.round(robot_radius_m(profile), **details)
+    return RobotBody.polygon(chosen.footprint_m, **details)

@@ -159,12 +159,10 @@ def _open_log(scenario: Scenario, target: Path) -> McapLog:
     about the last simulated second) is readable with `vplane_mj.log_read.read_log`.
     """
     from vplane_mj.log_mcap import McapLog
-    from vplane_mj.robot import robot_radius_m
-    from vplane_mj.world import SonarLayout
+    from vplane_mj.sensors import scan_bearings
 
-    bearings = SonarLayout.from_spec(scenario.sensors).bearings
     partial = target.with_name(f".{target.name}.partial")
-    return McapLog(partial, scenario, robot_radius_m(), bearings, scenario.sensors.range_max, {})
+    return McapLog(partial, scenario, scan_bearings(scenario), {})
 
 
 def _finish_log(log: McapLog, target: Path, summary: dict | None) -> Path:

@@ -1,12 +1,14 @@
-"""A run: physics at a fixed step, wheel PI at the motor rate, sonar + planner at control_hz.
+"""A run: physics at a fixed step, wheel PI at the motor rate, range sensor + planner at control_hz.
 
 `Run` steps one control tick at a time (`step`) and decides in one place how the run ends
 (`_ending`: the six ways, in the order they are checked); `run_scenario` runs it to the end.
 A tick is two halves: `observe` (sense) and `apply` (a decision drives the wheels), so that
 a decision can also come from outside (the reinforcement-learning environments, through
-`vplane_mj.navigation_task`). The planner sees only an Observation (pose, goal, sonar
-ranges). The simulator's obstacle geometry is used only to score the run (clearance) and to
-draw it, never to plan.
+`vplane_mj.navigation_task`). The robot is the scenario's profile; the planner sees only an
+Observation (pose, goal, the ranges of its sonars or laser) and is built for the robot's body
+(footprint, limits, sensor kind). The simulator's obstacle geometry is used only to score the
+run (clearance of the footprint), to draw it, and to cast the laser's rays as a laser's
+physics would, never to plan.
 """
 
 from __future__ import annotations
@@ -27,10 +29,11 @@ from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.render import Track
+from vplane_mj.robot import robot_body
 from vplane_mj.scenario import Scenario
-from vplane_mj.sonar import SonarRays, SonarRing
+from vplane_mj.sensors import range_sensor
 from vplane_mj.summary import Outcome, RunSummary
-from vplane_mj.world import ROBOT_PREFIX, SonarLayout, build_model
+from vplane_mj.world import build_model
 
 EXTERNAL_PLANNER = "external"
 """The summary's planner name of a run whose decisions come from outside the package."""
@@ -115,40 +118,28 @@ class Run:
         self.model = build_model(scenario, rangefinders=False)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
-        self.drive = Drive(self.model, self.data, scenario.run.control_hz)
-        sensors = scenario.sensors
-        self.layout = SonarLayout.from_spec(sensors)
-        self.sonar = SonarRing(
-            sensors.count,
-            sensors.rays_per_sonar,
-            sensors.range_max,
-            np.random.default_rng(scenario.run.seed),
-            noise_std=sensors.noise_std,
-            dropout=sensors.dropout,
-            crosstalk=sensors.crosstalk,
-            dead=sensors.dead,
-        )
-        sonar_model = build_model(scenario, rangefinders=True)
-        first_ray = sonar_model.sensor(ROBOT_PREFIX + "sonar0_ray0").id
-        self.rays = SonarRays(sonar_model, first_ray, sensors.count * sensors.rays_per_sonar, self.data)
+        profile = scenario.robot.profile
+        self.drive = Drive(self.model, self.data, scenario.run.control_hz, profile)
+        self.sensor = range_sensor(scenario, self.data)
         self.localiser = Localiser(self.drive, scenario)
+        self.body = robot_body(profile, scenario.sensors.kind)
         self.radius = self.drive.geometry["radius_m"]
         self.planner_name = EXTERNAL_PLANNER if external else scenario.planner
         self.planner = (
-            None if external else make_planner(scenario.planner, scenario.planner_params, self.radius)
+            None if external else make_planner(scenario.planner, scenario.planner_params, self.body)
         )
         world = scenario.world
         self.clearance = Clearance(
-            shapes.scene_footprints(world.obstacles, world.size if world.border else None)
+            shapes.scene_footprints(world.obstacles, world.size if world.border else None),
+            None if self.body.disc else self.body.footprint,
         )
         self.collisions = CollisionCounter(self.model, self.data)
         self.goal = np.asarray(scenario.robot.goal, float)
         self.tolerance = scenario.robot.goal_tolerance
-        self.beam = math.radians(sensors.beam_deg)
-        self.ranges = np.full(sensors.count, np.nan)
-        self.next_sonar_s = 0.0
+        self.ranges = np.full(len(self.sensor.bearings), np.nan)
+        self.next_scan_s = 0.0
         self.position = self.drive.xpos[:2].copy()
-        self.clearance.add(self.position[None, :])
+        self.clearance.add(np.array([[*self.position, self.drive.yaw()]]))
         self.times: list[float] = []
         self.positions: list[np.ndarray] = []
         self.modes: list[str] = []
@@ -222,9 +213,9 @@ class Run:
             believed_yaw,
             self.goal,
             self.tolerance,
-            self.layout.bearings,
+            self.sensor.bearings,
             self.ranges,
-            self.beam,
+            self.sensor.beam_width,
         )
         return self._observation
 
@@ -290,14 +281,14 @@ class Run:
 
     # -- the stages of a tick ---------------------------------------------------------------
     def _sense(self) -> tuple[np.ndarray, float]:
-        """Read the sonar's ranges (cast when it pings, at its rate) and the pose the planner uses:
+        """Read the range sensor (when a reading is due at its rate) and the pose the planner uses:
         that pose (position in m, yaw in rad), also kept for the rest of the tick."""
         time_s = self.data.time
-        if time_s >= self.next_sonar_s - 1e-9:
-            self.ranges = self.sonar.read(self.rays.cast())
-            while self.next_sonar_s <= time_s + 1e-9:
-                self.next_sonar_s += 1.0 / self.scenario.sensors.rate_hz
         self.yaw = self.drive.yaw()
+        if time_s >= self.next_scan_s - 1e-9:
+            self.ranges = self.sensor.read(float(self.position[0]), float(self.position[1]), self.yaw)
+            while self.next_scan_s <= time_s + 1e-9:
+                self.next_scan_s += 1.0 / self.sensor.rate_hz
         self.yaws.append(self.yaw)
         self._belief = self.localiser.pose(self.position, self.yaw)
         return self._belief
@@ -346,7 +337,7 @@ class Run:
         first, rest = travelled(self.position, trace)
         self.path_length += first
         self.path_length += rest
-        self.position = trace[-1].copy()
+        self.position = trace[-1, :2].copy()
 
     def _check_contacts(self) -> None:
         if self.collisions.found[0] > 0 or self.collisions.touching:
@@ -389,6 +380,12 @@ class Run:
             planes=self.planes,
         )
 
+    @property
+    def _from_centre(self) -> float:
+        """What the clearance measured from the robot's centre loses to its footprint (m): the
+        radius of a round robot; 0 for an outline, measured from the outline itself."""
+        return self.radius if self.body.disc else 0.0
+
     def summary(self) -> RunSummary:
         """The run's summary (call once it has ended)."""
         scenario, ending, clearance = self.scenario, self.ending, self.clearance
@@ -412,21 +409,25 @@ class Run:
             wall_time_s=self.wall_time_s,
             path_length_m=self.path_length,
             collisions=len(self.collisions.points),
-            min_clearance_m=None if math.isinf(clearance.minimum) else clearance.minimum - self.radius,
-            mean_clearance_m=None if math.isinf(clearance.mean) else clearance.mean - self.radius,
+            min_clearance_m=None if math.isinf(clearance.minimum) else clearance.minimum - self._from_centre,
+            mean_clearance_m=None if math.isinf(clearance.mean) else clearance.mean - self._from_centre,
             **motion_quality(np.array(self.yaws), self.path_length),
             planner_cpu_ms_mean=1e3 * float(np.mean(cpu)) if cpu else None,
             planner_cpu_ms_max=1e3 * float(np.max(cpu)) if cpu else None,
             local_minima=self.local_minima,
             escapes=self.escapes,
             robot_radius_m=self.radius,
+            robot_profile=scenario.robot.profile,
+            footprint_m=[[float(x), float(y)] for x, y in self.body.footprint],
+            top_speed_mps=self.body.limits.max_speed_mps,
+            sensor_kind=scenario.sensors.kind,
             **path_quality(
                 scenario,
-                self.radius,
+                self.radius if self.body.disc else self.body.half_width_m,
                 success,
                 self.path_length,
                 self.time_to_goal,
-                self.drive.gains.max_speed,
+                self.body.limits.max_speed_mps,
             ),
             final_distance_to_goal_m=math.hypot(
                 self.goal[0] - self.position[0], self.goal[1] - self.position[1]

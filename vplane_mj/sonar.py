@@ -10,8 +10,6 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from vplane_mj.robot import SONAR_MOUNT_RADIUS_M
-
 
 class SonarRays:
     """The rangefinders of the sonar ring, evaluated on the robot's current kinematics.
@@ -41,7 +39,9 @@ class SonarRays:
 
 
 class SonarRing:
-    """Turns the raw ray readings of the ring into sonar ranges measured from the robot's centre.
+    """Turns the raw ray readings of the sonars into ranges measured from the robot's centre.
+
+    Each sonar's range is its own reading plus its mount's `reach` along its bearing (m).
 
     A ray that missed (MuJoCo reads -1) or reached the cutoff is no echo. The shortest
     echo of a sonar's rays wins, as the first echo of a real beam would. The faults, in
@@ -53,7 +53,7 @@ class SonarRing:
 
     def __init__(
         self,
-        count: int,
+        reach: np.ndarray,
         rays_per_sonar: int,
         range_max: float,
         rng: np.random.Generator,
@@ -62,7 +62,8 @@ class SonarRing:
         crosstalk: float = 0.0,
         dead: tuple[int, ...] = (),
     ):
-        self.count = count
+        self.reach = np.asarray(reach, dtype=float)
+        self.count = len(self.reach)
         self.rays_per_sonar = rays_per_sonar
         self.range_max = range_max
         self.rng = rng
@@ -76,16 +77,16 @@ class SonarRing:
         per_sonar = np.asarray(rays, float).reshape(self.count, self.rays_per_sonar)
         # Misses (-1) never win; a cutoff reading (range_max) wins only when no ray echoed.
         shortest = np.where(per_sonar >= 0.0, per_sonar, np.inf).min(axis=1)
-        ranges = np.where(shortest < self.range_max, shortest + SONAR_MOUNT_RADIUS_M, np.nan)
+        ranges = np.where(shortest < self.range_max, shortest + self.reach, np.nan)
         if self.noise_std > 0.0:
             ranges = ranges + self.rng.normal(0.0, self.noise_std, self.count)
-            ranges = np.maximum(ranges, SONAR_MOUNT_RADIUS_M)
+            ranges = np.maximum(ranges, self.reach)
         if self.dropout > 0.0:
             ranges[self.rng.random(self.count) < self.dropout] = np.nan
         if self.crosstalk > 0.0:
             heard = self.rng.random(self.count) < self.crosstalk
-            farthest = np.where(np.isnan(ranges), self.range_max + SONAR_MOUNT_RADIUS_M, ranges)
-            spurious = self.rng.uniform(SONAR_MOUNT_RADIUS_M, farthest)
+            farthest = np.where(np.isnan(ranges), self.range_max + self.reach, ranges)
+            spurious = self.rng.uniform(self.reach, farthest)
             ranges = np.where(heard, spurious, ranges)
         if len(self.dead):
             ranges[self.dead] = np.nan

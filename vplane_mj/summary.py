@@ -55,6 +55,10 @@ class RunSummary:
     local_minima: int = 0
     escapes: int = 0
     robot_radius_m: float | None = None
+    robot_profile: str = "default"
+    footprint_m: list[list[float]] = field(default_factory=list)
+    top_speed_mps: float | None = None
+    sensor_kind: str = "sonar"
     reference_length_m: float | None = None
     optimal_length_m: float | None = None
     path_ratio: float | None = None

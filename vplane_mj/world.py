@@ -1,9 +1,11 @@
 """Build the MuJoCo world of a scenario with MjSpec: arena, border, obstacles, robot, sonar.
 
-Element names are predictable: obstacle geoms are `obstacle<i>_<part>` (parts per kind
-in PART_NAMES) and border walls `border_<side>`, all in the static body `obstacles`;
-sonar ray sites are `robot/sonar<k>_ray<j>`, in order, so their poses are contiguous,
-and so are the readings of the rangefinders of the same names.
+The robot is its profile's model (`vplane_mj.profiles`, models/*.xml). Element names are
+predictable: obstacle geoms are `obstacle<i>_<part>` (parts per kind in PART_NAMES) and
+border walls `border_<side>`, all in the static body `obstacles`; sonar ray sites are
+`robot/sonar<k>_ray<j>`, in order, so their poses are contiguous, and so are the readings of
+the rangefinders of the same names. A laser is not a MuJoCo sensor: `vplane_mj.laser` casts
+it in 2D against the same pieces the obstacles are built from.
 """
 
 from __future__ import annotations
@@ -15,15 +17,9 @@ import mujoco
 import numpy as np
 
 from vplane_mj import shapes
+from vplane_mj.profiles import PROFILES
 from vplane_mj.resources import model_path
-from vplane_mj.robot import (
-    BASE_BODY,
-    SONAR_MOUNT_HEIGHT_M,
-    SONAR_MOUNT_RADIUS_M,
-    WHEEL_JOINTS,
-    WHEEL_MOTORS,
-    robot_facts,
-)
+from vplane_mj.robot import BASE_BODY, SONAR_MOUNT_RADIUS_M, WHEEL_JOINTS, WHEEL_MOTORS, robot_facts
 from vplane_mj.scenario import RobotSpec, Scenario, SensorSpec
 
 OBSTACLE_HEIGHT_M = 0.5
@@ -48,20 +44,41 @@ SONAR_SITE_RGBA = (0.1, 0.7, 0.2, 0.6)
 
 @dataclass(frozen=True)
 class SonarLayout:
-    """Geometry of the sonar ring: one bearing (rad, robot frame) per sonar; rays per sonar."""
+    """Geometry of the sonars: each one's bearing (rad, robot frame) and mount (x, y in m,
+    base_link), their height above base_link's origin (m), and the rays' offsets (rad) about a
+    sonar's bearing. `reach` is each mount's distance (m) along its own bearing: a range
+    measured from the sonar plus its reach is measured from the robot's centre, along the
+    bearing (exact on the ring, whose mounts lie on their bearings; for mounts off their
+    bearing, the echo is placed on the bearing through the centre, off by the mount's
+    distance from that line)."""
 
     bearings: np.ndarray
+    mounts: np.ndarray
+    reach: np.ndarray
+    height_m: float
     ray_offsets: np.ndarray
 
     @classmethod
-    def from_spec(cls, spec: SensorSpec) -> SonarLayout:
-        bearings = np.arange(spec.count) * (2 * math.pi / spec.count)
+    def from_spec(cls, spec: SensorSpec, profile: str = "default") -> SonarLayout:
+        """The profile's sonars at their places, or the evenly spaced ring of `spec.count` on a
+        circle of SONAR_MOUNT_RADIUS_M."""
+        robot = PROFILES[profile]
+        if robot.sonar_mounts is None:
+            bearings = np.arange(spec.count) * (2 * math.pi / spec.count)
+            mounts = np.array(
+                [(SONAR_MOUNT_RADIUS_M * math.cos(b), SONAR_MOUNT_RADIUS_M * math.sin(b)) for b in bearings]
+            )
+            reach = np.full(spec.count, SONAR_MOUNT_RADIUS_M)
+        else:
+            mounts = np.array([(x, y) for x, y, _ in robot.sonar_mounts])
+            bearings = np.radians([heading for _, _, heading in robot.sonar_mounts])
+            reach = mounts[:, 0] * np.cos(bearings) + mounts[:, 1] * np.sin(bearings)
         if spec.rays_per_sonar == 1:
             offsets = np.zeros(1)
         else:
             half = math.radians(spec.beam_deg) / 2
             offsets = np.linspace(-half, half, spec.rays_per_sonar)
-        return cls(bearings=bearings, ray_offsets=offsets)
+        return cls(bearings, mounts, reach, robot.sensor_height_m, offsets)
 
 
 def build_spec(scenario: Scenario, rangefinders: bool = True) -> mujoco.MjSpec:
@@ -93,8 +110,10 @@ def build_spec(scenario: Scenario, rangefinders: bool = True) -> mujoco.MjSpec:
         intprm=[1, 1, 1],  # data "found", reduce "mindist", one contact
     )
 
-    robot = mujoco.MjSpec.from_file(str(model_path("robot.xml")))
-    _add_sonar_ring(robot, scenario.sensors, rangefinders)
+    robot = mujoco.MjSpec.from_file(str(model_path(PROFILES[scenario.robot.profile].model_file)))
+    if scenario.sensors.kind == "sonar":
+        layout = SonarLayout.from_spec(scenario.sensors, scenario.robot.profile)
+        _add_sonar_ring(robot, layout, scenario.sensors, rangefinders)
     _apply_actuation_faults(robot, scenario.robot)
     x, y = scenario.robot.start
     yaw = scenario.robot.start_yaw
@@ -152,21 +171,16 @@ def _add_piece(body: mujoco.MjsBody, name: str, piece: shapes.Piece, material: s
     geom.alt.euler = [0.0, 0.0, piece.yaw]
 
 
-def _add_sonar_ring(robot: mujoco.MjSpec, spec: SensorSpec, rangefinders: bool) -> None:
+def _add_sonar_ring(robot: mujoco.MjSpec, layout: SonarLayout, spec: SensorSpec, rangefinders: bool) -> None:
     """Sonar k emulates a beam of `beam_deg` with `rays_per_sonar` rays.
 
-    All rays of one sonar start at the same site position on the ring; each ray is a
+    All rays of one sonar start at the same site position, its mount; each ray is a
     site whose +z axis points along the ray. With `rangefinders`, each site carries a
     rangefinder cut off at the range limit, with the sonar's period as its interval.
     """
-    layout = SonarLayout.from_spec(spec)
     base = robot.body(BASE_BODY)
     for k, bearing in enumerate(layout.bearings):
-        pos = [
-            SONAR_MOUNT_RADIUS_M * math.cos(bearing),
-            SONAR_MOUNT_RADIUS_M * math.sin(bearing),
-            SONAR_MOUNT_HEIGHT_M,
-        ]
+        pos = [float(layout.mounts[k, 0]), float(layout.mounts[k, 1]), layout.height_m]
         for j, offset in enumerate(layout.ray_offsets):
             angle = bearing + offset
             name = f"sonar{k}_ray{j}"
@@ -197,7 +211,7 @@ def _apply_actuation_faults(robot: mujoco.MjSpec, spec: RobotSpec) -> None:
     for geom in robot.geoms:
         if geom.classname.name == "wheel":
             geom.friction[0] = spec.wheel_friction
-    limit = robot_facts().torque_limit_nm
+    limit = robot_facts(spec.profile).torque_limit_nm
     for motor_name, joint, gain, bias in zip(
         WHEEL_MOTORS, WHEEL_JOINTS, spec.motor_gain, spec.motor_bias_nm, strict=True
     ):

@@ -13,6 +13,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from vplane_mj.profiles import PROFILES
 from vplane_mj.scenario.fields import Field, Invalid, join_key
 from vplane_mj.shapes import Box, Cup, Cylinder, HShape, Obstacle, Wall
 
@@ -47,6 +48,7 @@ WORLD_FIELDS = {
 }
 
 ROBOT_FIELDS = {
+    "profile": Field("str", choices=tuple(PROFILES)),
     "start": Field("point", required=True),
     "start_yaw_deg": Field("number", attr="start_yaw", convert=math.radians),
     "goal": Field("point", required=True),
@@ -56,7 +58,12 @@ ROBOT_FIELDS = {
     "motor_bias_nm": Field("pair"),
 }
 
+SENSOR_KINDS = ("sonar", "laser")
+MAX_SONAR_RANGE_M, MAX_LASER_RANGE_M = 20.0, 100.0
+"""The longest range (m) of each sensor kind: beyond them a reading means nothing in an arena."""
+
 SENSOR_FIELDS = {
+    "kind": Field("str", choices=SENSOR_KINDS),
     "noise_std": Field("number", ge=0, le=MAX_NOISE_STD_M),
     "dropout": Field("number", ge=0, lt=1),
     "crosstalk": Field("number", ge=0, lt=1),
@@ -66,9 +73,37 @@ SENSOR_FIELDS = {
     "count": Field("int", ge=4, le=128),
     "rays_per_sonar": Field("int", ge=1, le=15),
     "beam_deg": Field("number", gt=0, le=60),
-    "range_max": Field("number", gt=0.2, le=20),
+    "fov_deg": Field("number", gt=0, le=360),
+    "beams": Field("int", ge=2, le=2048),
+    "range_min": Field("number", ge=0, le=MAX_LASER_RANGE_M),
+    "range_max": Field("number", gt=0.2, le=MAX_LASER_RANGE_M),
     "rate_hz": Field("number", gt=0, le=100),
 }
+KIND_KEYS = {
+    "sonar": ("count", "rays_per_sonar", "beam_deg", "crosstalk", "dead"),
+    "laser": ("fov_deg", "beams", "range_min"),
+}
+"""The `[sensors]` keys that belong to one kind of sensor; the rest apply to both."""
+GENERIC_SENSORS: dict[str, dict[str, str | int | float]] = {
+    "sonar": {
+        "kind": "sonar",
+        "count": 16,
+        "rays_per_sonar": 3,
+        "beam_deg": 20.0,
+        "range_max": 3.0,
+        "rate_hz": 20.0,
+    },
+    "laser": {
+        "kind": "laser",
+        "fov_deg": 360.0,
+        "beams": 360,
+        "range_min": 0.1,
+        "range_max": 10.0,
+        "rate_hz": 10.0,
+    },
+}
+"""The `[sensors]` defaults of a kind the robot's profile does not carry (a laser on the default
+robot, say): a 16-sonar ring as the default robot's, a 360-degree laser of 1-degree beams."""
 
 RUN_FIELDS = {
     "seed": Field("int", ge=0, lt=2**32),

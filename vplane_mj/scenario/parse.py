@@ -43,7 +43,7 @@ def _build_scenario(doc: dict[str, Any], source: str, recorded: bool) -> Scenari
         robot=robot,
         planner=planner,
         planner_params=params,
-        sensors=read_sensors(doc),
+        sensors=read_sensors(doc, robot.profile),
         run=read_run(doc),
         raw=_freeze(doc),
     )

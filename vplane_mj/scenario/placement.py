@@ -1,18 +1,26 @@
-"""Where the robot may start and end: inside the arena, its disc clear of walls and obstacles.
+"""Where the robot may start and end: inside the arena, its footprint clear of walls and obstacles.
 
-The robot's radius is that of models/robot.xml (`vplane_mj.robot`), in metres.
+A round robot (the default profile) is its disc of the model's radius, as it always was; a
+robot with an outline polygon (`vplane_mj.profiles`) is that polygon: at the start in its
+start heading, at the goal in at least one heading (the heading of arrival is the planner's).
+Distances in metres.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 
 import numpy as np
 
-from vplane_mj.robot import robot_radius_m
+from vplane_mj.planning.body import RobotBody
+from vplane_mj.robot import robot_body
 from vplane_mj.scenario.fields import Invalid
 from vplane_mj.scenario.spec import RobotSpec, WorldSpec
 from vplane_mj.shapes import scene_footprints
+
+GOAL_HEADINGS = 72
+"""Headings tried for the footprint at the goal (every 5 degrees)."""
 
 
 def _check_in_arena(key: str, point: tuple[float, float], size: tuple[float, float]) -> None:
@@ -23,9 +31,9 @@ def _check_in_arena(key: str, point: tuple[float, float], size: tuple[float, flo
         raise Invalid(key, reason)
 
 
-def _check_border_gap(key: str, point: tuple[float, float], size: tuple[float, float]) -> None:
-    """With border walls, the robot's disc at the point stays off them."""
-    (x, y), (w, h), radius = point, size, robot_radius_m()
+def _check_border_gap(key: str, point: tuple[float, float], size: tuple[float, float], radius: float) -> None:
+    """With border walls, a round robot's disc at the point stays off them."""
+    (x, y), (w, h) = point, size
     gap = min(x, w - x, y, h - y)
     if gap < radius:
         reason = (
@@ -35,11 +43,10 @@ def _check_border_gap(key: str, point: tuple[float, float], size: tuple[float, f
         raise Invalid(key, reason)
 
 
-def _check_obstacle_gaps(points: Mapping[str, tuple[float, float]], world: WorldSpec) -> None:
-    """The robot's disc at each point stays off every obstacle."""
+def _check_obstacle_gaps(points: Mapping[str, tuple[float, float]], world: WorldSpec, radius: float) -> None:
+    """A round robot's disc at each point stays off every obstacle."""
     if not world.obstacles:
         return
-    radius = robot_radius_m()
     xy = np.array(list(points.values()), dtype=float)
     gaps = np.array([scene_footprints([ob]).distance(xy) for ob in world.obstacles])
     for column, key in enumerate(points):
@@ -53,11 +60,43 @@ def _check_obstacle_gaps(points: Mapping[str, tuple[float, float]], world: World
             raise Invalid(key, f"is {gap:.3f} m from {where}, {limit}")
 
 
+def _check_outline(
+    key: str, point: tuple[float, float], headings: np.ndarray, world: WorldSpec, body: RobotBody
+) -> None:
+    """The robot's outline at the point, in at least one of `headings` (rad), overlaps no
+    obstacle and no border wall."""
+    things = [
+        (f"obstacle world.obstacles[{i}]", scene_footprints([ob])) for i, ob in enumerate(world.obstacles)
+    ]
+    if world.border:
+        things.append(("the border wall", scene_footprints([], world.size)))
+    if not things:
+        return
+    poses = np.column_stack((np.full(len(headings), point[0]), np.full(len(headings), point[1]), headings))
+    gaps = np.array([pieces.outline_distance(body.footprint, poses) for _, pieces in things])
+    clearance = gaps.min(axis=0)  # per heading, to the nearest thing
+    best = int(np.argmax(clearance))
+    if clearance[best] >= 0.0:
+        return
+    name = things[int(np.argmin(gaps[:, best]))][0]
+    where = f"at yaw {math.degrees(headings[0]):g} deg" if len(headings) == 1 else "in every heading"
+    reason = f"the {body.profile} robot's footprint {where} overlaps {name} (by {-clearance[best]:.3f} m)"
+    raise Invalid(key, reason)
+
+
 def check_placement(world: WorldSpec, robot: RobotSpec) -> None:
-    """Start and goal inside the arena, clear of the border walls and of the obstacles."""
+    """Start and goal inside the arena, the robot's footprint there clear of the border walls and
+    of the obstacles."""
     points = {"robot.start": robot.start, "robot.goal": robot.goal}
     for key, point in points.items():
         _check_in_arena(key, point, world.size)
+    body = robot_body(robot.profile)
+    if body.disc:
         if world.border:
-            _check_border_gap(key, point, world.size)
-    _check_obstacle_gaps(points, world)
+            for key, point in points.items():
+                _check_border_gap(key, point, world.size, body.radius_m)
+        _check_obstacle_gaps(points, world, body.radius_m)
+        return
+    _check_outline("robot.start", robot.start, np.array([robot.start_yaw]), world, body)
+    headings = np.arange(GOAL_HEADINGS) * (2 * math.pi / GOAL_HEADINGS)
+    _check_outline("robot.goal", robot.goal, headings, world, body)

@@ -2,8 +2,9 @@
 
 Besides each key's own rule (`keys.py`), a section checks what spans keys: the format
 and name, an obstacle's shape, the planner's parameters against its table, a motor bias
-within the torque limit of models/robot.xml, dead sonars within the ring, a control
-period of at least one physics step.
+within the torque limit of the profile's model, the sensor's keys against its kind and its
+defaults from the robot's profile, dead sonars within the ring, a laser's range limits in
+order, a control period of at least one physics step.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from typing import Any
 from vplane_mj.planning import registry
 from vplane_mj.planning.params import ParamError
 from vplane_mj.planning.plugins import is_import_spec
+from vplane_mj.profiles import PROFILES
 from vplane_mj.robot import robot_facts
 from vplane_mj.scenario.fields import (
     Invalid,
@@ -27,7 +29,10 @@ from vplane_mj.scenario.fields import (
 )
 from vplane_mj.scenario.keys import (
     FORMAT,
+    GENERIC_SENSORS,
+    KIND_KEYS,
     MAX_NAME_LENGTH,
+    MAX_SONAR_RANGE_M,
     NAME_PATTERN,
     OBSTACLE_KINDS,
     ROBOT_FIELDS,
@@ -101,10 +106,13 @@ def _facing(start: tuple[float, float], goal: tuple[float, float]) -> float:
 
 
 def read_robot(doc: Mapping[str, Any]) -> RobotSpec:
-    """The `[robot]` table, start_yaw resolved; a motor bias within the torque limit."""
+    """The `[robot]` table, profile, start_yaw and wheel friction resolved; a motor bias within
+    the torque limit of the profile's model."""
     values = read_fields(sub_table(doc, "robot", required=True), "robot", ROBOT_FIELDS)
+    values.setdefault("profile", "default")
     values.setdefault("start_yaw", _facing(values["start"], values["goal"]))
-    limit = robot_facts().torque_limit_nm
+    values.setdefault("wheel_friction", PROFILES[values["profile"]].wheel_friction)
+    limit = robot_facts(values["profile"]).torque_limit_nm
     for index, bias in enumerate(values.get("motor_bias_nm", ())):
         if abs(bias) > limit:
             reason = f"item {index}: must be within the motor's torque limit +-{limit:g} N m, got {bias!r}"
@@ -141,13 +149,39 @@ def read_planner(doc: Mapping[str, Any], recorded: bool = False) -> tuple[str, M
     return name, MappingProxyType(params)
 
 
-def read_sensors(doc: Mapping[str, Any]) -> SensorSpec:
-    """The optional `[sensors]` table; dead sonars must exist in the ring."""
-    sensors = SensorSpec(**read_fields(sub_table(doc, "sensors"), "sensors", SENSOR_FIELDS))
-    for index, sonar in enumerate(sub_table(doc, "sensors").get("dead", [])):
+def read_sensors(doc: Mapping[str, Any], profile: str = "default") -> SensorSpec:
+    """The optional `[sensors]` table over the defaults of the robot's profile (of another kind
+    than the profile's sensor: that kind's generic defaults). Keys of the other kind are refused;
+    a profile whose sonars sit at fixed places refuses `count`; dead sonars must exist in the
+    ring; a laser's shortest range lies below its longest; a sonar reaches at most
+    MAX_SONAR_RANGE_M."""
+    table = sub_table(doc, "sensors")
+    given = read_fields(table, "sensors", SENSOR_FIELDS)
+    robot = PROFILES[profile]
+    kind = given.get("kind", robot.sensors["kind"])
+    other = next(k for k in KIND_KEYS if k != kind)
+    for key in table:
+        if key in KIND_KEYS[other]:
+            own = ", ".join(KIND_KEYS[kind])
+            reason = f"a {other} key, but this sensor is kind = {kind!r} (its own keys: {own})"
+            raise Invalid(f"sensors.{key}", reason)
+    if "count" in table and robot.sonar_mounts is not None:
+        reason = f"the {profile} profile's {len(robot.sonar_mounts)} sonars sit where the robot has them"
+        raise Invalid("sensors.count", reason)
+    defaults = robot.sensors if kind == robot.sensors["kind"] else GENERIC_SENSORS[kind]
+    resolved = {key: SENSOR_FIELDS[key].to_python(value) for key, value in defaults.items()}
+    sensors = SensorSpec(**{**resolved, **given})
+    for index, sonar in enumerate(table.get("dead", [])):
         if sonar >= sensors.count:
             ring = f"a ring of count = {sensors.count} (0 to {sensors.count - 1})"
             raise Invalid("sensors.dead", f"item {index}: no sonar {sonar} in {ring}")
+    if kind == "sonar" and sensors.range_max > MAX_SONAR_RANGE_M:
+        reason = f"a sonar reaches at most {MAX_SONAR_RANGE_M:g} m, got {sensors.range_max!r}"
+        raise Invalid("sensors.range_max", reason)
+    if kind == "laser" and not sensors.range_min < sensors.range_max:
+        key = "sensors.range_min" if "range_min" in table else "sensors.range_max"
+        reason = f"range_min ({sensors.range_min:g} m) must be less than range_max ({sensors.range_max:g} m)"
+        raise Invalid(key, reason)
     return sensors
 
 

@@ -29,13 +29,15 @@ class WorldSpec:
 
 @dataclass(frozen=True)
 class RobotSpec:
-    """Start and goal (m); start_yaw in radians, resolved (default: facing the goal).
+    """The robot's profile (`vplane_mj.profiles`); start and goal (m); start_yaw in radians,
+    resolved (default: facing the goal).
 
     Actuation faults: `wheel_friction` is the tyres' sliding friction coefficient (lower
-    lets the wheels slip); each motor (left, right) delivers `motor_gain` times the
-    commanded torque plus `motor_bias_nm` (N m).
+    lets the wheels slip; resolved: default the profile's); each motor (left, right)
+    delivers `motor_gain` times the commanded torque plus `motor_bias_nm` (N m).
     """
 
+    profile: str
     start: tuple[float, float]
     start_yaw: float
     goal: tuple[float, float]
@@ -47,7 +49,10 @@ class RobotSpec:
 
 @dataclass(frozen=True)
 class SensorSpec:
-    """The sonar ring: noise (m), dropout probability, layout, beam (deg), range (m), rate.
+    """The range sensor, resolved against the robot's profile: its `kind`, noise (m), dropout
+    probability, range (m) and rate (Hz); a sonar's layout and beam (deg); a laser's field of
+    view (deg), beams and shortest range (m). The keys of the other kind keep their defaults
+    and mean nothing.
 
     Sensor faults: `crosstalk` is the probability that a reading is a spurious short
     echo, `dead` the indices of sonars that never echo. `pose` is where the planner's
@@ -66,6 +71,10 @@ class SensorSpec:
     beam_deg: float = 20.0
     range_max: float = 3.0
     rate_hz: float = 20.0
+    fov_deg: float = 360.0
+    beams: int = 360
+    range_min: float = 0.1
+    kind: str = "sonar"
 
 
 @dataclass(frozen=True)
