@@ -10,6 +10,7 @@ import os
 import re
 import shutil
 import tempfile
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +19,7 @@ from hypothesis import settings
 
 from vplane_mj.cache import CACHE_ENV
 from vplane_mj.cli import main
+from vplane_mj.planning import registry
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import build_scenario, load_scenario, parse_scenario, wall
@@ -33,6 +35,13 @@ def pytest_sessionfinish(session, exitstatus):
 
 settings.register_profile("deterministic", derandomize=True, database=None)
 settings.load_profile("deterministic")
+
+
+@pytest.fixture
+def own_registry(monkeypatch):
+    """A planner registry of this test's own: what it registers is gone afterwards."""
+    monkeypatch.setattr(registry, "PLANNERS", registry._Planners())
+    return registry.PLANNERS
 
 
 @pytest.fixture
@@ -57,12 +66,15 @@ def shipped():
 
 @pytest.fixture
 def readme_examples():
-    """The Python code blocks of a README section (`## TITLE`), joined into one script."""
+    """The Python code blocks of a README section (`## TITLE`), joined into one script (a
+    block indented in a list item is dedented)."""
 
     def blocks(title: str) -> str:
         text = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
         section = text.split(f"\n## {title}\n", 1)[1].split("\n## ", 1)[0]
-        return "\n".join(re.findall(r"```python\n(.*?)```", section, re.S))
+        return "\n".join(
+            textwrap.dedent(block) for block in re.findall(r"```python\n(.*?)```", section, re.S)
+        )
 
     return blocks
 

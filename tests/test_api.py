@@ -335,7 +335,7 @@ def test_sweep_runs_scenarios_built_in_code_and_can_keep_nothing(tmp_path, monke
 
 
 def test_sweep_rejects_invalid_input_before_any_run_and_leaves_no_directory(tmp_path):
-    with pytest.raises(ScenarioError, match=r"planner\.name: unknown planner 'nope'"):
+    with pytest.raises(VPlaneError, match=r"^planners: unknown planner 'nope'"):
         sweep(["open_field"], ["nope"], out=tmp_path / "new" / "dir")
     with pytest.raises(VPlaneError, match="jobs: must be at least 1, got 0"):
         sweep(["open_field"], ["apf"], jobs=0, out=tmp_path / "new" / "dir")

@@ -5,6 +5,7 @@ import csv
 import dataclasses
 import json
 import os
+import shlex
 import signal
 import subprocess
 import sys
@@ -88,7 +89,7 @@ def test_a_sweep_writes_rows_table_and_plot_and_resumes(tmp_path, capsys):
     [
         (["--seeds", "5-2"], "--seeds"),
         (["--seeds", "x"], "--seeds"),
-        (["--planners", "apf,nope"], "planner.name"),
+        (["--planners", "apf,nope"], "--planners: unknown planner 'nope'"),
         (["--jobs", "0"], "--jobs"),
         (["--scheduler", "tcp://127.0.0.1:8786"], "--scheduler"),
         (["--set", "sensors.dropout=2"], "sensors.dropout"),
@@ -308,6 +309,11 @@ def broken(job):
     return dataclasses.replace(job, seed=7, toml=job.toml.replace('name = "apf"', 'name = "nope"'))
 
 
+def saved_text(saved: Path, job) -> str:
+    """A failed run's saved scenario: the command that runs it again, then the job's scenario."""
+    return f"# A run of a sweep that ended in error; to run it again:\n# vplane-mj run {saved}\n{job.toml}"
+
+
 def test_a_run_that_raises_is_an_error_row_with_its_scenario_saved_and_the_sweep_goes_on(tmp_path, capsys):
     good = plan_jobs(["open_field"], ["apf"], [0, 1])
     failing = broken(good[0])
@@ -325,7 +331,8 @@ def test_a_run_that_raises_is_an_error_row_with_its_scenario_saved_and_the_sweep
     assert "unknown planner 'nope'" in error["message"]
     assert "(at vplane_mj/scenario/parse.py:" in error["message"] and "in run_job" in error["message"]
     saved = tmp_path / "failed" / "open_field-apf-7.toml"
-    assert error["failed_scenario"] == str(saved) and saved.read_text() == failing.toml
+    assert error["failed_scenario"] == str(saved) and saved.read_text() == saved_text(saved, failing)
+    assert error["rerun"] == f"vplane-mj run {saved}"
     trace = (tmp_path / "failed" / "open_field-apf-7.traceback.txt").read_text()
     assert trace.startswith("Traceback (most recent call last):") and "ScenarioError" in trace
     assert sorted(path.name for path in (tmp_path / "failed").iterdir()) == [
@@ -334,10 +341,12 @@ def test_a_run_that_raises_is_an_error_row_with_its_scenario_saved_and_the_sweep
     ]
     [line] = summarize(rows)
     assert (line["runs"], line["errors"], line["success_rate"]) == (3, 1, pytest.approx(2 / 3))
-    assert error_lines(rows, tmp_path)[0] == (
-        f"1 of 3 runs ended in error; their scenarios are in {tmp_path / 'failed'} "
-        "(vplane-mj run FILE runs one again):"
-    )
+    assert error_lines(rows, tmp_path) == [
+        f"1 of 3 runs ended in error; their scenarios are in {tmp_path / 'failed'}, "
+        "each run again by the command below it:",
+        f"  open_field, apf, seed 7: {error['message']}",
+        f"    vplane-mj run {saved}",
+    ]
     capsys.readouterr()
 
     # The error row is a finished run: resuming runs nothing again.
@@ -365,10 +374,13 @@ def test_a_worker_killed_mid_sweep_is_an_error_row_and_every_other_run_finishes(
     assert all(row["steps"] > 0 for row in rows if row is not error)  # the queued runs were not lost
     job = next(j for j in planned_jobs(*SLOW_RUNS[1::2]) if j.key == error["key"])
     saved = tmp_path / "failed" / f"{job.scenario}-apf-{job.seed}.toml"
-    assert error["failed_scenario"] == str(saved) and saved.read_text() == job.toml
+    assert error["failed_scenario"] == str(saved) and saved.read_text() == saved_text(saved, job)
     assert [path.name for path in (tmp_path / "failed").iterdir()] == [saved.name]
     assert f"1 of 8 runs ended in error; their scenarios are in {tmp_path / 'failed'}" in out
-    assert f"  {saved}: the worker process running this run died: killed by SIGKILL" in out
+    died = (
+        f"  {job.scenario}, apf, seed {job.seed}: the worker process running this run died: killed by SIGKILL"
+    )
+    assert f"{died}\n    vplane-mj run {saved}\n" in out
     assert json.loads((tmp_path / "bench.json").read_text())["table"][0]["errors"] == 1
     with open(tmp_path / "bench.csv", newline="") as stream:
         table = list(csv.DictReader(stream))
@@ -391,8 +403,9 @@ def test_a_failed_dask_task_is_the_same_error_row_as_in_the_local_pool(tmp_path)
         rows = run_sweep([good, failing], tmp_path, 1, cluster.scheduler_address)
     assert [row["outcome"] for row in rows] == ["reached", "error"]
     saved = tmp_path / "failed" / "open_field-apf-7.toml"
-    assert rows[1]["failed_scenario"] == str(saved) and saved.read_text() == failing.toml
-    assert {**rows[1], "failed_scenario": ""} == {**local[0], "failed_scenario": ""}
+    assert rows[1]["failed_scenario"] == str(saved) and saved.read_text() == saved_text(saved, failing)
+    elsewhere = {"failed_scenario": "", "rerun": ""}  # the two sweeps' output directories differ
+    assert {**rows[1], **elsewhere} == {**local[0], **elsewhere}
 
 
 def test_a_dask_worker_that_dies_mid_run_is_an_error_row(tmp_path):
@@ -423,4 +436,43 @@ def test_a_dask_worker_that_dies_mid_run_is_an_error_row(tmp_path):
     assert row["message"].startswith("distributed.scheduler.KilledWorker: ")
     assert "all those workers died while running it" in row["message"]
     saved = tmp_path / "failed" / f"{job.scenario}-apf-{job.seed}.toml"
-    assert row["failed_scenario"] == str(saved) and saved.read_text() == job.toml
+    assert row["failed_scenario"] == str(saved) and saved.read_text() == saved_text(saved, job)
+
+
+FAILING_PLANNER = """
+from vplane_mj.planning import Decision, Planner, PlannerParams
+
+
+class Faulty(Planner):
+    name = "faulty"
+    summary = "toward the goal, and a bug after half a second"
+    citation = "none"
+    Params = PlannerParams
+
+    def step(self, obs):
+        if obs.time_s >= 0.5:
+            raise KeyError("no such thing")
+        return Decision(force=obs.goal - obs.position, mode="normal")
+"""
+
+
+def test_the_command_printed_for_a_run_in_error_runs_it_again(
+    tmp_path, capsys, monkeypatch, recwarn, own_registry
+):
+    """`bench --planners apf,file.py:Class` whose planner raises: the rows are in error, and the
+    command `bench` prints for each (also the first lines of its saved scenario) runs it again."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "faulty_bench_planner.py").write_text(FAILING_PLANNER)
+    argv = ["bench", "open_field", "--planners", "apf,faulty_bench_planner.py:Faulty", "--jobs", "1"]
+    assert main([*argv, "--out", "out"]) == 0
+    assert not recwarn.list  # the command line lists the runs in error instead of warning
+    out = capsys.readouterr().out
+    saved = Path("out") / "failed" / "open_field-faulty-0.toml"
+    rerun = f"vplane-mj run {saved} --planner {tmp_path / 'faulty_bench_planner.py'}:Faulty"
+    error = "planner 'faulty' raised at t = 0.500 s: KeyError: 'no such thing' (at "
+    assert f"1 of 2 runs ended in error; their scenarios are in {saved.parent}, each run again" in out
+    assert f"\n  open_field, faulty, seed 0: {error}" in out and f"\n    {rerun}\n" in out
+    assert saved.read_text().splitlines()[1] == f"# {rerun}"
+    assert main([*shlex.split(rerun)[1:], "--out", "again", "--no-render"]) == 3  # not "unknown planner"
+    assert error in capsys.readouterr().err
+    assert json.loads(Path("again/open_field-faulty-0.json").read_text())["outcome"] == "error"

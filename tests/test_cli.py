@@ -100,7 +100,7 @@ def test_seed_and_set_name_the_outputs(tmp_path, capsys):
         (["run", "no_such_scenario"], "no_such_scenario"),
         (["run", "open_field", "--set", "run.time_limit_s=-1"], "run.time_limit_s"),
         (["run", "open_field", "--set", "planner.no_such_param=1"], "planner.no_such_param"),
-        (["run", "open_field", "--planner", "nope"], "planner.name"),
+        (["run", "open_field", "--planner", "nope"], "--planner: unknown planner 'nope'"),
         (["run", "open_field", "--set", "novalue"], "--set"),
         (["run", "open_field", "--set", "sensors.dropout=1.0"], "sensors.dropout"),
         (["run", "open_field", "--set", "sensors.noise_std=-0.1"], "sensors.noise_std"),

@@ -14,6 +14,8 @@ import math
 import os
 import re
 import resource
+import subprocess
+import sys
 import tempfile
 import time
 import tracemalloc
@@ -25,12 +27,14 @@ import tomli_w
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
+from vplane_mj import run
 from vplane_mj.cli import main
-from vplane_mj.planning import registry
+from vplane_mj.log_read import read_log
+from vplane_mj.planning import register_planner, registry
 from vplane_mj.planning.params import Param
 from vplane_mj.reference import shortest_path
 from vplane_mj.robot import robot_radius_m
-from vplane_mj.scenario import Field, keys, parse_scenario
+from vplane_mj.scenario import Field, keys, load_scenario, parse_scenario
 from vplane_mj.sim import run_scenario
 from vplane_mj.summary import RunSummary
 
@@ -384,8 +388,14 @@ def _parent(path: str) -> str:
 
 
 def reported_key(err: str, source: str) -> str | None:
-    """The key path in `error: SOURCE: KEY: reason`, or None when the message has none."""
+    """The key path in `error: SOURCE: KEY: reason`, or in `error: --set KEY: reason (applied
+    to SOURCE)` (a key an override set); None when the message has none."""
     prefix = f"error: {source}: "
+    if err.startswith("error: --set"):
+        assert err.rstrip().endswith(f" (applied to {source})"), err[:500]
+        if err.startswith("error: --set: "):  # an override without a key
+            return None
+        prefix = "error: --set "
     assert err.startswith(prefix), err[:500]
     rest = err[len(prefix) :]
     match = re.match(r"((?:[A-Za-z0-9_-]+|\"(?:[^\"\\]|\\.)*\"|\[\d+\]|\.)+): ", rest)
@@ -675,13 +685,15 @@ ONCE_CRASHED = [
 
 @pytest.mark.parametrize("override, key", ONCE_CRASHED, ids=[key for _, key in ONCE_CRASHED])
 def test_values_that_once_crashed_a_run_are_rejected(tmp_path, capsys, override, key):
-    """Values that once ended a run in a traceback or outcome `error`: now invalid (exit 2, key named)."""
+    """Values that once ended a run in a traceback or outcome `error`: now invalid (exit 2, the
+    override and its key named)."""
     scenario = write_doc(tmp_path, base_doc("u"))
     out_dir = tmp_path / "out"
     out_dir.mkdir()
     argv = ["run", str(scenario), "--set", override, "--out", str(out_dir), "--no-log", "--no-render"]
     code, _, err = run_cli(capsys, *argv)
-    assert code == 2 and err.startswith(f"error: {scenario}: {key}: "), err[:300]
+    assert code == 2 and err.startswith(f"error: --set {key}: "), err[:300]
+    assert err.endswith(f" (applied to {scenario})\n"), err[-300:]
     assert list(out_dir.iterdir()) == []
 
 
@@ -855,3 +867,206 @@ def test_unusable_out_directory_exits_2_naming_it_and_writes_nothing(tmp_path, c
     assert out == ""
     assert sorted(tmp_path.rglob("*")) == before
     assert not list(Path("logs").glob("fuzz-*"))  # nor did it fall back to the default directory
+
+
+# --------------------------------------------------------------------------- 4. planners that raise
+
+RAISING_PLANNERS = """
+from vplane_mj.planning import Decision, Planner, PlannerParams
+
+
+class Boom(Planner):
+    name = "boom"
+    summary = "toward the goal for a second, then a bug"
+    citation = "none"
+    Params = PlannerParams
+
+    def step(self, obs):
+        if obs.time_s >= 1.0:
+            self.explode()
+        return Decision(force=obs.goal - obs.position, mode="normal")
+
+    def explode(self):
+        raise RuntimeError("kaboom")
+
+
+class BoomAtBirth(Boom):
+    name = "boom_at_birth"
+
+    def __init__(self, params, robot_radius_m):
+        raise RuntimeError("kaboom")
+"""
+
+
+@pytest.mark.parametrize(
+    "planner, log, raised_at_s",
+    [("Boom", True, 1.0), ("Boom", False, 1.0), ("BoomAtBirth", True, 0.0)],
+    ids=["in_step", "in_step_no_log", "in_constructor"],
+)
+def test_a_planner_that_raises_ends_its_run_in_error_and_keeps_the_log(tmp_path, planner, log, raised_at_s):
+    """`run --planner file.py:Class` whose planner raises: outcome `error`, its own exit status
+    (3), the exception and the planner's traceback in the summary, the log closed cleanly up to
+    the failing tick, and one line on stderr that says where they are."""
+    (tmp_path / "boom.py").write_text(RAISING_PLANNERS)
+    argv = ["run", "open_field", "--planner", f"boom.py:{planner}", "--out", "out", "--no-render"]
+    done = subprocess.run(
+        [sys.executable, "-m", "vplane_mj", *argv, *([] if log else ["--no-log"])],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 3, done.stderr
+    name = "boom" if planner == "Boom" else "boom_at_birth"
+    base = Path("out") / f"open_field-{name}-0"
+    summary = json.loads((tmp_path / base.with_suffix(".json")).read_text())
+    assert summary["outcome"] == "error" and summary["sim_time_s"] == raised_at_s
+    where = tmp_path / "boom.py"
+    raised = f"planner {name!r} raised at t = {raised_at_s:.3f} s: RuntimeError: kaboom (at {where}:"
+    assert summary["message"].startswith(raised)
+    trace = summary["traceback"]
+    assert trace.startswith("Traceback (most recent call last):")
+    assert trace.rstrip().endswith("RuntimeError: kaboom") and "vplane_mj/sim.py" not in trace
+    line = f"error: {summary['message']}; the exception and the planner's traceback are in {base}.json"
+    assert done.stderr == line + (f", the log up to it in {base}.mcap\n" if log else "\n")
+    assert (tmp_path / base.with_suffix(".mcap")).exists() == log
+    if log:
+        contents = read_log(tmp_path / base.with_suffix(".mcap"))
+        assert contents.complete and contents.summary == summary
+        assert contents.times_ns[-1] == round(raised_at_s * 1e9)  # up to the failing tick
+        assert contents.events[-1].text == summary["message"]
+
+
+def test_the_python_api_returns_the_run_of_a_planner_that_raises(tmp_path, own_registry):
+    """`vplane_mj.run` does not raise: the record holds the error, and the files are written."""
+    namespace: dict = {}
+    exec(compile(RAISING_PLANNERS, "raising_planners.py", "exec"), namespace)
+    register_planner(namespace["Boom"])
+    record = run(load_scenario("open_field", ["planner.name=boom"]), out=tmp_path, render=False)
+    assert record.summary.outcome == "error" and not record.reached
+    assert record.summary.message.startswith("planner 'boom' raised at t = 1.000 s: RuntimeError: kaboom")
+    assert 'File "raising_planners.py"' in record.summary.traceback
+    assert sorted(record.files) == ["log", "summary"]
+    assert read_log(record.files["log"]).summary == record.summary.to_dict()
+    assert record.summary.sim_time_s == 1.0 and record.trajectory.times[-1] == pytest.approx(0.95)
+
+
+# --------------------------------------------------------------------------- 5. mistaken names
+
+MISTAKES = [
+    (
+        ["run", "paper_c_escape", "--planner", "vplan"],
+        "error: --planner: unknown planner 'vplan'; available: apf, bug2, dwa, vfh, vobs, vplane, ",
+        "vplane_plus; did you mean 'vplane'?",
+    ),
+    (
+        ["run", "paper_c_escape", "--set", "planner.influense=0.6"],
+        "error: --set planner.influense: not a parameter of planner 'vplane' (attract_gain, ",
+        "; did you mean 'influence'? (applied to SCENARIO)",
+    ),
+    (
+        ["run", "paper_c_escape", "--set", "planner.name=vplane_pls"],
+        "error: --set planner.name: unknown planner 'vplane_pls'; available: ",
+        "; did you mean 'vplane_plus'? (applied to SCENARIO)",
+    ),
+    (
+        ["run", "paper_c_escape", "--set", "robot.gaol=[8, 2]"],
+        "error: --set robot.gaol: unknown key (allowed here: start, ",
+        "; did you mean 'goal'? (applied to SCENARIO)",
+    ),
+    (
+        ["run", "paper_c_escape", "--set", "robto.goal=[8, 2]"],
+        "error: --set robto.goal: unknown key (allowed here: format, ",
+        "; did you mean 'robot'? (applied to SCENARIO)",
+    ),
+    (
+        ["run", "paper_c_escape", "--set", "world.obstacles[0].kind=boz"],
+        "error: --set world.obstacles[0].kind: unknown obstacle kind 'boz' (known: ",
+        "; did you mean 'box'? (applied to SCENARIO)",
+    ),
+    (
+        ["run", "paper_c_escape", "--set", "sensors.pose=odometri"],
+        "error: --set sensors.pose: must be one of 'truth', 'odometry', got 'odometri'",
+        "; did you mean 'odometry'? (applied to SCENARIO)",
+    ),
+    (
+        ["run", "paper_c_escape", "--set", "run.sede=3"],
+        "error: --set run.sede: unknown key (allowed here: seed, ",
+        "; did you mean 'seed'? (applied to SCENARIO)",
+    ),
+    (
+        ["run", "paper_c_escape", "--seed", "-1"],
+        "error: --seed: must be at least 0, got -1",
+        " (applied to SCENARIO)",
+    ),
+    (
+        ["run", "paper_c_escap"],
+        "error: paper_c_escap: no such file or built-in scenario (built-in: ",
+        "; did you mean 'paper_c_escape'?",
+    ),
+    (
+        ["check", "paper_h_avoyd"],
+        "error: paper_h_avoyd: no such file or built-in scenario (built-in: ",
+        "; did you mean 'paper_h_avoid'?",
+    ),
+    (
+        ["bench", "open_field", "--planners", "apf,vpalne"],
+        "error: --planners: unknown planner 'vpalne'; available: ",
+        "; did you mean 'vplane'?",
+    ),
+    (
+        ["list", "--planner", "dwaa"],
+        "error: --planner: unknown planner 'dwaa'; available: ",
+        "; did you mean 'dwa'?",
+    ),
+    (
+        ["generate", "trap", "--out", "OUT"],
+        "error: family: unknown family 'trap' (known: barn, clutter, corridors, traps)",
+        "; did you mean 'traps'?",
+    ),
+]
+"""Mistakes on the command line, with how each message starts and ends: the option that
+was mistyped is named (not the scenario file it was applied to, for which SCENARIO stands),
+with the closest known name."""
+
+
+@pytest.mark.parametrize("argv, start, end", MISTAKES, ids=[" ".join(argv) for argv, *_ in MISTAKES])
+def test_a_mistaken_name_is_blamed_where_it_was_made_with_the_closest_known_one(
+    tmp_path, capsys, argv, start, end
+):
+    argv = [str(tmp_path / "out") if arg == "OUT" else arg for arg in argv]
+    if argv[0] in ("run", "bench"):
+        argv += ["--out", str(tmp_path / "out")]
+    code, out, err = run_cli(capsys, *argv)
+    scenario = load_scenario("paper_c_escape").source if "paper_c_escape" in argv else ""
+    end = end.replace("SCENARIO", scenario)
+    assert code == 2 and out == "" and err.count("\n") == 1, err
+    assert err.startswith(start) and err.rstrip("\n").endswith(end), err
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
+
+
+@pytest.mark.parametrize(
+    "table, key, value, hint",
+    [
+        ("", "robto", {"goal": GOAL}, "did you mean 'robot'?"),
+        ("robot", "gaol", GOAL, "did you mean 'goal'?"),
+        ("world", "boarder", True, "did you mean 'border'?"),
+        ("world.obstacles[0]", "centre", [2.0, 2.0], "did you mean 'center'?"),
+        ("sensors", "nois_std", 0.1, "did you mean 'noise_std'?"),
+        ("run", "time_limt_s", 10, "did you mean 'time_limit_s'?"),
+        ("planner", "plane_gian", 1.0, "did you mean 'plane_gain'?"),
+        ("planner", "name", "VPlane", "did you mean 'vplane'?"),
+    ],
+)
+def test_a_mistaken_name_in_a_file_is_blamed_on_the_file_with_the_closest_known_one(
+    tmp_path, capsys, table, key, value, hint
+):
+    """A mistyped key (or planner name) in any table of a file: the file, the key, the closest one."""
+    doc = base_doc()
+    target = doc["world"]["obstacles"][0] if table == "world.obstacles[0]" else doc.get(table, doc)
+    target[key] = value
+    scenario = write_doc(tmp_path, doc)
+    code, _, err = run_cli(capsys, "check", str(scenario))
+    where = f"{table}.{key}" if table else key
+    assert code == 2 and err.startswith(f"error: {scenario}: {where}: "), err
+    assert err.rstrip().endswith(hint), err

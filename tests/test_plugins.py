@@ -8,6 +8,7 @@ import json
 import multiprocessing
 import os
 import re
+import shlex
 import subprocess
 import sys
 import textwrap
@@ -29,7 +30,6 @@ from vplane_mj.planning import (
     load_planner,
     param,
     register_planner,
-    registry,
 )
 from vplane_mj.planning.plugins import canonical_spec
 from vplane_mj.robot import robot_radius_m
@@ -77,13 +77,6 @@ def vplane_mj(*args: str, cwd: Path, env: dict | None = None) -> subprocess.Comp
         timeout=300,
         env=env,
     )
-
-
-@pytest.fixture
-def own_registry(monkeypatch):
-    """A registry of this test's own: what it registers is gone afterwards."""
-    monkeypatch.setattr(registry, "PLANNERS", registry._Planners())
-    return registry.PLANNERS
 
 
 # -- a scenario file is data: it never imports ----------------------------------------------
@@ -195,11 +188,12 @@ def test_run_names_outputs_by_the_class_name_and_the_log_replays_without_it(tmp_
 def test_set_and_list_work_for_a_class_named_on_the_command_line(tmp_path):
     bad = vplane_mj("run", "open_field", "--planner", EXAMPLE_SPEC, "--set", "planner.walk_z=3", cwd=tmp_path)
     assert bad.returncode == 2
-    assert "open_field.toml: planner.walk_z: not a parameter of planner 'random_walk' (attract_gain," in (
-        bad.stderr
+    assert bad.stderr.startswith(
+        "error: --set planner.walk_z: not a parameter of planner 'random_walk' (attract_gain,"
     )
+    assert "; did you mean 'walk_s'? (applied to " in bad.stderr and "open_field.toml)" in bad.stderr
     low = vplane_mj("run", "open_field", "--planner", EXAMPLE_SPEC, "--set", "planner.walk_s=0", cwd=tmp_path)
-    assert low.returncode == 2 and "planner.walk_s: must be greater than 0, got 0" in low.stderr
+    assert low.returncode == 2 and "--set planner.walk_s: must be greater than 0, got 0" in low.stderr
     listed = vplane_mj("list", "--planner", EXAMPLE_SPEC, "--planner", "apf", cwd=tmp_path)
     assert listed.returncode == 0, listed.stderr
     lines = listed.stdout.splitlines()
@@ -279,7 +273,8 @@ def test_a_fresh_worker_registers_the_classes_the_job_names(own_registry):
     load_planner(EXAMPLE_SPEC)
     jobs = plan_jobs(["open_field"], ["random_walk", "apf"], [3], ["run.time_limit_s=2"])
     assert jobs[0].key.startswith("open_field|random_walk|3|")  # the key of a built-in's job, same form
-    assert jobs[0].planner_imports == (canonical_spec(EXAMPLE_SPEC),)  # what a worker must import
+    assert jobs[0].registered_planner == canonical_spec(EXAMPLE_SPEC)  # what a worker must import
+    assert jobs[1].registered_planner is None  # a built-in planner: nothing
     # A spawned process starts with nothing registered, as a Dask worker does.
     with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as pool:
         row = pool.submit(run_job, jobs[0]).result(timeout=300)
@@ -369,3 +364,148 @@ def test_sweep_takes_planner_classes_and_import_specs(own_registry):
     assert all(row["outcome"] == "timeout" for row in result.rows)  # 3 s is too short to arrive
     with pytest.raises(VPlaneError, match=r"^planners: nowhere:Nope: cannot import nowhere"):
         sweep(["open_field"], ["nowhere:Nope"], [0], jobs=1, out=None)
+
+
+# -- planners defined in the calling script -----------------------------------------------------
+
+SCRIPT_PLANNERS = """
+import json
+import sys
+import warnings
+from dataclasses import dataclass
+
+import vplane_mj
+from vplane_mj.planning import Decision, Planner, PlannerParams, param, register_planner
+
+with open("executions.txt", "a") as executions:  # a line each time this file runs
+    executions.write("ran\\n")
+
+
+@dataclass(frozen=True)
+class StraightParams(PlannerParams):
+    gain: float = param(0.5, "", "force per metre to the goal", gt=0)
+
+
+class Straight2(Planner):
+    name = "straight2"
+    summary = "straight to the goal"
+    citation = "none"
+    Params = StraightParams
+
+    def step(self, obs):
+        return Decision(force=self.params.gain * (obs.goal - obs.position), mode="normal")
+
+
+class Boom2(Straight2):
+    name = "boom2"
+    summary = "straight to the goal, and a bug after a second"
+
+    def step(self, obs):
+        if obs.time_s >= 1.0:
+            raise ZeroDivisionError("boom")
+        return super().step(obs)
+"""
+
+UNGUARDED_SWEEP = """
+scheduler = sys.argv[1] if len(sys.argv) > 1 else None
+register_planner(Straight2)
+planners = ["apf", Straight2 if scheduler else "straight2"]  # by class, or registered and by name
+result = vplane_mj.sweep(["open_field", "single_box"], planners, seeds=[0, 1], jobs=2,
+                         scheduler=scheduler, out=None, overrides=["run.time_limit_s=25"])
+print(json.dumps([[row["scenario"], row["planner"], row["seed"], row["outcome"]] for row in result.rows]))
+"""
+
+
+def run_script(path: Path, *args: str) -> subprocess.CompletedProcess:
+    """`python SCRIPT ARGS` in the script's directory, as a user runs their script."""
+    return subprocess.run(
+        [sys.executable, path.name, *args], cwd=path.parent, capture_output=True, text=True, timeout=600
+    )
+
+
+@pytest.mark.parametrize("engine", ["local", "dask"])
+def test_a_planner_class_of_the_calling_script_runs_in_the_workers(tmp_path, engine):
+    script = tmp_path / "my_sweep.py"
+    script.write_text(SCRIPT_PLANNERS + UNGUARDED_SWEEP)  # no `if __name__ == "__main__":`
+    if engine == "local":
+        done = run_script(script)
+    else:
+        distributed = pytest.importorskip("distributed")
+        with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster:
+            done = run_script(script, cluster.scheduler_address)
+    assert done.returncode == 0, done.stderr
+    rows = json.loads(done.stdout.splitlines()[-1])
+    assert [row[:3] for row in rows] == [
+        [scenario, planner, seed]
+        for scenario in ("open_field", "single_box")
+        for planner in ("apf", "straight2")
+        for seed in (0, 1)
+    ]
+    assert all(outcome != "error" for *_, outcome in rows), rows
+    assert [outcome for scenario, planner, _, outcome in rows if scenario == "open_field"] == ["reached"] * 4
+    # The workers got the class without running the script again (its sweep included).
+    assert (tmp_path / "executions.txt").read_text() == "ran\n"
+    assert "SweepErrorWarning" not in done.stderr
+
+
+GUARDED_SWEEP_WITH_ERRORS = """
+if __name__ == "__main__":
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = vplane_mj.sweep(["open_field"], ["apf", Straight2, Boom2], seeds=[0, 1], jobs=2,
+                                 out="out", report=False, overrides=["run.time_limit_s=25"])
+    said = [(warning.category.__name__, str(warning.message)) for warning in caught]
+    print(json.dumps({"warnings": said, "errors": result.errors}))
+"""
+
+
+def test_a_sweep_whose_planner_raises_warns_and_each_error_runs_again_by_its_command(tmp_path):
+    script = tmp_path / "my_sweep.py"
+    script.write_text(SCRIPT_PLANNERS + GUARDED_SWEEP_WITH_ERRORS)
+    done = run_script(script)
+    assert done.returncode == 0, done.stderr
+    said = json.loads(done.stdout.splitlines()[-1])
+    [(category, warning)] = said["warnings"]
+    raised = f"planner 'boom2' raised at t = 1.000 s: ZeroDivisionError: boom (at {script}:"
+    assert category == "SweepErrorWarning"
+    first = "the first, open_field with boom2 and seed 0"
+    assert warning.startswith(f"2 of 6 runs ended in error (SweepResult.errors); {first}: {raised}")
+    assert [(row["planner"], row["seed"]) for row in said["errors"]] == [("boom2", 0), ("boom2", 1)]
+    error = said["errors"][0]
+    assert error["message"].startswith(raised) and error["message"].endswith(" in step)")
+    assert error["traceback"].rstrip().endswith("ZeroDivisionError: boom")
+    saved = Path("out") / "failed" / "open_field-boom2-0.toml"
+    assert error["failed_scenario"] == str(saved)
+    assert error["rerun"] == f"vplane-mj run {saved} --planner {script}:Boom2"
+    assert (tmp_path / saved).read_text().splitlines()[:2] == [
+        "# A run of a sweep that ended in error; to run it again:",
+        f"# {error['rerun']}",
+    ]
+    assert "ZeroDivisionError: boom" in (tmp_path / saved.with_suffix(".traceback.txt")).read_text()
+    # The command runs it again: the same run, the same error (exit 3), not an unknown planner.
+    again = vplane_mj(*shlex.split(error["rerun"])[1:], "--out", "again", "--no-render", cwd=tmp_path)
+    assert again.returncode == 3, again.stderr
+    rerun = json.loads((tmp_path / "again" / "open_field-boom2-0.json").read_text())
+    assert rerun["message"] == error["message"] and rerun["sim_time_s"] == error["sim_time_s"]
+    assert (tmp_path / "executions.txt").read_text() == "ran\n" * 2  # the script, then its import
+
+
+def test_the_readme_planner_snippets_run_as_a_script(tmp_path, readme_examples):
+    """The code of "Your own planner", as a user's script: the planner class, registered in
+    code, run by `vplane_mj.run` and swept by `vplane_mj.sweep` with a planner file."""
+    script = tmp_path / "readme_planner.py"
+    script.write_text(readme_examples("Your own planner"))
+    done = subprocess.run(
+        [sys.executable, str(script)], cwd=ROOT, capture_output=True, text=True, timeout=600
+    )
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert lines[0] == "reached 0.6"
+    header, *table = lines[1:]
+    assert header.split()[:3] == ["planner", "runs", "success_rate"]
+    assert [(row.split()[0], row.split()[1]) for row in table] == [
+        ("apf", "4"),
+        ("cautious", "4"),
+        ("random_walk", "4"),
+    ]
+    assert "SweepErrorWarning" not in done.stderr

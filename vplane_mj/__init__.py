@@ -33,7 +33,7 @@ _EXPORTS = {
     "vplane_mj.summary": ("Outcome", "RunSummary"),
     "vplane_mj.planning.events": ("EventKind",),
     "vplane_mj.runner": ("RunEvent", "RunRecord", "Trajectory", "run"),
-    "vplane_mj.sweeps": ("SweepResult", "sweep"),
+    "vplane_mj.sweeps": ("SweepErrorWarning", "SweepResult", "sweep"),
 }
 """Module -> the public names it provides."""
 _MODULE_OF = {name: module for module, names in _EXPORTS.items() for name in names}
@@ -46,6 +46,7 @@ __all__ = [
     "RunSummary",
     "Scenario",
     "ScenarioError",
+    "SweepErrorWarning",
     "SweepResult",
     "Trajectory",
     "VPlaneError",
@@ -76,7 +77,7 @@ if TYPE_CHECKING:
         wall,
     )
     from vplane_mj.summary import Outcome, RunSummary
-    from vplane_mj.sweeps import SweepResult, sweep
+    from vplane_mj.sweeps import SweepErrorWarning, SweepResult, sweep
 
 
 def __getattr__(name: str) -> Any:

@@ -30,7 +30,7 @@ from pathlib import Path
 from vplane_mj.errors import VPlaneError
 from vplane_mj.failures import (
     FAILED_DIR,
-    FAILED_SCENARIO_KEY,
+    RERUN_KEY,
     FailureKind,
     RunFailure,
     call_or_failure,
@@ -38,8 +38,10 @@ from vplane_mj.failures import (
     finished_row,
 )
 from vplane_mj.outputs import write_atomically, write_json
+from vplane_mj.planning.registry import WorkerPlanner, for_worker
 from vplane_mj.pool import run_in_pool
 from vplane_mj.scenario import load_scenario
+from vplane_mj.scenario.overrides import Override
 
 JOURNAL = "bench.jsonl"
 TABLE_COLUMNS = (
@@ -62,16 +64,18 @@ TABLE_COLUMNS = (
 class Job:
     """One run of a sweep: the resolved scenario text and where it came from.
 
-    `planner_imports` are the planner classes the user named by import spec (`module:Class`,
-    `/abs/path/file.py:Class`): a worker registers them before it reads the scenario. They are
-    not part of the key: a run is the same run whichever way its planner was found.
+    `registered_planner` is the job's planner when it was registered in the calling process,
+    as the worker registers it before it reads the scenario (`registry.for_worker`: an import
+    spec such as `module:Class` or `/abs/path/file.py:Class`, or a class of the calling
+    script); None for a built-in or installed one. It is not part of the key: a run is the
+    same run whichever way its planner was found.
     """
 
     scenario: str
     planner: str
     seed: int
     toml: str
-    planner_imports: tuple[str, ...] = ()
+    registered_planner: WorkerPlanner | None = None
 
     @property
     def key(self) -> str:
@@ -101,27 +105,27 @@ def parse_seeds(text: str) -> list[int]:
     return sorted(seeds)
 
 
+def job_choice(planner: str, seed: int) -> tuple[Override, Override]:
+    """The overrides that make a scenario one job's run: its planner and seed (named in
+    messages as the sweep's `planners` and `seeds`)."""
+    return Override(f"planner.name={planner}", "planners"), Override(f"run.seed={seed}", "seeds")
+
+
 def plan_jobs(
-    scenarios: Iterable[str], planners: Iterable[str], seeds: Iterable[int], overrides: Iterable[str] = ()
+    scenarios: Iterable[str],
+    planners: Iterable[str],
+    seeds: Iterable[int],
+    overrides: Iterable[str | Override] = (),
 ) -> list[Job]:
     """Every combination, with `--set` style overrides, each validated as `vplane-mj run` would;
-    the import specs of the planners registered in this process go with every job to its worker."""
-    planners = list(planners)
-    imports = worker_imports(planners)
+    a planner registered in this process goes with each of its jobs to the worker (`Job`)."""
     jobs = []
     for ref in scenarios:
         for planner in planners:
             for seed in seeds:
-                scenario = load_scenario(ref, [*overrides, f"planner.name={planner}", f"run.seed={seed}"])
-                jobs.append(Job(scenario.name, planner, seed, scenario.to_toml(), imports))
+                scenario = load_scenario(ref, [*overrides, *job_choice(planner, seed)])
+                jobs.append(Job(scenario.name, planner, seed, scenario.to_toml(), for_worker(planner)))
     return jobs
-
-
-def worker_imports(planners: Iterable[str]) -> tuple[str, ...]:
-    """The import specs a worker needs for these planners (none for built-in or installed ones)."""
-    from vplane_mj.planning.registry import worker_spec
-
-    return tuple(dict.fromkeys(spec for name in planners if (spec := worker_spec(name))))
 
 
 PATH_KEY = "path_xy"
@@ -133,13 +137,13 @@ PATH_TOLERANCE_M = 0.02
 def run_job(job: Job) -> dict:
     """Run one job (in a worker process): its summary, the job's key and, under PATH_KEY,
     the travelled path simplified to PATH_TOLERANCE_M (for the report's picture of it)."""
-    from vplane_mj.planning.registry import load_planner
+    from vplane_mj.planning.registry import register_in_worker
     from vplane_mj.polyline import PathSimplifier
     from vplane_mj.scenario import parse_scenario
     from vplane_mj.sim import run_scenario
 
-    for spec in job.planner_imports:
-        load_planner(spec)
+    if job.registered_planner is not None:
+        register_in_worker(job.registered_planner)
     result = run_scenario(parse_scenario(job.toml, f"{job.scenario} (bench)"))
     path = PathSimplifier(PATH_TOLERANCE_M)
     for x, y in (*result.positions, result.final_pose[:2]):
@@ -324,17 +328,19 @@ MAX_ERRORS_LISTED = 10
 
 def error_lines(rows: list[dict], out_dir: Path) -> list[str]:
     """How many runs ended in `error` and where their scenarios are, then the first
-    MAX_ERRORS_LISTED of them with their messages; nothing when none did."""
+    MAX_ERRORS_LISTED of them, each with its message and the command that runs it again;
+    nothing when none did."""
     errors = [row for row in rows if row["outcome"] == "error"]
     if not errors:
         return []
     lines = [
         f"{len(errors)} of {len(rows)} runs ended in error; their scenarios are in "
-        f"{out_dir / FAILED_DIR} (vplane-mj run FILE runs one again):"
+        f"{out_dir / FAILED_DIR}, each run again by the command below it:"
     ]
     for row in errors[:MAX_ERRORS_LISTED]:
-        where = row.get(FAILED_SCENARIO_KEY) or f"{row['scenario']}, {row['planner']}, seed {row['seed']}"
-        lines.append(f"  {where}: {row['message']}")
+        lines.append(f"  {row['scenario']}, {row['planner']}, seed {row['seed']}: {row['message']}")
+        if RERUN_KEY in row:
+            lines.append(f"    {row[RERUN_KEY]}")
     if len(errors) > MAX_ERRORS_LISTED:
         lines.append(f"  and {len(errors) - MAX_ERRORS_LISTED} more (bench.csv has them all)")
     return lines

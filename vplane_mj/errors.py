@@ -8,13 +8,19 @@ class VPlaneError(Exception):
 
 
 class ScenarioError(VPlaneError):
-    """Invalid scenario input: names the file, the key path and the reason."""
+    """Invalid scenario input: names the file, the key path and the reason; or, when an
+    override (`--set KEY=VALUE`, `--seed N`) set the key, that override (`origin`) first."""
 
-    def __init__(self, source: str, key: str, reason: str):
+    def __init__(self, source: str, key: str, reason: str, origin: str = ""):
         self.source = source
         self.key = key
         self.reason = reason
-        super().__init__(f"{source}: {key}: {reason}" if key else f"{source}: {reason}")
+        self.origin = origin
+        if origin:
+            message = f"{origin}: {reason} (applied to {source})"
+        else:
+            message = f"{source}: {key}: {reason}" if key else f"{source}: {reason}"
+        super().__init__(message)
 
 
 class WorldFileError(VPlaneError):

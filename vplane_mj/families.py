@@ -400,10 +400,15 @@ def generate(
 
     Candidates are drawn from one generator seeded with `seed`, so the same arguments always
     give the same files; a candidate that fails validation or has no path is drawn again.
+    An unknown family is a VPlaneError that names the closest one.
     """
-    from vplane_mj.errors import ScenarioError
+    from vplane_mj.errors import ScenarioError, VPlaneError
     from vplane_mj.scenario import parse_scenario
+    from vplane_mj.suggestions import did_you_mean
 
+    if family not in FAMILIES:
+        hint = did_you_mean(family, FAMILIES)
+        raise VPlaneError(f"family: unknown family {family!r} (known: {', '.join(sorted(FAMILIES))}){hint}")
     if has_path is None:
         has_path = _robot_has_path
     rng = np.random.default_rng(seed)

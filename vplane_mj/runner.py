@@ -99,7 +99,10 @@ def run(
     with `log` the `.mcap` log, with `render` the `.png` render, with `video` an `.mp4`
     replay (from the log); `out=None` writes nothing. Invalid input raises a VPlaneError
     before anything is written. Interrupted (KeyboardInterrupt) during the simulation, the
-    log is closed cleanly and kept; files are always whole or absent.
+    log is closed cleanly and kept; files are always whole or absent. A planner whose code
+    raises does not make `run` raise: the run ends with outcome `error`, `summary.message`
+    names the exception and where, `summary.traceback` holds the planner's traceback, and
+    the files are written as for any run (the log up to the failing tick).
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(os.fspath(scenario))

@@ -1,7 +1,9 @@
 """A run: physics at a fixed step, wheel PI at the motor rate, range sensor + planner at control_hz.
 
 `Run` steps one control tick at a time (`step`) and decides in one place how the run ends
-(`_ending`: the six ways, in the order they are checked); `run_scenario` runs it to the end.
+(`_ending`: the six ways, in the order they are checked), besides the planner's code raising,
+which ends it as `error` with the exception kept (`_planner_raised`); `run_scenario` runs it
+to the end.
 A tick is two halves: `observe` (sense) and `apply` (a decision drives the wheels), so that
 a decision can also come from outside (the reinforcement-learning environments, through
 `vplane_mj.navigation_task`). The robot is the scenario's profile; the planner sees only an
@@ -24,6 +26,9 @@ import numpy as np
 from vplane_mj import __version__, shapes
 from vplane_mj.control import heading_command
 from vplane_mj.drive import BELIEF_PATIENCE_S, CollisionCounter, Drive, Localiser
+from vplane_mj.errors import VPlaneError
+from vplane_mj.failures import RunFailure, failure_of
+from vplane_mj.interrupts import Interrupted
 from vplane_mj.metrics import Clearance, motion_quality, path_quality, trajectory_digest, travelled
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.registry import make_planner
@@ -125,9 +130,16 @@ class Run:
         self.body = robot_body(profile, scenario.sensors.kind)
         self.radius = self.drive.geometry["radius_m"]
         self.planner_name = EXTERNAL_PLANNER if external else scenario.planner
-        self.planner = (
-            None if external else make_planner(scenario.planner, scenario.planner_params, self.body)
-        )
+        self.planner_failure: RunFailure | None = None  # what the planner's code raised, if it did
+        failed: Exception | None = None
+        try:
+            self.planner = (
+                None if external else make_planner(scenario.planner, scenario.planner_params, self.body)
+            )
+        except (VPlaneError, Interrupted):  # no planner by that name, or bad parameters
+            raise
+        except Exception as exc:  # the planner's constructor: the run ends at once as `error`
+            self.planner, failed = None, exc
         world = scenario.world
         self.clearance = Clearance(
             shapes.scene_footprints(world.obstacles, world.size if world.border else None),
@@ -161,18 +173,27 @@ class Run:
                 f"run started: {scenario.name}, planner {self.planner_name}, seed {scenario.run.seed}",
             )
         )
+        if failed is not None:
+            self._planner_raised(failed)
 
     # -- the loop ---------------------------------------------------------------------------
     def step(self) -> Ending | None:
         """One control tick with the planner: `observe`, its decision, `apply`; the ending once
-        the run is over (it stays over)."""
-        if self.planner is None:
+        the run is over (it stays over). The planner raising ends the run as `error`."""
+        planner = self.planner
+        if planner is None and self.ending is None:
             raise RuntimeError("step: this run's decisions come from outside: use observe and apply")
         observation = self.observe()
-        if observation is None:
+        if observation is None or planner is None:
             return self.ending
         started = time.perf_counter()
-        decision = self.planner.step(observation)
+        try:
+            decision = planner.step(observation)
+        except Interrupted:
+            raise
+        except Exception as exc:  # the planner's own code: kept with its traceback
+            self._observation = None
+            return self._planner_raised(exc)
         elapsed = time.perf_counter() - started
         self.planner_cpu.append(elapsed)
         self.wall_time_s += elapsed
@@ -350,6 +371,16 @@ class Run:
         for observer in self.observers:
             observer.on_event(self.data.time, event)
 
+    def _planner_raised(self, exc: Exception) -> Ending:
+        """End the run as `error` on an exception of the planner's code, kept in
+        `planner_failure` with its traceback from the planner's call on."""
+        trace = exc.__traceback__
+        self.planner_failure = failure = failure_of(exc, trace.tb_next if trace else None)
+        text = f"planner {self.planner_name!r} raised at t = {self.data.time:.3f} s: {failure.message}"
+        ending = Ending(Outcome.ERROR, Event(EventKind.ERROR, text))
+        self._finish(ending)
+        return ending
+
     def _finish(self, ending: Ending) -> None:
         """Note how the run ended and show the observers the state it ended in."""
         self.ending = ending
@@ -435,6 +466,7 @@ class Run:
             odometry_error_m=self.localiser.error(self.position),
             trajectory_sha256=trajectory_digest(self.positions, self.position, self.drive.yaw()),
             message="" if reached or ending.outcome is Outcome.TIMEOUT else ending.event.text,
+            traceback=self.planner_failure.traceback if self.planner_failure else "",
             planner_params={} if self.planner is None else self.planner.params.as_dict(),
             version=__version__,
         )

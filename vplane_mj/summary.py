@@ -24,7 +24,8 @@ class Outcome(StrEnum):
     STUCK = "stuck"
     """The planner gave up, or odometry held the robot at a goal it had not reached."""
     ERROR = "error"
-    """The simulation or the planner failed (a MuJoCo warning, a non-finite state or force)."""
+    """The simulation or the planner failed (a MuJoCo warning, a non-finite state or force, an
+    exception raised by the planner's code)."""
 
 
 @dataclass(frozen=True)
@@ -67,6 +68,9 @@ class RunSummary:
     odometry_error_m: float | None = None
     trajectory_sha256: str = ""
     message: str = ""
+    traceback: str = ""
+    """The planner's traceback when its code raised (outcome `error`, `message` names the
+    exception and where); empty otherwise."""
     planner_params: dict[str, float] = field(default_factory=dict)
     version: str = ""
     format: int = SUMMARY_FORMAT

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -14,20 +15,26 @@ from pathlib import Path
 from vplane_mj.bench import (
     Job,
     format_table,
+    job_choice,
     parse_seeds,
     plan_jobs,
     run_sweep,
     summarize,
-    worker_imports,
     write_outputs,
 )
 from vplane_mj.errors import VPlaneError
 from vplane_mj.outputs import DEFAULT_OUT, output_directory
+from vplane_mj.planning import registry
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.plugins import PlannerError, is_import_spec
-from vplane_mj.planning.registry import PLANNERS, load_planner, register_planner
+from vplane_mj.planning.registry import for_worker, load_planner, register_planner, unknown_planner
 from vplane_mj.scenario import Scenario, parse_scenario
-from vplane_mj.summary import RunSummary
+from vplane_mj.summary import Outcome, RunSummary
+
+
+class SweepErrorWarning(UserWarning):
+    """Some runs of a sweep ended in `error` (a planner raised, a worker died, ...): `sweep`
+    returns their rows all the same (`SweepResult.errors`) and warns once with their count."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -39,6 +46,12 @@ class SweepResult:
     rows: list[dict]
     table: list[dict]
     files: tuple[Path, ...]
+
+    @property
+    def errors(self) -> list[dict]:
+        """The rows of the runs that ended in `error` (each with its `message`; in a kept output
+        directory also its `failed_scenario` and `rerun`), in row order."""
+        return [row for row in self.rows if row["outcome"] == Outcome.ERROR]
 
     def summaries(self) -> list[RunSummary]:
         """The rows as run summaries."""
@@ -76,7 +89,7 @@ def sweep(
     workers = (os.cpu_count() or 1) if jobs is None else jobs
     if workers < 1:
         raise VPlaneError(f"jobs: must be at least 1, got {workers}")
-    chosen = sorted(PLANNERS) if planners is None else [planner_name(p) for p in planners]
+    chosen = sorted(registry.PLANNERS) if planners is None else [planner_name(p) for p in planners]
     seed_list = parse_seeds(seeds) if isinstance(seeds, str) else list(seeds)
 
     def sweep_into(out_dir: Path, report: bool) -> SweepResult:
@@ -88,20 +101,37 @@ def sweep(
 
     if out is None:
         with tempfile.TemporaryDirectory(prefix="vplane-mj-sweep-") as scratch:
-            return sweep_into(Path(scratch), report=False)
-    with output_directory(Path(out)) as out_dir:
-        return sweep_into(out_dir, report)
+            result = sweep_into(Path(scratch), report=False)
+    else:
+        with output_directory(Path(out)) as out_dir:
+            result = sweep_into(out_dir, report)
+    if result.errors:
+        warnings.warn(_errors_warning(result), SweepErrorWarning, stacklevel=2)
+    return result
+
+
+def _errors_warning(result: SweepResult) -> str:
+    """The warning of a sweep some of whose runs ended in `error`: how many, and the first."""
+    first = result.errors[0]
+    return (
+        f"{len(result.errors)} of {len(result.rows)} runs ended in error (SweepResult.errors); "
+        f"the first, {first['scenario']} with {first['planner']} and seed {first['seed']}: {first['message']}"
+    )
 
 
 def planner_name(planner: str | type[Planner], option: str = "planners") -> str:
-    """The name a sweep's rows give `planner`: a name as it is; an import spec or a class
-    registered here first (a VPlaneError naming `option` when it is no valid planner)."""
+    """The name a sweep's rows give `planner`: a known name as it is; an import spec or a
+    class registered here first (a VPlaneError naming `option` when it is no valid planner)."""
     try:
         if isinstance(planner, type):
             return register_planner(planner).name
-        return load_planner(planner).name if is_import_spec(planner) else planner
+        if is_import_spec(planner):
+            return load_planner(planner).name
     except PlannerError as exc:
         raise VPlaneError(f"{option}: {exc}") from None
+    if planner not in registry.PLANNERS:
+        raise VPlaneError(f"{option}: {unknown_planner(planner)}")
+    return planner
 
 
 def _plan(
@@ -125,10 +155,9 @@ def _jobs_of(
     scenario: Scenario, planners: list[str], seeds: list[int], overrides: Sequence[str]
 ) -> list[Job]:
     """The jobs of one Scenario object, validated as `plan_jobs` validates a file's."""
-    text, jobs, imports = scenario.to_toml(), [], worker_imports(planners)
+    text, jobs = scenario.to_toml(), []
     for planner in planners:
         for seed in seeds:
-            choice = [*overrides, f"planner.name={planner}", f"run.seed={seed}"]
-            resolved = parse_scenario(text, scenario.source, choice)
-            jobs.append(Job(resolved.name, planner, seed, resolved.to_toml(), imports))
+            resolved = parse_scenario(text, scenario.source, [*overrides, *job_choice(planner, seed)])
+            jobs.append(Job(resolved.name, planner, seed, resolved.to_toml(), for_worker(planner)))
     return jobs

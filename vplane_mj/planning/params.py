@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from typing import Any, Self
 
 from vplane_mj.errors import VPlaneError
+from vplane_mj.suggestions import did_you_mean
 
 MAX_MAGNITUDE = 1e6
 """No planner parameter may exceed this in absolute value: a larger one is surely a mistake,
@@ -110,7 +111,10 @@ class PlannerParams:
         for key, value in overrides.items():
             spec = table.get(key)
             if spec is None:
-                raise ParamError(key, f"not a parameter of planner {planner!r} ({', '.join(table)})")
+                known = ", ".join(table)
+                raise ParamError(
+                    key, f"not a parameter of planner {planner!r} ({known}){did_you_mean(key, table)}"
+                )
             reason = spec.check(value)
             if reason:
                 raise ParamError(key, reason)

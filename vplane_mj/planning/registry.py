@@ -20,6 +20,7 @@ from vplane_mj.planning.base import Planner
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.params import PlannerInfo
 from vplane_mj.planning.plugins import PlannerError, canonical_spec, import_planner, planner_problem
+from vplane_mj.suggestions import did_you_mean
 
 if TYPE_CHECKING:
     from importlib.metadata import EntryPoint
@@ -50,7 +51,7 @@ class _Planners(Mapping[str, type[Planner]]):
         self._classes: dict[str, type[Planner]] = {}
         self._registered: list[str] = []
         self._specs: dict[str, type[Planner]] = {}
-        self._worker_specs: dict[str, str | None] = {}
+        self._command_specs: dict[str, str | None] = {}
         self._installed: dict[str, EntryPoint] | None = None
 
     def installed(self) -> dict[str, EntryPoint]:
@@ -109,7 +110,7 @@ class _Planners(Mapping[str, type[Planner]]):
             raise PlannerError(f"{where}: the name {name!r} is taken by {taken}")
         self._classes[name] = cls
         self._registered.append(name)
-        self._worker_specs[name] = _importable_spec(cls)
+        self._command_specs[name] = _command_line_spec(cls)
         return cls
 
     def load(self, spec: str) -> type[Planner]:
@@ -119,18 +120,39 @@ class _Planners(Mapping[str, type[Planner]]):
         if cls is None:
             cls = self.register(import_planner(spec), source=spec)
             self._specs[key] = cls
-            self._worker_specs[cls.name] = key
+            self._command_specs[cls.name] = key
         return cls
 
-    def worker_spec(self, name: str) -> str | None:
-        """The import spec another process (a sweep's worker) imports to know planner `name`:
-        None for a built-in or installed planner, which every process knows by its name."""
-        return self._worker_specs.get(name)
+    def for_worker(self, name: str) -> WorkerPlanner | None:
+        """What another process (a sweep's worker) registers to know planner `name`: None for a
+        built-in or installed planner, which every process knows by its name; the import spec of
+        a class from a module or a planner file; the class itself when it comes from the script
+        being run (`__main__`), which a worker must not import: importing a script runs it."""
+        if name not in self._registered:
+            return None
+        cls = self._classes[name]
+        if cls.__module__ == "__main__" and "<locals>" not in cls.__qualname__:
+            return cls
+        return self._command_specs[name]
+
+    def command_line_spec(self, name: str) -> str | None:
+        """The `--planner` import spec that names registered planner `name` on the command line
+        (for a class of the script being run, the script's file), or None when there is none."""
+        return self._command_specs.get(name)
 
 
-def _importable_spec(cls: type) -> str | None:
+WorkerPlanner = str | type[Planner]
+"""A registered planner as a sweep's job carries it to its worker: an import spec, or a class
+of the calling script (`__main__`). Such a class travels by reference to the local pool's
+workers, forked with it already registered, and by value (cloudpickle) to Dask's workers."""
+
+
+def _command_line_spec(cls: type) -> str | None:
     """`module:Class` for a class another process can import; for a class of the script being
-    run (`__main__`), that script's file; None when neither exists (an interactive session)."""
+    run (`__main__`), that script's file; None when neither exists (an interactive session, a
+    class defined in a function)."""
+    if "<locals>" in cls.__qualname__:
+        return None
     if cls.__module__ != "__main__":
         return _qualified(cls)
     script = getattr(sys.modules["__main__"], "__file__", None)
@@ -169,9 +191,26 @@ def load_planner(spec: str) -> type[Planner]:
     return PLANNERS.load(spec)
 
 
-def worker_spec(name: str) -> str | None:
-    """How a worker process imports registered planner `name` (None: it needs no import)."""
-    return PLANNERS.worker_spec(name)
+def command_line_spec(name: str) -> str | None:
+    """The `--planner` import spec of registered planner `name`, or None (see `_Planners`)."""
+    return PLANNERS.command_line_spec(name)
+
+
+def for_worker(name: str) -> WorkerPlanner | None:
+    """What a worker process registers to know planner `name` (None: nothing, it knows it)."""
+    return PLANNERS.for_worker(name)
+
+
+def register_in_worker(planner: WorkerPlanner) -> type[Planner]:
+    """In a worker process: register what `for_worker` gave (a class already registered here,
+    as in a forked worker, is left as it is)."""
+    return load_planner(planner) if isinstance(planner, str) else register_planner(planner)
+
+
+def unknown_planner(name: str, note: str = "") -> str:
+    """Why `name` names no planner: the planners available, and the closest name to it."""
+    known = ", ".join(sorted(PLANNERS))
+    return f"unknown planner {name!r}{note}; available: {known}{did_you_mean(name, PLANNERS)}"
 
 
 def planner_info(name: str) -> PlannerInfo:

@@ -34,8 +34,10 @@ from vplane_mj.scenario.keys import (
     MIN_OBSTACLE_M,
     NAME_PATTERN,
 )
+from vplane_mj.scenario.overrides import Override
 from vplane_mj.scenario.parse import parse_document, parse_scenario
 from vplane_mj.scenario.spec import RobotSpec, RunSpec, Scenario, SensorSpec, WorldSpec
+from vplane_mj.suggestions import did_you_mean
 
 __all__ = [
     "CODE_SOURCE",
@@ -83,8 +85,20 @@ def resolve_path(ref: str) -> Path:
                 return candidate
     if ref and path.is_dir():
         raise ScenarioError(ref, "", "is a directory, not a scenario file")
-    names = ", ".join(builtin.stem for builtin in _builtin_paths()) or "none"
-    raise ScenarioError(ref, "", f"no such file or built-in scenario (built-in: {names})")
+    builtin = [builtin.stem for builtin in _builtin_paths()]
+    reason = f"no such file or built-in scenario (built-in: {', '.join(builtin) or 'none'})"
+    raise ScenarioError(ref, "", reason + _closest_scenario(ref, builtin))
+
+
+def _closest_scenario(ref: str, builtin: list[str]) -> str:
+    """The "did you mean" of a scenario that does not exist: for a name, the closest name in
+    ./scenarios/ or among the built-in ones; for a path, the closest file beside it."""
+    path = Path(ref)
+    if NAME_PATTERN.fullmatch(ref):
+        return did_you_mean(ref, [*(found.stem for found in Path("scenarios").glob("*.toml")), *builtin])
+    if not path.parent.is_dir():
+        return ""
+    return did_you_mean(ref, [str(found) for found in path.parent.glob("*.toml")])
 
 
 def _read_text(path: Path, source: str) -> str:
@@ -100,7 +114,7 @@ def _read_text(path: Path, source: str) -> str:
         raise ScenarioError(source, "", reason) from None
 
 
-def load_scenario(ref: str, overrides: Sequence[str] = ()) -> Scenario:
+def load_scenario(ref: str, overrides: Sequence[str | Override] = ()) -> Scenario:
     """Read, parse, override and validate the scenario `ref` (a path or a scenario name).
 
     The source named in messages is `ref` itself when it is a path, else the file found.

@@ -16,6 +16,8 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, TypeGuard
 
+from vplane_mj.suggestions import did_you_mean
+
 
 class Invalid(Exception):
     """A rule broken at `key`; parse_scenario turns it into a ScenarioError."""
@@ -121,7 +123,8 @@ def _check_str(value: object, field: Field) -> str | None:
     if not isinstance(value, str):
         return f"must be a string, got {type_name(value)}"
     if field.choices and value not in field.choices:
-        return f"must be one of {', '.join(map(repr, field.choices))}, got {value!r}"
+        choices = ", ".join(map(repr, field.choices))
+        return f"must be one of {choices}, got {value!r}{did_you_mean(value, field.choices)}"
     return None
 
 
@@ -197,7 +200,8 @@ def _reject_unknown(table: Mapping[str, Any], path: str, allowed: Sequence[str])
     """Fail on the first key of `table` that is not in `allowed`."""
     for key in table:
         if key not in allowed:
-            raise Invalid(join_key(path, key), f"unknown key (allowed here: {', '.join(allowed)})")
+            reason = f"unknown key (allowed here: {', '.join(allowed)}){did_you_mean(key, allowed)}"
+            raise Invalid(join_key(path, key), reason)
 
 
 def checked(value: Any, field: Field, key: str) -> Any:

@@ -14,7 +14,7 @@ from typing import Any
 
 from vplane_mj.errors import ScenarioError
 from vplane_mj.scenario.fields import Invalid
-from vplane_mj.scenario.overrides import apply_override
+from vplane_mj.scenario.overrides import Override, apply_override
 from vplane_mj.scenario.placement import check_placement
 from vplane_mj.scenario.sections import read_planner, read_robot, read_run, read_sensors, read_top, read_world
 from vplane_mj.scenario.spec import Scenario
@@ -51,6 +51,22 @@ def _build_scenario(doc: dict[str, Any], source: str, recorded: bool) -> Scenari
     return scenario
 
 
+def _origin(key: str, applied: list[tuple[str, Override]]) -> str:
+    """How an error at `key` names the last override that set it, a table or array that holds
+    it, or a key inside it (the override made the table at `key`); "" when none did."""
+    for path, override in reversed(applied):
+        if key == path or _inside(key, path):
+            return override.origin(key)
+        if _inside(path, key):
+            return override.origin(path)
+    return ""
+
+
+def _inside(key: str, path: str) -> bool:
+    """Whether `key` lies inside the table or array at `path`."""
+    return key.startswith((f"{path}.", f"{path}["))
+
+
 def _parse_toml(text: str, source: str) -> dict[str, Any]:
     """The TOML document, or a ScenarioError quoting tomllib (line and column)."""
     try:
@@ -59,7 +75,9 @@ def _parse_toml(text: str, source: str) -> dict[str, Any]:
         raise ScenarioError(source, "", f"invalid TOML: {exc}") from None
 
 
-def parse_scenario(text: str, source: str, overrides: Sequence[str] = (), recorded: bool = False) -> Scenario:
+def parse_scenario(
+    text: str, source: str, overrides: Sequence[str | Override] = (), recorded: bool = False
+) -> Scenario:
     """Parse TOML text, apply `--set KEY=VALUE` overrides, validate: a Scenario or ScenarioError.
 
     `recorded`: the text is a finished run's scenario (from its log), whose planner need not be
@@ -68,16 +86,23 @@ def parse_scenario(text: str, source: str, overrides: Sequence[str] = (), record
 
 
 def parse_document(
-    doc: dict[str, Any], source: str, overrides: Sequence[str] = (), recorded: bool = False
+    doc: dict[str, Any], source: str, overrides: Sequence[str | Override] = (), recorded: bool = False
 ) -> Scenario:
     """Validate a document as TOML parses it (tables as dicts, arrays as lists), after the
-    `--set KEY=VALUE` overrides (applied to `doc` in place): a Scenario or ScenarioError."""
+    `--set KEY=VALUE` overrides (applied to `doc` in place): a Scenario or ScenarioError.
+
+    An error at a key an override set (or inside it) names that override, not `source`."""
+    applied: list[tuple[str, Override]] = []  # the key path each override set, in order
+    culprit: Override | None = None
     try:
-        for override in overrides:
-            apply_override(doc, override)
+        for override in map(Override.of, overrides):
+            culprit = override
+            applied.append((apply_override(doc, override.text), override))
+        culprit = None
         return _build_scenario(doc, source, recorded)
     except Invalid as exc:
-        raise ScenarioError(source, exc.key, exc.reason) from None
+        origin = culprit.origin(exc.key) if culprit else _origin(exc.key, applied)
+        raise ScenarioError(source, exc.key, exc.reason, origin) from None
     except Exception as exc:  # promised: no input ever escapes as anything but ScenarioError
         reason = f"cannot be validated (internal error, please report it: {exc!r})"
         raise ScenarioError(source, "", reason) from exc

@@ -45,6 +45,7 @@ from vplane_mj.scenario.keys import (
 )
 from vplane_mj.scenario.spec import RobotSpec, RunSpec, SensorSpec, WorldSpec
 from vplane_mj.shapes import Obstacle
+from vplane_mj.suggestions import did_you_mean
 
 
 def _check_format(doc: Mapping[str, Any]) -> None:
@@ -77,8 +78,9 @@ def _read_obstacle(item: Any, path: str) -> Obstacle:
     kind_name = checked(item["kind"], STRING, join_key(path, "kind"))
     kind = OBSTACLE_KINDS.get(kind_name)
     if kind is None:
-        known = ", ".join(OBSTACLE_KINDS)
-        raise Invalid(join_key(path, "kind"), f"unknown obstacle kind {kind_name!r} (known: {known})")
+        hint = did_you_mean(kind_name, OBSTACLE_KINDS)
+        reason = f"unknown obstacle kind {kind_name!r} (known: {', '.join(OBSTACLE_KINDS)}){hint}"
+        raise Invalid(join_key(path, "kind"), reason)
     shape = kind.shape(**read_fields(item, path, kind.fields, extra=("kind",)))
     if kind.check:
         kind.check(shape, path)
@@ -133,8 +135,7 @@ def read_planner(doc: Mapping[str, Any], recorded: bool = False) -> tuple[str, M
         return name, MappingProxyType({key: value for key, value in table.items() if key != "name"})
     if name not in registry.PLANNERS:
         default = "" if given else " (the default)"
-        known = ", ".join(sorted(registry.PLANNERS))
-        reason = f"unknown planner {name!r}{default}; available: {known}"
+        reason = registry.unknown_planner(name, default)
         if is_import_spec(name):
             reason += (
                 "; a scenario names a planner only by name: a planner class is imported only when "
