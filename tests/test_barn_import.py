@@ -13,8 +13,9 @@ import numpy as np
 import pytest
 
 from vplane_mj.barn_import import barn_path_length, import_worlds
-from vplane_mj.barn_layout import JACKAL_RADIUS_M, parse_layout, to_arena
+from vplane_mj.barn_layout import JACKAL_RADIUS_M, to_arena
 from vplane_mj.cli import main
+from vplane_mj.scenario import parse_document
 from vplane_mj.sdf_world import read_world_shapes
 from vplane_mj.shapes import scene_footprints
 
@@ -47,7 +48,7 @@ def test_the_sample_becomes_a_scenario_of_the_challenges_layout(world_1):
     }
     assert doc["run"] == {"time_limit_s": 100.0}
     assert "path_1.npy" in doc["description"]
-    scenario = parse_layout(doc, "barn_world_1.toml")
+    scenario = parse_document(doc, "barn_world_1.toml")
     assert len(scenario.world.obstacles) == 237
 
 
@@ -81,7 +82,7 @@ def test_the_field_fills_the_layouts_field_and_the_walls_stand_outside_the_arena
 
 def test_start_and_goal_are_clear_for_the_jackal(world_1):
     doc, _ = world_1
-    scenario = parse_layout(doc, "barn_world_1.toml")
+    scenario = parse_document(doc, "barn_world_1.toml")
     scene = scene_footprints(scenario.world.obstacles, scenario.world.size)
     gaps = scene.distance(np.array([scenario.robot.start, scenario.robot.goal]))
     assert np.all(gaps >= JACKAL_RADIUS_M)
@@ -245,8 +246,11 @@ def test_a_directory_without_world_files_exits_2(tmp_path, capsys):
 @pytest.mark.parametrize(
     ("gazebo_y", "reason"),
     [
-        (3.05, "does not make a valid scenario: robot.start: lies inside"),
-        (3.3, "the start [2.1, 2.85] is 0.225 m from an obstacle, closer than the Jackal's half diagonal"),
+        (
+            3.05,
+            "does not make a valid scenario: robot.start: the jackal robot's footprint at yaw 90 deg overlaps",
+        ),
+        (3.36, "the start [2.1, 2.85] is 0.285 m from an obstacle, closer than the Jackal's half diagonal"),
     ],
 )
 def test_a_start_the_jackal_would_overlap_is_refused(tmp_path, capsys, gazebo_y, reason):

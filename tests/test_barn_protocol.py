@@ -6,10 +6,11 @@ import tomllib
 import numpy as np
 import pytest
 
-from vplane_mj.barn_layout import JACKAL_RADIUS_M, parse_layout
+from vplane_mj.barn_layout import JACKAL_RADIUS_M
 from vplane_mj.barn_protocol import JACKAL_CELLS, connect_ends, field_cylinders, open_windows
 from vplane_mj.cli import main
 from vplane_mj.reference import shortest_path_length
+from vplane_mj.scenario import parse_document
 
 
 def _generate(out, seed, count=12):
@@ -60,7 +61,7 @@ def test_the_obstacles_are_cells_of_the_field(seed_0):
 def test_every_world_lets_the_jackal_through(seed_0):
     assert JACKAL_RADIUS_M >= 0.33
     for name, text in seed_0.items():
-        scenario = parse_layout(tomllib.loads(text), name)
+        scenario = parse_document(tomllib.loads(text), name)
         assert shortest_path_length(scenario, JACKAL_RADIUS_M) is not None
 
 
@@ -75,7 +76,7 @@ def test_the_difficulty_varies_from_sparse_to_dense(seed_0):
     for name, text in seed_0.items():
         doc = tomllib.loads(text)
         filled.append(len(doc["world"]["obstacles"]) / (28 * 31))
-        reference.append(shortest_path_length(parse_layout(doc, name), JACKAL_RADIUS_M))
+        reference.append(shortest_path_length(parse_document(doc, name), JACKAL_RADIUS_M))
     assert min(filled) < 0.1 and max(filled) > 0.2  # scattered cells to dense blobs
     assert max(reference) - min(reference) > 0.3  # some worlds make the Jackal wind through
 

@@ -28,11 +28,11 @@ from vplane_mj.barn_layout import (
     JACKAL_RADIUS_M,
     jackal_reference_length,
     layout_document,
-    parse_layout,
     to_arena,
 )
 from vplane_mj.errors import ScenarioError, WorldFileError
 from vplane_mj.families import Case
+from vplane_mj.scenario import parse_document
 from vplane_mj.sdf_world import WorldShape, read_world_shapes
 from vplane_mj.shapes import scene_footprints
 
@@ -138,7 +138,7 @@ def import_world(path: Path) -> ImportedWorld:
         description += f"; BARN's own path ({path_file.name}) is {barn_path_m:.3f} m"
     document = layout_document(name, description, [obstacle(shape) for shape in shapes])
     try:
-        scenario = parse_layout(document, source)
+        scenario = parse_document(document, source)
     except ScenarioError as exc:
         raise WorldFileError(source, "", f"does not make a valid scenario: {exc.key}: {exc.reason}") from None
     _check_jackal_clear(scenario)

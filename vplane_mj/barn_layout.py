@@ -9,9 +9,9 @@ the project's reference path (`vplane_mj.reference`) for a disc of the Jackal's 
 
 from __future__ import annotations
 
-import copy
-import math
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from vplane_mj.profiles import PROFILES
 
 if TYPE_CHECKING:
     from vplane_mj.scenario import Scenario
@@ -32,11 +32,9 @@ TIME_LIMIT_S = 100.0
 PROFILE = "jackal"
 """The robot profile of the challenge's robot, a Clearpath Jackal."""
 
-JACKAL_OUTLINE_M = (0.508, 0.430)
-"""The Jackal's outline, length x width (m)."""
-JACKAL_RADIUS_M = math.hypot(*JACKAL_OUTLINE_M) / 2
-"""Half the Jackal's diagonal (0.333 m): the disc that covers it at any heading, the size
-a world of this layout must let through."""
+JACKAL_RADIUS_M = PROFILES[PROFILE].footprint_radius_m() or 0.0
+"""Half the Jackal's diagonal (0.333 m): the disc that covers its outline at any heading, the
+size a world of this layout must let through."""
 
 GAZEBO_START_M, GAZEBO_GOAL_M = (-2.25, 3.0), (-2.25, 13.0)
 """Where BARN's Gazebo worlds place the start and the goal (m)."""
@@ -71,19 +69,6 @@ def layout_document(name: str, description: str, obstacles: list[dict]) -> dict:
         },
         "run": {"time_limit_s": TIME_LIMIT_S},
     }
-
-
-def parse_layout(document: dict[str, Any], source: str) -> Scenario:
-    """Validate a document of this layout with the scenario parser (a ScenarioError if invalid).
-
-    `robot.profile` is dropped before validating, as this version of the parser does not know
-    the key yet; when robot profiles land, this function becomes `parse_document` itself.
-    """
-    from vplane_mj.scenario import parse_document
-
-    checked = copy.deepcopy(document)
-    checked.get("robot", {}).pop("profile", None)  # goes when `[robot] profile` lands
-    return parse_document(checked, source)
 
 
 def jackal_reference_length(scenario: Scenario) -> float | None:

@@ -33,10 +33,10 @@ from vplane_mj.barn_layout import (
     cell_center,
     jackal_reference_length,
     layout_document,
-    parse_layout,
 )
 from vplane_mj.errors import ScenarioError
 from vplane_mj.families import Case, smooth_cells
+from vplane_mj.scenario import parse_document
 
 FILL_RANGE = (0.15, 0.35)
 """Initial fill probability of a cell, drawn uniformly per world."""
@@ -132,7 +132,7 @@ def generate_protocol(count: int, seed: int) -> list[Case]:
         if case is None:
             continue
         try:
-            scenario = parse_layout(case.document, f"{case.name}.toml")
+            scenario = parse_document(case.document, f"{case.name}.toml")
         except ScenarioError:
             continue
         if jackal_reference_length(scenario) is not None:
