@@ -449,11 +449,35 @@ def _list(args: argparse.Namespace) -> int:
         print("Built-in scenarios:")
         for name, description in builtin_scenarios():
             print(f"  {name:<20} {description}")
+        _print_profiles()
         names = sorted(PLANNERS)
     print("\nPlanners (parameters: default, unit, meaning):")
     for name in names:
         _print_planner(name)
     return 0
+
+
+def _print_profiles() -> None:
+    """The robot profiles of `vplane-mj list`: size, top speed and sensor of each."""
+    from vplane_mj.profiles import PROFILES
+    from vplane_mj.robot import robot_body
+
+    print("\nRobot profiles ([robot] profile = NAME):")
+    for name, profile in PROFILES.items():
+        body = robot_body(name)
+        if body.disc:
+            size = f"disc of {2 * body.radius_m:.3f} m"
+        else:
+            size = f"{body.front_m + body.rear_m:.3f} x {2 * body.half_width_m:.3f} m"
+        sensor = dict(profile.sensors)
+        if sensor["kind"] == "laser":
+            what = f"laser {sensor['fov_deg']:g} deg, {sensor['beams']} beams, {sensor['range_min']:g}-"
+            what += f"{sensor['range_max']:g} m, {sensor['rate_hz']:g} Hz"
+        else:
+            where = "at their places" if profile.sonar_mounts else "in a ring"
+            what = f"{sensor['count']} sonars {where}, {sensor['beam_deg']:g} deg, {sensor['range_max']:g} m"
+        speed = f"{profile.limits.max_speed_mps:g} m/s"
+        print(f"  {name:<18} {profile.title}: {size}, {speed}, {what}")
 
 
 def _print_planner(name: str) -> None:
