@@ -248,7 +248,8 @@ def test_a_directory_without_world_files_exits_2(tmp_path, capsys):
     [
         (
             3.05,
-            "does not make a valid scenario: robot.start: the jackal robot's footprint at yaw 90 deg overlaps",
+            "does not make a valid scenario: robot.start: the jackal robot's footprint at yaw 90 deg "
+            "overlaps",
         ),
         (3.36, "the start [2.1, 2.85] is 0.285 m from an obstacle, closer than the Jackal's half diagonal"),
     ],

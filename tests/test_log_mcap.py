@@ -26,6 +26,7 @@ from vplane_mj.log_mcap import (
     METADATA_NAME,
     METRICS_JSON_SCHEMA,
     PATH_TOLERANCE_M,
+    RANGE_STEP_M,
     McapLog,
     time_ns,
 )
@@ -154,7 +155,9 @@ def test_scan_has_nan_for_no_echo_and_the_ring_step(run):
         assert math.isclose(step, 2 * math.pi / 16)
         assert msg.start_angle == 0.0
         np.testing.assert_array_equal(np.isnan(logged), ~np.isfinite(ranges))
-        np.testing.assert_array_equal(logged[np.isfinite(ranges)], ranges[np.isfinite(ranges)])
+        echoes = np.isfinite(ranges)
+        np.testing.assert_allclose(logged[echoes], ranges[echoes], rtol=0.0, atol=RANGE_STEP_M / 2)
+        assert np.all(logged[echoes] / RANGE_STEP_M == np.round(logged[echoes] / RANGE_STEP_M))
         saw_nan |= bool(np.isnan(logged).any())
         saw_echo |= bool(np.isfinite(logged).any())
     assert saw_nan and saw_echo

@@ -35,9 +35,9 @@ vanish are removed with `SceneUpdate.deletions`.
 
 `/scan` holds the sensor's ranges from the robot's centre at the sensor's height, rounded to
 RANGE_STEP_M (a step that compresses: a 720-beam laser costs about 2 MB a minute at 20 Hz,
-three times less than at full precision): a laser's beams or a sonar ring as they are; sonars at uneven bearings (the pioneer3dx) on a scan of
-one-degree steps, each reading at its bearing's degree (the nearer of two that share one),
-NaN elsewhere.
+three times less than at full precision): a laser's beams or a sonar ring as they are;
+sonars at uneven bearings (the pioneer3dx) on a scan of one-degree steps, each reading at its
+bearing's degree (the nearer of two that share one), NaN elsewhere.
 
 `/metrics` and `/run/events` use only plain JSON schema types (`number`, `string`, arrays
 of numbers), as viewers require: a value that is missing (`force_virtual` without a
