@@ -12,9 +12,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from vplane_mj.cache import CACHE_ENV
 from vplane_mj.cli import main
-from vplane_mj.log_read import read_log
+from vplane_mj.geometry.cache import CACHE_ENV
+from vplane_mj.logs.reader import read_log
 
 BAD_SCENARIO = """
 format = 1
