@@ -18,7 +18,10 @@ import types
 import warnings
 from typing import TYPE_CHECKING, Any
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
+CONTRACT_VERSION = "1.2"
+"""The version of the public contract (docs/interface.md: scenario format, command line,
+outputs, log topics) this package follows."""
 
 # The tool runs headless: render offscreen with OSMesa unless the user chose a backend.
 # Set before mujoco imports OpenGL, which would otherwise try GLFW and X11.

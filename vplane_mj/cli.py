@@ -94,6 +94,11 @@ def _parser() -> argparse.ArgumentParser:
         prog="vplane-mj",
         description="Artificial potential fields and the virtual-plane escape, in MuJoCo.",
     )
+    parser.add_argument(
+        "--version",
+        action="version",
+        version=f"vplane-mj {vplane_mj.__version__} (contract v{vplane_mj.CONTRACT_VERSION})",
+    )
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     run = commands.add_parser("run", help="one headless run of a scenario")
@@ -402,11 +407,13 @@ def _summary(args: argparse.Namespace) -> int:
 
 def _render(args: argparse.Namespace) -> int:
     from vplane_mj.logs.replay import load_log, track_from_log
-    from vplane_mj.viz.render import render_top_view, write_png
+    from vplane_mj.sim.summary import RunSummary
+    from vplane_mj.viz.render import render_top_view, run_caption, write_png
 
     contents, scenario = load_log(args.log)
     _check_parent(args.output)
-    image = render_top_view(scenario, track_from_log(args.log, contents))
+    caption = run_caption(RunSummary.from_dict(contents.summary)) if contents.summary else scenario.name
+    image = render_top_view(scenario, track_from_log(args.log, contents), caption)
     write_atomically(args.output, lambda tmp: write_png(image, tmp))
     print(f"wrote {args.output}")
     return 0

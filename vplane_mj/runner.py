@@ -117,9 +117,9 @@ def run(
     try:
         files["summary"] = write_json(base.with_suffix(".json"), result.summary.to_dict())
         if render:
-            from vplane_mj.viz.render import render_top_view, write_png
+            from vplane_mj.viz.render import render_top_view, run_caption, write_png
 
-            image = render_top_view(scenario, result.track())
+            image = render_top_view(scenario, result.track(), run_caption(result.summary))
             files["render"] = write_atomically(base.with_suffix(".png"), lambda tmp: write_png(image, tmp))
         if video:
             from vplane_mj.viz.video import write_video

@@ -17,6 +17,7 @@ import mujoco
 import numpy as np
 
 from vplane_mj.sim.loop import Track
+from vplane_mj.sim.summary import RunSummary
 from vplane_mj.sim.world import build_model
 
 MODE_RGBA = {
@@ -40,29 +41,136 @@ PNG_FILTER_UP = 2
 """PNG's row filter "Up": each byte minus the one above it."""
 
 
-def render_top_view(scenario, track: Track) -> np.ndarray:
-    """RGB image (H, W, 3) of the whole arena from the orthographic top camera."""
+LEGEND_PX = 200
+"""Width (px) of the panel right of the arena that holds the caption, the legend and the scale."""
+ROW_PX = 22
+"""Height (px) of one line of the panel."""
+CAPTION_LINES = 5
+"""The most lines of a caption the panel shows."""
+TEXT_DROP_PX = 0
+"""How far (px) below the bottom of a line of MuJoCo's text its placing point lies."""
+MODE_NAMES = {
+    "normal": "path: normal",
+    "avoiding": "path: avoiding",
+    "escaping": "path: escaping",
+    "trapped": "path: trapped",
+    "following": "path: following",
+}
+
+
+def render_top_view(scenario, track: Track, caption: str = "") -> np.ndarray:
+    """RGB image (H, W, 3) of the whole arena from the orthographic top camera, with a panel at
+    its right: the `caption` (a few short lines), a legend of what the picture shows and a scale
+    bar."""
     model = build_model(scenario)
     data = mujoco.MjData(model)
     x, y, yaw = track.final_pose
     data.qpos[:7] = (x, y, 0.0, math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
     mujoco.mj_forward(model, data)
     height, width = model.vis.global_.offheight, model.vis.global_.offwidth
-    with mujoco.Renderer(model, height=height, width=width, max_geom=MAX_PATH_SEGMENTS + 500) as renderer:
-        options = mujoco.MjvOption()
-        options.flags[mujoco.mjtVisFlag.mjVIS_RANGEFINDER] = False
-        renderer.update_scene(data, camera="top", scene_option=options)
-        scene = renderer.scene
-        _add_disc(scene, scenario.robot.start, 0.12, START_RGBA)
-        _add_disc(scene, scenario.robot.goal, scenario.robot.goal_tolerance, GOAL_RGBA)
-        for e1, e2 in track.planes:
-            _add_segment(scene, e1, e2, PLANE_RGBA, width=6.0)
-        for objective in track.objectives:
-            _add_disc(scene, objective, 0.08, OBJECTIVE_RGBA)
-        _add_path(scene, track.positions, track.modes)
-        for point in track.collision_points:
-            _add_disc(scene, point, 0.06, COLLISION_RGBA)
-        return renderer.render()
+    model.vis.global_.offwidth = width + LEGEND_PX
+    scene = mujoco.MjvScene(model, maxgeom=MAX_PATH_SEGMENTS + 500)
+    camera = mujoco.MjvCamera()
+    camera.type, camera.fixedcamid = mujoco.mjtCamera.mjCAMERA_FIXED, model.camera("top").id
+    options = mujoco.MjvOption()
+    options.flags[mujoco.mjtVisFlag.mjVIS_RANGEFINDER] = False
+    mujoco.mjv_updateScene(model, data, options, None, camera, mujoco.mjtCatBit.mjCAT_ALL, scene)
+    _add_track(scene, scenario, track)
+    metres_per_px = model.cam_fovy[camera.fixedcamid] / height  # orthographic: the view's height in m
+    image = np.empty((height, width + LEGEND_PX, 3), dtype=np.uint8)
+    gl = mujoco.GLContext(width + LEGEND_PX, height)
+    gl.make_current()
+    context = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_100)
+    try:
+        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, context)
+        whole = mujoco.MjrRect(0, 0, width + LEGEND_PX, height)
+        mujoco.mjr_rectangle(whole, 1.0, 1.0, 1.0, 1.0)
+        mujoco.mjr_render(mujoco.MjrRect(0, 0, width, height), scene, context)
+        _draw_panel(context, width, height, caption, _legend(track), metres_per_px)
+        mujoco.mjr_readPixels(image, None, whole, context)
+    finally:
+        context.free()
+        gl.free()
+    return np.flipud(image)
+
+
+def run_caption(summary: RunSummary) -> str:
+    """The caption of a run's render: the scenario; the planner, seed and robot; how it ended."""
+    travelled = f"{summary.path_length_m:.1f} m"
+    if summary.collisions:
+        travelled += f", {summary.collisions} collision{'s' if summary.collisions > 1 else ''}"
+    return "\n".join(
+        (
+            summary.scenario,
+            f"{summary.planner}, seed {summary.seed}",
+            f"robot: {summary.robot_profile}",
+            f"{summary.outcome} at {summary.sim_time_s:.1f} s",
+            travelled,
+        )
+    )
+
+
+def _add_track(scene: mujoco.MjvScene, scenario, track: Track) -> None:
+    """The start, the goal disc, the virtual planes and objectives, the path and the collisions."""
+    _add_disc(scene, scenario.robot.start, 0.12, START_RGBA)
+    _add_disc(scene, scenario.robot.goal, scenario.robot.goal_tolerance, GOAL_RGBA)
+    for e1, e2 in track.planes:
+        _add_segment(scene, e1, e2, PLANE_RGBA, width=6.0)
+    for objective in track.objectives:
+        _add_disc(scene, objective, 0.08, OBJECTIVE_RGBA)
+    _add_path(scene, track.positions, track.modes)
+    for point in track.collision_points:
+        _add_disc(scene, point, 0.06, COLLISION_RGBA)
+
+
+def _legend(track: Track) -> list[tuple[str, tuple[float, float, float, float]]]:
+    """The legend's rows (text, colour): start and goal, the path's modes in this run, and the
+    virtual objectives, planes and collisions when it has any."""
+    rows = [("start", START_RGBA), ("goal (tolerance)", GOAL_RGBA)]
+    for mode in dict.fromkeys(track.modes):
+        rows.append((MODE_NAMES.get(mode, f"path: {mode}"), MODE_RGBA.get(mode, OTHER_MODE_RGBA)))
+    if track.objectives:
+        rows.append(("virtual objective", OBJECTIVE_RGBA))
+    if track.planes:
+        rows.append(("virtual plane", PLANE_RGBA))
+    if track.collision_points:
+        rows.append(("collision", COLLISION_RGBA))
+    return rows
+
+
+def _draw_panel(context, left: int, height: int, caption: str, legend, metres_per_px: float) -> None:
+    """The caption's lines, the legend's swatches and texts from the top, a scale bar at the bottom.
+
+    MuJoCo places text relative to the last rectangle drawn, and clips it there: a clear
+    rectangle over the panel comes first; y is TEXT_DROP_PX below the text's bottom.
+    """
+    font = mujoco.mjtFont.mjFONT_NORMAL
+    panel = mujoco.MjrRect(left, 0, LEGEND_PX, height)
+
+    def text(line: str, x_px: int, y_px: int) -> None:
+        mujoco.mjr_rectangle(panel, 1.0, 1.0, 1.0, 0.0)
+        x, y = (x_px - left) / LEGEND_PX, (y_px - TEXT_DROP_PX) / height
+        mujoco.mjr_text(font, line, context, x, y, 0.0, 0.0, 0.0)
+
+    top = height - 8
+    for line in [line for line in caption.splitlines() if line][:CAPTION_LINES]:
+        top -= ROW_PX
+        text(line, left + 10, top)
+    top -= ROW_PX // 2
+    for label, (r, g, b, a) in legend:
+        top -= ROW_PX
+        mujoco.mjr_rectangle(mujoco.MjrRect(left + 10, top, 16, 16), r, g, b, a)
+        text(label, left + 34, top)
+    bar_m = _scale_length(metres_per_px * (LEGEND_PX - 40))
+    bar_px = round(bar_m / metres_per_px)
+    mujoco.mjr_rectangle(mujoco.MjrRect(left + 10, 16, bar_px, 6), 0.0, 0.0, 0.0, 1.0)
+    text(f"{bar_m:g} m", left + 10, 30)
+
+
+def _scale_length(longest_m: float) -> float:
+    """The longest round length (1, 2 or 5 times a power of ten, m) at most `longest_m`."""
+    power = 10.0 ** math.floor(math.log10(longest_m))
+    return max(step * power for step in (1.0, 2.0, 5.0) if step * power <= longest_m)
 
 
 def write_png(image: np.ndarray, path: Path | str) -> None:
