@@ -15,9 +15,9 @@ from typing import TYPE_CHECKING
 import vplane_mj
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import DEFAULT_OUT, prepare_out_dir, write_atomically
-from vplane_mj.interrupts import Interrupted, signals_raise_interrupted
 from vplane_mj.planning.plugins import PlannerError
 from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
+from vplane_mj.terminal import Interrupted, signals_raise_interrupted
 from vplane_mj.worlds.families import FAMILIES
 
 if TYPE_CHECKING:
