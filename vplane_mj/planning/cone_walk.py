@@ -68,21 +68,9 @@ def cone_cells(
     extent2 = far_x * far_x + far_y * far_y + cell_m * cell_m
     count = 0
     for c in range(start.shape[0]):
-        r = ranges[c]
-        band_lo2, band_hi2, clear, show = math.inf, -1.0, 0.0, 0.0
-        if r == r:  # an echo
-            band_hi = r + arc_m + DISTANCE_MARGIN_M
-            if marks[c] and band_hi > 0.0:
-                band_lo = max(r - arc_m - DISTANCE_MARGIN_M, 0.0)
-                band_lo2, band_hi2 = band_lo * band_lo, band_hi * band_hi
-                clear = max(r - arc_m + DISTANCE_MARGIN_M, 0.0)
-            else:
-                clear = max(r - cell_m + DISTANCE_MARGIN_M, 0.0)
-            show = clear
-        elif silent_m > 0.0:
-            show = silent_m + DISTANCE_MARGIN_M
-        if not track_seen:
-            show = 0.0
+        band_lo2, band_hi2, clear, show = _cone_reach(
+            ranges[c], marks[c], arc_m, cell_m, silent_m, track_seen
+        )
         reach2 = min(max(band_hi2, clear * clear, show * show), extent2)
         if reach2 <= 0.0:
             continue
@@ -115,6 +103,30 @@ def cone_cells(
                 count,
             )
     return count
+
+
+@njit(cache=True)
+def _cone_reach(
+    r: float, marks: bool, arc_m: float, cell_m: float, silent_m: float, track_seen: bool
+) -> tuple[float, float, float, float]:
+    """For a cone with the range `r` (m, NaN: no echo): the squared bounds (m^2) of the arc band
+    it marks (inf and -1 when it marks none), and how far (m) it clears marked cells and shows
+    unseen ones (0 without `track_seen`)."""
+    band_lo2, band_hi2, clear, show = math.inf, -1.0, 0.0, 0.0
+    if r == r:  # an echo
+        band_hi = r + arc_m + DISTANCE_MARGIN_M
+        if marks and band_hi > 0.0:
+            band_lo = max(r - arc_m - DISTANCE_MARGIN_M, 0.0)
+            band_lo2, band_hi2 = band_lo * band_lo, band_hi * band_hi
+            clear = max(r - arc_m + DISTANCE_MARGIN_M, 0.0)
+        else:
+            clear = max(r - cell_m + DISTANCE_MARGIN_M, 0.0)
+        show = clear
+    elif silent_m > 0.0:
+        show = silent_m + DISTANCE_MARGIN_M
+    if not track_seen:
+        show = 0.0
+    return band_lo2, band_hi2, clear, show
 
 
 @njit(cache=True)
