@@ -14,7 +14,9 @@ force, each from obstacle points (echoes or map cells) in the world frame, metre
   A round robot's turn sweeps nothing new, so it is always free.
 - `SpeedPolicy`: the force magnitude that asks the heading controller (v = k_v |F| cos e) for
   no more than the speed the robot can still brake from within the room ahead, after one
-  control period at that speed, at most its top speed: v (t + v / 2a) <= room.
+  control period at that speed, at most its top speed: v (t + v / 2a) <= room; and, on a
+  known way ahead, no more than lets it turn toward each of the way's points before it gets
+  there (`bend_speed`).
 
 A robot that brakes from its top speed within `SHAPED_STOP_M` (the default robot: 0.03 m,
 the TurtleBot3: 0.01 m) is not slowed by the policy: its fields' own repulsion stops it, and
@@ -140,6 +142,26 @@ class SpeedPolicy:
         v = a * (math.sqrt(t * t + 2 * max(0.0, room_m) / a) - t)
         return min(limits.max_speed_mps, v)
 
+    def bend_speed(self, position: np.ndarray, yaw: float, way: np.ndarray) -> float:
+        """The largest speed (m/s, at most the top speed) at which the robot at `position`, `yaw`
+        turns to face each point of `way` (N, 2; world, m, in order along it) before it has
+        travelled the way's length to that point: v <= s w / theta, s that length, theta the
+        turn, w half the top turn rate (the turn rate ramps up, and the controller's falls as
+        the heading nears the point). Points within the robot's circumscribed radius along the
+        way do not count: the robot steers for points beyond its own outline."""
+        limits = self.body.limits
+        steps = np.diff(np.vstack((position, way)), axis=0)
+        travelled = np.cumsum(np.hypot(steps[:, 0], steps[:, 1]))
+        beyond = travelled >= self.body.radius_m
+        if not beyond.any():
+            return limits.max_speed_mps
+        way, travelled = way[beyond], travelled[beyond]
+        rel = way - position
+        turn = np.abs(wrap_angle(np.arctan2(rel[:, 1], rel[:, 0]) - yaw))
+        rate = 0.5 * limits.max_turn_rate_radps
+        speeds = travelled * rate / np.maximum(turn, 1e-9)
+        return float(min(limits.max_speed_mps, speeds.min()))
+
     def magnitude(self, speed_mps: float) -> float:
         """The force magnitude that asks the heading controller for `speed_mps` when aligned."""
         return speed_mps / self.body.gains.speed_gain
@@ -182,9 +204,16 @@ class Governor:
         """Whether the governor leaves every force as it is (a round robot that brakes short)."""
         return self.body.disc and not self.policy.active
 
-    def govern(self, force: np.ndarray, position: np.ndarray, yaw: float, points: np.ndarray) -> np.ndarray:
+    def govern(
+        self,
+        force: np.ndarray,
+        position: np.ndarray,
+        yaw: float,
+        points: np.ndarray,
+        speed_mps: float = math.inf,
+    ) -> np.ndarray:
         """`force` (world frame) made safe for the body at `position`, `yaw` among obstacle
-        `points` (N, 2; world, m)."""
+        `points` (N, 2; world, m), asking for at most `speed_mps` (m/s) besides."""
         length = float(np.hypot(force[0], force[1]))
         if self.idle or length < 1e-9 or not math.isfinite(length):
             return force
@@ -196,4 +225,4 @@ class Governor:
             if direction != wanted:
                 force = length * np.array([math.cos(direction), math.sin(direction)])
         policy = self.policy
-        return policy.limit(force, policy.safe_speed(room)) if policy.active else force
+        return policy.limit(force, min(speed_mps, policy.safe_speed(room))) if policy.active else force

@@ -60,6 +60,8 @@ SILENT_FREE_M = 1.0
 """A sonar that hears no echo shows its first metre free, for the choice of objectives only."""
 OBJECTIVE_ROOM_M = 0.05
 """A virtual objective lies at least this much beyond the robot's disc from every mapped obstacle."""
+BEND_HORIZON_M = 3.0
+"""The way this far ahead (m) bounds the speed by the turns it asks for (motion.py)."""
 TRAP_REACH_M = 2.5
 """Obstacle cells farther than this from the robot are not part of the trap it is in."""
 
@@ -271,11 +273,19 @@ class VPlanePlusPlanner(VPlanePlanner):
     def _governed(self, force: np.ndarray, obs: Observation) -> np.ndarray:
         """The force fitted to the robot's body (motion.py) among the echoes and the mapped
         cells around it (not swept), which remember what the sensor sees between its beams or
-        behind."""
+        behind; on a way, no faster than lets the robot turn along the way's next
+        `BEND_HORIZON_M`."""
         if self.governor.idle:
             return force
         cells = self._mapped_cells_near(obs.position, self.governor.reach_m)
-        return self.governor.govern(force, obs.position, obs.yaw, np.vstack((obs.echo_points(), cells)))
+        way = self.escape_way if self.temp_goal is not None else self.follow_way if self.following else []
+        speed = math.inf
+        if way:
+            ahead = np.array(way)
+            travelled = np.cumsum(np.hypot(*np.diff(np.vstack((obs.position, ahead)), axis=0).T))
+            speed = self.governor.policy.bend_speed(obs.position, obs.yaw, ahead[travelled <= BEND_HORIZON_M])
+        points = np.vstack((obs.echo_points(), cells))
+        return self.governor.govern(force, obs.position, obs.yaw, points, speed)
 
     def _mapped_cells_near(self, position: np.ndarray, reach_m: float) -> np.ndarray:
         """Centres (N, 2) of the mapped obstacle cells (not swept) within a square of half side
