@@ -145,10 +145,12 @@ class SpeedPolicy:
     def bend_speed(self, position: np.ndarray, yaw: float, way: np.ndarray) -> float:
         """The largest speed (m/s, at most the top speed) at which the robot at `position`, `yaw`
         turns to face each point of `way` (N, 2; world, m, in order along it) before it has
-        travelled the way's length to that point: v <= s w / theta, s that length, theta the
-        turn, w half the top turn rate (the turn rate ramps up, and the controller's falls as
-        the heading nears the point). Points within the robot's circumscribed radius along the
-        way do not count: the robot steers for points beyond its own outline."""
+        travelled the way's length to that point: v <= s / t(theta), s that length, theta the
+        turn and t(theta) the time the drive takes to turn it from rest, its turn rate ramped at
+        the top turn acceleration alpha and limited to the top turn rate w: sqrt(2 theta / alpha)
+        up to theta = w^2 / 2 alpha, theta / w + w / 2 alpha beyond. Points
+        within the robot's circumscribed radius along the way do not count: the robot steers
+        for points beyond its own outline."""
         limits = self.body.limits
         steps = np.diff(np.vstack((position, way)), axis=0)
         travelled = np.cumsum(np.hypot(steps[:, 0], steps[:, 1]))
@@ -158,9 +160,11 @@ class SpeedPolicy:
         way, travelled = way[beyond], travelled[beyond]
         rel = way - position
         turn = np.abs(wrap_angle(np.arctan2(rel[:, 1], rel[:, 0]) - yaw))
-        rate = 0.5 * limits.max_turn_rate_radps
-        speeds = travelled * rate / np.maximum(turn, 1e-9)
-        return float(min(limits.max_speed_mps, speeds.min()))
+        rate, accel = limits.max_turn_rate_radps, limits.max_turn_accel_radps2
+        time = np.where(
+            turn <= rate * rate / (2 * accel), np.sqrt(2 * turn / accel), turn / rate + rate / (2 * accel)
+        )
+        return float(min(limits.max_speed_mps, (travelled / np.maximum(time, 1e-9)).min()))
 
     def magnitude(self, speed_mps: float) -> float:
         """The force magnitude that asks the heading controller for `speed_mps` when aligned."""
@@ -179,8 +183,9 @@ class Governor:
     """A planner's last word on its force, for its body: steered away from a turn in place that
     would sweep the footprint into a point (`turn_direction`, margin `turn_margin_m`), then
     shortened to the speed the robot can brake from within the room ahead (`SpeedPolicy`,
-    margin `stop_margin_m`). For a round robot that `SpeedPolicy` never slows, the force as
-    it is."""
+    margin `stop_margin_m`). A robot the margins shut in (no turn, no room) moves as long as
+    its footprint touches nothing. For a round robot that `SpeedPolicy` never slows, the force
+    as it is."""
 
     body: RobotBody
     stop_margin_m: float
@@ -222,6 +227,10 @@ class Governor:
         if not self.body.disc:
             wanted = math.atan2(force[1], force[0])
             direction = turn_direction(self.body, local, yaw, wanted, self.turn_margin_m, room)
+            if direction == yaw and room <= 0.0:
+                # Shut in with the margins: move as long as the footprint touches nothing.
+                room = room_ahead(self.body, local, 0.0, 0.0)
+                direction = turn_direction(self.body, local, yaw, wanted, 0.0, room)
             if direction != wanted:
                 force = length * np.array([math.cos(direction), math.sin(direction)])
         policy = self.policy
