@@ -590,7 +590,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             certainty >= p.map_sure,
             (certainty >= p.map_threshold) & (certainty < p.map_sure),
             cell,
-            self.robot.half_width_m + p.path_clearance_m,  # ways are driven along, aligned
+            self._lethal_m(),
             p.inflation_m,
             p.inflation_weight,
             p.doubt_cost,
@@ -604,6 +604,13 @@ class VPlanePlusPlanner(VPlanePlanner):
         for plane in planes:  # but no way crosses a virtual plane, even under the robot
             window.block_segment(plane.e1, plane.e2)
         return window
+
+    def _lethal_m(self) -> float:
+        """How close (m) the map's ways come to an obstacle cell's centre: ways are driven along,
+        aligned, so the robot's half width plus `path_clearance_m`; for a robot that is not round,
+        plus the governor's turn margin, which it keeps when it turns toward the way."""
+        lethal = self.robot.half_width_m + self.params.path_clearance_m
+        return lethal if self.robot.disc else lethal + self.params.turn_margin_m
 
     def _way(self, window: gridsearch.Window, start: np.ndarray, end: np.ndarray) -> list[np.ndarray] | None:
         """Waypoints (m) of the map's shortest way from `start` to `end` (beyond the window:
