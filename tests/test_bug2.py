@@ -5,13 +5,14 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj import shapes, synthetic
-from vplane_mj.control import ControllerGains, heading_command
+from vplane_mj.geometry import shapes, synthetic
 from vplane_mj.planning import bug2
 from vplane_mj.planning.types import Observation
-from vplane_mj.robot import robot_radius_m
+from vplane_mj.robots.facts import robot_radius_m
+from vplane_mj.robots.profiles import ControllerGains
 from vplane_mj.scenario import load_scenario
-from vplane_mj.sim import run_scenario
+from vplane_mj.sim.control import heading_command
+from vplane_mj.sim.loop import run_scenario
 
 ENCLOSURE = (  # a closed square of walls around (4, 3): x, y in [3.4, 4.6] x [2.4, 3.6]
     shapes.Wall((3.4, 2.4), (3.4, 3.6), 0.1),
@@ -83,6 +84,21 @@ def test_goes_to_goal_in_the_open_and_follows_near_a_wall():
     assert plan.hit_distance == pytest.approx(2.4)
     # Turning left with the wall on the right: the force points up along the wall.
     assert near.force[1] > 0.5 and near.force[1] > abs(near.force[0])
+
+
+@pytest.mark.parametrize("open_side", [1, -1])
+def test_a_laser_turns_toward_the_side_it_hears_nothing_from(open_side):
+    # A post right ahead; on one side walls 4 m off, on the other nothing within the laser's
+    # 30 m but an echo 6 m off: the side without echoes is the freer one.
+    laser = synthetic.LAYOUTS["jackal_laser"]
+    side = np.sign(laser.bearings)
+    ranges = np.where(side == -open_side, 4.0, np.nan)
+    ranges[np.flatnonzero(side == open_side)[::50]] = 6.0
+    ranges[np.abs(laser.bearings) < 0.2] = 0.3
+    obs = Observation(0.0, np.zeros(2), 0.0, np.array([5.0, 0.0]), 0.15, laser.bearings, ranges, laser.beam)
+    decision = planner(follow_side=0).step(obs)
+    assert decision.mode == "following"
+    assert ("turning left" if open_side == 1 else "turning right") in decision.events[0].text
 
 
 def test_follows_a_wall_around_its_end_and_leaves_on_the_m_line():

@@ -93,7 +93,7 @@ class VPlanePlusParams(VPlaneParams):
         4.0, "", "extra step cost right at the clearance (costmap inflation)", ge=0
     )
     map_hit_range_m: float = param(
-        1.5, "m", "echoes farther than this only clear the map (arcs too wide)", gt=0
+        1.5, "m", "echoes farther than this only clear the map, unless their arc is a cell wide at most", gt=0
     )
     map_sure: int = param(
         10, "", "certainty at which an obstacle cell is sure (lower: doubtful)", ge=1, integer=True
