@@ -15,10 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from vplane_mj.planning import fields, scan
+from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.localmap import LocalMap
 from vplane_mj.planning.minima import LocalMinimumDetector
 from vplane_mj.planning.motion import Governor
-from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.params import PlannerParams, param
 from vplane_mj.planning.types import Observation
 

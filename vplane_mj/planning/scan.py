@@ -7,9 +7,6 @@ much. `repulsion_points` keeps, of a scan denser than `DENSE_BEAMS`, the nearest
 of `RING_SECTORS` sectors about the ring's bearings: what a sonar of the ring would report
 there. A scan of at most `DENSE_BEAMS` beams (every sonar ring) is used as it is.
 
-The sonar map (localmap.py) reads a scan as an evenly spaced ring of beams about the robot.
-`map_scan` gives it a dense scan as such a ring of `MAP_SECTORS` beams, each the nearest echo
-within its sector (none outside the sensor's field of view), its beam the sector's width.
 """
 
 from __future__ import annotations
@@ -24,30 +21,11 @@ RING_SECTORS = 16
 """Sectors of the full circle a dense scan is reduced to (the default sonar ring's 22.5 deg)."""
 DENSE_BEAMS = 64
 """A scan of more beams than this is dense."""
-MAP_SECTORS = 360
-"""Beams of the ring a dense scan is given to the map as (1 degree each)."""
 
 
 def is_dense(obs: Observation) -> bool:
     """Whether the scan has more than `DENSE_BEAMS` beams (a laser's, not a sonar ring's)."""
     return len(obs.bearings) > DENSE_BEAMS
-
-
-def map_scan(obs: Observation) -> tuple[np.ndarray, np.ndarray, float]:
-    """Bearings (rad, robot frame), ranges (m, NaN: no echo) and beam width (rad) of the scan
-    as the sonar map reads it (module docstring)."""
-    if not is_dense(obs):
-        return obs.bearings, obs.ranges, obs.beam_width
-    ring = obs.__dict__.get("_map_scan")
-    if ring is None:
-        width = 2 * math.pi / MAP_SECTORS
-        ranges = np.full(MAP_SECTORS, np.nan)
-        hit = np.flatnonzero(np.isfinite(obs.ranges))
-        sector = np.floor(obs.bearings[hit] / width + 0.5).astype(int) % MAP_SECTORS
-        np.fmin.at(ranges, sector, obs.ranges[hit])
-        ring = (np.arange(MAP_SECTORS) * width, ranges, width)
-        obs.__dict__["_map_scan"] = ring
-    return ring
 
 
 def repulsion_points(obs: Observation) -> np.ndarray:

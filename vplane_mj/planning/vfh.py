@@ -2,7 +2,8 @@
 
 The sonar certainty grid (localmap.py) gives a polar histogram with obstacle cells
 enlarged by the robot's half width (its radius when round) plus a clearance (histogram.py):
-the free valleys are the directions the robot fits through, driving along them aligned; cells beyond the goal do not count. Candidates are the
+the free valleys are the directions the robot fits through, driving along them aligned;
+cells beyond the goal do not count. Candidates are the
 goal direction when it lies in a valley, the middle of narrow valleys and, in wide
 valleys, the directions half a wide valley in from each border. The cost
 5 |c - goal| + 2 |c - heading| + 2 |c - previous| picks one (VFH+'s weights). The force
@@ -19,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning import histogram, scan
+from vplane_mj.planning import histogram
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.groups import MinimumParams, MotionParams, SonarMapParams
@@ -67,7 +68,7 @@ class VfhPlanner(Planner):
 
     def step(self, obs: Observation) -> Decision:
         p = self.params
-        self.map.update(obs.position, obs.yaw, *scan.map_scan(obs))
+        self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
         enlarge = self.robot.half_width_m + p.clearance_m
         window = min(p.window_m, obs.distance_to_goal() + enlarge)  # nothing beyond the goal blocks it
         cells, certainty = self.map.cells(p.map_threshold, obs.position, window)

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning import fields, histogram, scan
+from vplane_mj.planning import fields, histogram
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
@@ -129,7 +129,7 @@ class VPlanePlanner(Planner):
     # -- the loop -------------------------------------------------------------------------
     def step(self, obs: Observation) -> Decision:
         p = self.params
-        self.map.update(obs.position, obs.yaw, *scan.map_scan(obs))
+        self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
         self.echoes.append(obs.echo_points())
         decision = Decision(force=np.zeros(2), mode="normal")
         if self.planes:
@@ -287,7 +287,12 @@ class VPlanePlanner(Planner):
         # A valley is a direction the robot drives along, aligned with it: cells enlarged by
         # its half width (VFH+'s robot radius for a round robot).
         h = histogram.polar_histogram(
-            obs.position, cells, certainty, self.n_sectors, p.window_m, self.robot.half_width_m + p.clearance_m
+            obs.position,
+            cells,
+            certainty,
+            self.n_sectors,
+            p.window_m,
+            self.robot.half_width_m + p.clearance_m,
         )
         blocked = h > p.histogram_threshold
         goal_free = not blocked[histogram.sector_of(goal_bearing, self.n_sectors)]
@@ -380,4 +385,6 @@ class VPlanePlanner(Planner):
         span = end - start
         t = np.clip((cells - start) @ span / max(float(span @ span), 1e-12), 0.0, 1.0)
         nearest = start + t[:, None] * span
-        return bool(np.min(np.hypot(*(cells - nearest).T)) > self.robot.half_width_m + self.params.clearance_m)
+        return bool(
+            np.min(np.hypot(*(cells - nearest).T)) > self.robot.half_width_m + self.params.clearance_m
+        )
