@@ -7,7 +7,7 @@ the goal direction) it records the hit point and switches to "following", keepin
 on one side at `wall_distance_m`. It leaves the wall when it is back on the m-line closer
 to the goal than the hit point and the way to the goal is clear. It gives up when it comes
 back to the hit point after a loop around the obstacle (the goal is unreachable) or after
-`max_follow_s` of following.
+`max_follow_s` of following. The governor (motion.py) fits the force to the robot's body.
 """
 
 from __future__ import annotations
@@ -20,7 +20,8 @@ import numpy as np
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
-from vplane_mj.planning.params import PlannerParams, param
+from vplane_mj.planning.groups import MotionParams
+from vplane_mj.planning.params import param
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.planning.vectors import unit, wrap_angle
 
@@ -33,8 +34,8 @@ SILENT_FREE_M = 3.0
 
 
 @dataclass(frozen=True)
-class Bug2Params(PlannerParams):
-    """Bug2's hit and leave tests, wall following and the m-line."""
+class Bug2Params(MotionParams):
+    """Bug2's hit and leave tests, wall following and the m-line, and the governor's margins."""
 
     hit_distance_m: float = param(0.45, "m", "an echo this close ahead (+-30 deg of the goal) is a hit", gt=0)
     wall_distance_m: float = param(0.4, "m", "distance kept from the followed wall (from the centre)", gt=0)
@@ -83,6 +84,7 @@ class Bug2Planner(Planner):
         self.side = 1  # +1: wall on the right (turned left); -1: wall on the left
         self.left_hit_area = False
         self.gave_up = False
+        self.governor = params.governor(self.robot)
 
     # ------------------------------------------------------------------ geometry
 
@@ -224,4 +226,6 @@ class Bug2Planner(Planner):
             return Decision(force=np.zeros(2), mode="gave_up", events=events, gave_up=True)
         components = self._go_to_goal(obs) if self.mode == "go_to_goal" else self._follow(obs)
         force = np.sum(list(components.values()), axis=0)
+        if not self.governor.idle:
+            force = self.governor.govern(force, position, obs.yaw, obs.echo_points())
         return Decision(force=force, mode=self.mode, components=components, events=events)
