@@ -18,7 +18,8 @@ class Observation:
     sensor's: an evenly spaced sonar ring, uneven sonar arrays (several beams may share a
     bearing), or a laser's scan over its field of view, in any order. `beam_width` (rad) is
     each beam's width, the same for all: an echo lies somewhere within it (a laser's is its
-    angle step).
+    angle step). `velocity` is the robot's speed along its heading (m/s, negative when
+    reversing) and turn rate (rad/s), as its wheel encoders measure them.
     """
 
     time_s: float
@@ -29,6 +30,7 @@ class Observation:
     bearings: np.ndarray
     ranges: np.ndarray
     beam_width: float
+    velocity: tuple[float, float] = (0.0, 0.0)
 
     def echo_points(self) -> np.ndarray:
         """World-frame points (N, 2) of the echoes, each on its beam's axis; no-echo readings are dropped.
@@ -63,6 +65,9 @@ class Decision:
     `local_minimum` and `escape_completed` mark a detection and a finished escape;
     `objective` is the virtual new objective while one exists (world frame, m) and
     `planes` the virtual planes in force, each as its two end points.
+    `command`, when given, is the body speed (m/s, negative to reverse) and turn rate (rad/s)
+    to drive, within the robot's limits, instead of what the heading controller makes of the
+    force (which is then only shown): for a planner that plans in velocities, or must back off.
     """
 
     force: np.ndarray
@@ -74,3 +79,4 @@ class Decision:
     gave_up: bool = False
     objective: np.ndarray | None = None
     planes: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
+    command: tuple[float, float] | None = None

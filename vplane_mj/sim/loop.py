@@ -31,7 +31,7 @@ from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario import Scenario
-from vplane_mj.sim.control import heading_command
+from vplane_mj.sim.control import heading_command, within_limits
 from vplane_mj.sim.drive import BELIEF_PATIENCE_S, CollisionCounter, Drive, Localiser
 from vplane_mj.sim.failure import RunFailure, failure_of
 from vplane_mj.sim.metrics import Clearance, motion_quality, path_quality, trajectory_digest, travelled
@@ -250,6 +250,7 @@ class Run:
             self.sensor.bearings,
             self.ranges,
             self.sensor.beam_width,
+            self.drive.wheel_velocity(),
         )
         return self._observation
 
@@ -347,6 +348,8 @@ class Run:
         decision = self._decision
         assert self._belief is not None and decision is not None, "reporting a tick not planned"
         believed_xy, believed_yaw = self._belief
+        if command is None and decision.command is not None:
+            command = within_limits(decision.command, self.drive.gains)
         if command is None:
             command = heading_command(
                 float(decision.force[0]), float(decision.force[1]), believed_yaw, self.drive.gains
