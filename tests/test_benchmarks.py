@@ -39,6 +39,7 @@ def table_rows(text: str, first_cell: str) -> list[list[str]]:
         ("planner_cost.py", ("open_field", "--driver", "apf", "--repeat", "1"), "open_field", 2),
         ("video.py", ("open_field", "--repeat", "1"), "open_field", 3),
         ("map_update.py", ("--repeat", "1", "--poses", "2"), "jackal_laser", 2),
+        ("dm_control_env.py", ("single_box", "--steps", "2", "--repeat", "1"), "pixels top 84 x 84", 1),
     ],
 )
 def test_timing_benchmarks_print_their_table(tmp_path, script, arguments, first_cell, number_column):

@@ -68,7 +68,7 @@ class VPlaneNavEnv(gymnasium.Env):
         and is the run's `run.seed` (sensor noise and faults), as `vplane-mj run --seed SEED`."""
         super().reset(seed=seed)
         episode_seed = seed if seed is not None else int(self.np_random.integers(2**31))
-        return self.task.begin(episode_seed)
+        return self.task.begin(self.task.episode_scenario(episode_seed))
 
     def step(self, action: np.ndarray) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         """One control tick with `action` in place of the planner's decision."""
