@@ -9,6 +9,7 @@ import math
 import os
 import re
 import shutil
+import sysconfig
 import tempfile
 import textwrap
 from pathlib import Path
@@ -42,6 +43,17 @@ def own_registry(monkeypatch):
     """A planner registry of this test's own: what it registers is gone afterwards."""
     monkeypatch.setattr(registry, "PLANNERS", registry._Planners())
     return registry.PLANNERS
+
+
+@pytest.fixture
+def console_script():
+    """The path of an installed command (a package's console script) of the Python running the
+    tests: in its scripts directory (a virtual environment's bin), whatever PATH holds."""
+
+    def find(name: str) -> str:
+        return str(Path(sysconfig.get_path("scripts")) / name)
+
+    return find
 
 
 @pytest.fixture

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
+import importlib.util
 import itertools
 import json
 import math
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -494,9 +494,10 @@ def test_cylinders_no_border_and_a_planner_without_virtual_parts(scenario_from, 
     assert len(contents.times_ns) == len(result.times) + 1 and contents.complete
 
 
-@pytest.mark.skipif(shutil.which("pymcap-cli") is None, reason="pymcap-cli is not installed")
-def test_pymcap_cli_doctor_accepts_the_file(run):
-    done = subprocess.run(["pymcap-cli", "doctor", str(run["path"])], capture_output=True, text=True)
+@pytest.mark.skipif(importlib.util.find_spec("pymcap_cli") is None, reason="pymcap-cli is not installed")
+def test_pymcap_cli_doctor_accepts_the_file(run, console_script):
+    command = [console_script("pymcap-cli"), "doctor", str(run["path"])]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stdout + done.stderr
 
 
