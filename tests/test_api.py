@@ -350,6 +350,7 @@ def test_sweep_rejects_invalid_input_before_any_run_and_leaves_no_directory(tmp_
     assert not (tmp_path / "new").exists()
 
 
+@pytest.mark.slow
 def test_the_readme_examples_run(tmp_path, monkeypatch, readme_examples, capsys):
     monkeypatch.chdir(tmp_path)
     exec(compile(readme_examples("Python API"), "README.md", "exec"), {})

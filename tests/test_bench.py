@@ -126,6 +126,7 @@ def test_parse_seeds():
             parse_seeds(bad)
 
 
+@pytest.mark.slow
 def test_a_dask_cluster_gives_the_same_rows_as_the_local_pool(tmp_path, capsys):
     distributed = pytest.importorskip("distributed")
     local, remote = tmp_path / "local", tmp_path / "dask"
@@ -367,6 +368,7 @@ def assert_the_rerun_completes_the_sweep(out_dir, gate, done):
     [(signal.SIGINT, False), (signal.SIGINT, True), (signal.SIGTERM, False), (signal.SIGTERM, True)],
     ids=["SIGINT-process", "SIGINT-group", "SIGTERM-process", "SIGTERM-group"],
 )
+@pytest.mark.slow
 def test_an_interrupted_sweep_keeps_its_finished_runs_stops_its_workers_and_resumes(
     tmp_path, gate, signum, whole_group
 ):
@@ -396,6 +398,7 @@ def test_an_interrupted_sweep_keeps_its_finished_runs_stops_its_workers_and_resu
     assert_the_rerun_completes_the_sweep(out_dir, gate, done=2)
 
 
+@pytest.mark.slow
 def test_a_killed_sweep_leaves_a_journal_the_rerun_resumes_from(tmp_path, gate):
     out_dir = tmp_path / "out"
     process = start_bench(out_dir, gate)
@@ -474,6 +477,7 @@ def test_a_run_that_raises_is_an_error_row_with_its_scenario_saved_and_the_sweep
     assert len((tmp_path / JOURNAL).read_text().splitlines()) == 3
 
 
+@pytest.mark.slow
 def test_a_worker_killed_mid_sweep_is_an_error_row_and_every_other_run_finishes(tmp_path, gate):
     out_dir = tmp_path / "out"
     process = start_bench(out_dir, gate)
@@ -513,6 +517,7 @@ def test_a_worker_killed_mid_sweep_is_an_error_row_and_every_other_run_finishes(
     assert len((out_dir / JOURNAL).read_text().splitlines()) == 8
 
 
+@pytest.mark.slow
 def test_a_failed_dask_task_is_the_same_error_row_as_in_the_local_pool(tmp_path):
     distributed = pytest.importorskip("distributed")
     good = plan_jobs(["open_field"], ["apf"], [0])[0]
@@ -530,6 +535,7 @@ def test_a_failed_dask_task_is_the_same_error_row_as_in_the_local_pool(tmp_path)
     assert {**rows[1], **elsewhere} == {**local[0], **elsewhere}
 
 
+@pytest.mark.slow
 def test_a_dask_worker_that_dies_mid_run_is_an_error_row(tmp_path, gate):
     distributed = pytest.importorskip("distributed")
     import dask

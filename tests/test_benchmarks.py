@@ -15,6 +15,8 @@ import pytest
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.loop import run_scenario
 
+pytestmark = pytest.mark.slow  # a long suite: `python -m pytest -m slow` runs it
+
 BENCHMARKS = Path(__file__).parents[1] / "benchmarks"
 
 

@@ -187,6 +187,7 @@ def test_bad_options_are_clear_errors():
         env.step(np.zeros(3))
 
 
+@pytest.mark.slow
 def test_the_readme_examples_run(tmp_path, monkeypatch, readme_examples, capsys):
     monkeypatch.chdir(tmp_path)
     exec(compile(readme_examples("dm_env environment"), "README.md", "exec"), {})

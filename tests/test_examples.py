@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.slow  # a long suite: `python -m pytest -m slow` runs it
+
 EXAMPLES = Path(__file__).parents[1] / "examples"
 SUMMARY_LINE = re.compile(
     r"^(?P<scenario>\w+) \[(?P<planner>\w+), seed (?P<seed>\d+)\]: (?P<outcome>\w+) after "

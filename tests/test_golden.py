@@ -35,6 +35,8 @@ from vplane_mj.scenario import load_scenario, parse_scenario
 from vplane_mj.sim.loop import run_scenario
 from vplane_mj.worlds.families import generate, trap_suite
 
+pytestmark = pytest.mark.slow  # a long suite: `python -m pytest -m slow` runs it
+
 GOLDEN = Path(__file__).with_name("golden_digests.json")
 GOLDEN_TIME_LIMIT_S = 40.0
 """Simulated seconds at most per run (s)."""

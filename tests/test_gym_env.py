@@ -27,6 +27,7 @@ def episode(env, actions, seed):
     return steps
 
 
+@pytest.mark.slow
 def test_gymnasium_checks_pass_for_both_kinds_of_action():
     made = gymnasium.make(ENV_ID, scenario="single_box")
     check_env(made.unwrapped)
@@ -111,6 +112,7 @@ def test_bad_options_are_clear_errors():
         VPlaneNavEnv("single_box", overrides=["sensors.dropout=2"])
 
 
+@pytest.mark.slow
 def test_the_readme_examples_run(tmp_path, monkeypatch, readme_examples, capsys):
     monkeypatch.chdir(tmp_path)
     exec(compile(readme_examples("Gymnasium environment"), "README.md", "exec"), {})

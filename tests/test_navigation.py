@@ -13,6 +13,8 @@ from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim.loop import run_scenario
 from vplane_mj.worlds.families import cup_case, rotated, trap_suite
 
+pytestmark = pytest.mark.slow  # a long suite: `python -m pytest -m slow` runs it
+
 PAPER = ["paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape"]
 
 

@@ -42,6 +42,7 @@ def decode_size(path) -> tuple[int, int]:
         reader.close()
 
 
+@pytest.mark.slow
 def test_run_writes_an_h264_mp4_in_real_time_beside_the_log(logged, capsys):
     video = logged / "paper_c_escape-vplane-0.mp4"
     assert video.is_file() and not list(logged.glob(".*partial"))
@@ -58,6 +59,7 @@ def test_run_writes_an_h264_mp4_in_real_time_beside_the_log(logged, capsys):
     assert orange > 20  # sonar echoes
 
 
+@pytest.mark.slow
 def test_gif_at_a_speed(logged, capsys, tmp_path):
     target = tmp_path / "run.gif"
     log = logged / "paper_c_escape-vplane-0.mcap"
