@@ -490,11 +490,11 @@ def test_a_sweep_whose_planner_raises_warns_and_each_error_runs_again_by_its_com
     assert (tmp_path / "executions.txt").read_text() == "ran\n" * 2  # the script, then its import
 
 
-def test_the_readme_planner_snippets_run_as_a_script(tmp_path, readme_examples):
-    """The code of "Your own planner", as a user's script: the planner class, registered in
+def test_the_documented_planner_snippets_run_as_a_script(tmp_path, doc_examples):
+    """The code of docs/own-planner.md, as a user's script: the planner class, registered in
     code, run by `vplane_mj.run` and swept by `vplane_mj.sweep` with a planner file."""
-    script = tmp_path / "readme_planner.py"
-    script.write_text(readme_examples("Your own planner"))
+    script = tmp_path / "own_planner.py"
+    script.write_text(doc_examples("own-planner.md", "Parameters and class attributes", "Registering it"))
     done = subprocess.run(
         [sys.executable, str(script)], cwd=ROOT, capture_output=True, text=True, timeout=600
     )
