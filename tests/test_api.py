@@ -27,11 +27,11 @@ from vplane_mj import (
     wall,
 )
 from vplane_mj.cli import main
-from vplane_mj.interrupts import Interrupted
 from vplane_mj.logs.reader import read_log
 from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim.metrics import trajectory_digest
 from vplane_mj.sim.summary import without_timing
+from vplane_mj.terminal import Interrupted
 
 TRAP = """
 format = 1

@@ -38,6 +38,7 @@ def table_rows(text: str, first_cell: str) -> list[list[str]]:
     [
         ("planner_cost.py", ("open_field", "--driver", "apf", "--repeat", "1"), "open_field", 2),
         ("video.py", ("open_field", "--repeat", "1"), "open_field", 3),
+        ("map_update.py", ("--repeat", "1", "--poses", "2"), "jackal_laser", 2),
     ],
 )
 def test_timing_benchmarks_print_their_table(tmp_path, script, arguments, first_cell, number_column):
@@ -92,3 +93,15 @@ def test_sweep_benchmarks_write_their_results(tmp_path):
         out = run_benchmark(script, *arguments, "--time-limit", "5", "--out", name, cwd=tmp_path)
         assert f"wrote {name}/{name}.png" in out
         assert (tmp_path / name / f"{name}.png").stat().st_size > 1000
+
+
+def test_barn_protocol_sweeps_the_planners_beside_barns_published_figures(tmp_path):
+    out = run_benchmark(
+        "barn_protocol.py",
+        *("--count", "1", "--seeds", "0", "--planners", "vplane_plus,apf", "--out", "barn"),
+        cwd=tmp_path,
+    )
+    rows = {row["planner"]: row for row in csv.DictReader((tmp_path / "barn" / "barn_protocol.csv").open())}
+    assert set(rows) == {"vplane_plus", "apf"} and all(row["runs"] == "1" for row in rows.values())
+    assert table_rows(out, "BARN: DWA baseline") and table_rows(out, "BARN: best entries")
+    assert (tmp_path / "barn" / "barn_protocol.png").stat().st_size > 1000

@@ -199,7 +199,7 @@ LOADED = """
 import sys
 from vplane_mj.cli import main
 status = main(sys.argv[1:])
-heavy = ("OpenGL", "matplotlib", "scipy", "dm_control", "dm_env")
+heavy = ("OpenGL", "matplotlib", "scipy", "dm_control", "dm_env", "numba")
 print(status, sorted(name for name in heavy if name in sys.modules))
 """
 

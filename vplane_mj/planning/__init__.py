@@ -1,4 +1,5 @@
-"""Planning: pure numpy, no MuJoCo. What a planner receives each control tick and what it answers.
+"""Planning: numpy (numba for a laser's map update), no MuJoCo. What a planner receives each
+control tick and what it answers.
 
 The names for writing a planner of one's own (README, "Your own planner"):
 

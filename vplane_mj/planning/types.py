@@ -11,11 +11,14 @@ from vplane_mj.planning.events import Event
 
 @dataclass(frozen=True)
 class Observation:
-    """The planner's whole view of the world: its pose, its goal and its sonar ring.
+    """The planner's whole view of the world: its pose, its goal and its range scan.
 
     `ranges` (m) are measured from the robot's centre along `bearings` (rad, robot
-    frame, counter-clockwise from the heading, evenly spaced); NaN means no echo.
-    `beam_width` (rad) is each sonar's beam: an echo lies somewhere within it.
+    frame, counter-clockwise from the heading); NaN means no echo. The bearings are any
+    sensor's: an evenly spaced sonar ring, uneven sonar arrays (several beams may share a
+    bearing), or a laser's scan over its field of view, in any order. `beam_width` (rad) is
+    each beam's width, the same for all: an echo lies somewhere within it (a laser's is its
+    angle step).
     """
 
     time_s: float
@@ -28,7 +31,7 @@ class Observation:
     beam_width: float
 
     def echo_points(self) -> np.ndarray:
-        """World-frame points (N, 2) of the sonar echoes; no-echo readings are dropped.
+        """World-frame points (N, 2) of the echoes, each on its beam's axis; no-echo readings are dropped.
 
         Computed once per observation and shared by every caller, so it is read-only.
         """

@@ -26,7 +26,6 @@ import numpy as np
 from vplane_mj import __version__
 from vplane_mj.errors import VPlaneError
 from vplane_mj.geometry import shapes
-from vplane_mj.interrupts import Interrupted
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Decision, Observation
@@ -39,6 +38,7 @@ from vplane_mj.sim.metrics import Clearance, motion_quality, path_quality, traje
 from vplane_mj.sim.sensors import range_sensor
 from vplane_mj.sim.summary import Outcome, RunSummary
 from vplane_mj.sim.world import build_model
+from vplane_mj.terminal import Interrupted
 
 EXTERNAL_PLANNER = "external"
 """The summary's planner name of a run whose decisions come from outside the package."""
