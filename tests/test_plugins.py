@@ -503,7 +503,8 @@ def test_the_documented_planner_snippets_run_as_a_script(tmp_path, doc_examples)
     assert lines[0] == "reached 0.6"
     header, *table = lines[1:]
     assert header.split()[:3] == ["planner", "runs", "success_rate"]
-    assert [(row.split()[0], row.split()[1]) for row in table] == [
+    rows = [row.split() for row in table if row.split() and row.split()[0].isidentifier()]  # no rules
+    assert [(row[0], row[1]) for row in rows] == [
         ("apf", "4"),
         ("cautious", "4"),
         ("random_walk", "4"),
