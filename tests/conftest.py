@@ -77,15 +77,17 @@ def shipped():
 
 
 @pytest.fixture
-def readme_examples():
-    """The Python code blocks of a README section (`## TITLE`), joined into one script (a
-    block indented in a list item is dedented)."""
+def doc_examples():
+    """The Python code blocks of sections (`## TITLE`) of a documentation page (docs/PAGE), in
+    the page's order, joined into one script (a block indented in a list item is dedented)."""
 
-    def blocks(title: str) -> str:
-        text = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
-        section = text.split(f"\n## {title}\n", 1)[1].split("\n## ", 1)[0]
+    def blocks(page: str, *titles: str) -> str:
+        text = (Path(__file__).parents[1] / "docs" / page).read_text(encoding="utf-8")
+        sections = [text.split(f"\n## {title}\n", 1)[1].split("\n## ", 1)[0] for title in titles]
         return "\n".join(
-            textwrap.dedent(block) for block in re.findall(r"```python\n(.*?)```", section, re.S)
+            textwrap.dedent(block)
+            for section in sections
+            for block in re.findall(r"```python\n(.*?)```", section, re.S)
         )
 
     return blocks

@@ -1,4 +1,4 @@
-"""The Python API (README "Python API"): scenarios loaded and built in code, `run`, `sweep`, and
+"""The Python API (docs/python-api.md): scenarios loaded and built in code, `run`, `sweep`, and
 the command line as a thin layer over them."""
 
 import importlib
@@ -351,9 +351,10 @@ def test_sweep_rejects_invalid_input_before_any_run_and_leaves_no_directory(tmp_
 
 
 @pytest.mark.slow
-def test_the_readme_examples_run(tmp_path, monkeypatch, readme_examples, capsys):
+def test_the_documented_examples_run(tmp_path, monkeypatch, doc_examples, capsys):
     monkeypatch.chdir(tmp_path)
-    exec(compile(readme_examples("Python API"), "README.md", "exec"), {})
+    script = doc_examples("python-api.md", "Run a scenario", "Build a scenario in code", "Sweep")
+    exec(compile(script, "docs/python-api.md", "exec"), {})
     assert load_scenario("my_trap.toml").name == "my_trap"
     assert (tmp_path / "logs" / "paper_c_escape-vplane-3.json").exists()
     assert json.loads((tmp_path / "results" / "bench.json").read_text())["table"][0]["runs"] == 6
