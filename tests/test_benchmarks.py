@@ -1,5 +1,5 @@
 """The benchmark scripts run: each, with the smallest arguments it takes, exits 0 and prints or
-writes its results (their numbers are the README's business, not the tests')."""
+writes its results (their numbers are the docs' business, not the tests')."""
 
 from __future__ import annotations
 

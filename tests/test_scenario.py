@@ -568,7 +568,7 @@ SHIPPED = [
     "paper_h_escape",
     "single_box",
 ]
-"""The scenarios the package ships (README "Scenario files"), sorted by name."""
+"""The scenarios the package ships (docs/scenarios.md), sorted by name."""
 
 
 def test_shipped_scenarios_all_validate():
