@@ -88,6 +88,7 @@ def test_physics_is_dm_controls_over_the_model_and_data_the_run_steps():
     env.close()
 
 
+@pytest.mark.slow  # a process of its own
 def test_the_size_table_is_fitted_when_the_first_physics_is_made_and_not_on_import():
     script = """
 import sys

@@ -115,7 +115,7 @@ class VPlaneNavDmEnv(dm_env.Environment):
 
     def observation_spec(self) -> dict[str, specs.BoundedArray]:
         """`ranges` (count,) float32 m, `echo` (count,) int8 0/1, `goal` (2,) float32 m in the
-        robot frame, `velocity` (2,) float32 m/s and rad/s: see the README."""
+        robot frame, `velocity` (2,) float32 m/s and rad/s: see docs/environments.md."""
         return self._observation_spec
 
     def action_spec(self) -> specs.BoundedArray:
@@ -124,7 +124,7 @@ class VPlaneNavDmEnv(dm_env.Environment):
         return self._action_spec
 
     def reward_spec(self) -> specs.Array:
-        """A float64 scalar: the reward of the README (progress in m, collisions, time, success)."""
+        """A float64 scalar: the reward of docs/environments.md (progress in m, collisions, time, success)."""
         return specs.Array((), np.float64, name="reward")
 
     def close(self) -> None:
