@@ -22,6 +22,7 @@ from vplane_mj.scenario import load_scenario, parse_scenario
 from vplane_mj.sim.world import (
     BORDER_SIDES,
     CHASE_BACK_M,
+    CHASE_CAMERA,
     CHASE_UP_M,
     GOAL_SITE,
     ROBOT_PREFIX,
@@ -29,7 +30,8 @@ from vplane_mj.sim.world import (
     build_model,
 )
 
-CHASE_CAMERA = ROBOT_PREFIX + "chase"
+CHASE_NAME = ROBOT_PREFIX + CHASE_CAMERA
+"""The chase camera's name in the world."""
 BASE_LINK = ROBOT_PREFIX + BASE_BODY
 
 
@@ -63,7 +65,7 @@ def top_pixel(physics, point, height: int, width: int) -> tuple[int, int]:
 def chase_pixel(physics, point, height: int, width: int) -> tuple[int, int]:
     """Row and column where the chase camera shows the world point (x, y, z in m): dm_control's
     camera matrix (a perspective camera)."""
-    xs, ys, s = dm_mujoco.Camera(physics, height, width, camera_id=CHASE_CAMERA).matrix @ [*point, 1.0]
+    xs, ys, s = dm_mujoco.Camera(physics, height, width, camera_id=CHASE_NAME).matrix @ [*point, 1.0]
     return int(ys / s), int(xs / s)
 
 
@@ -121,7 +123,7 @@ WORLDS += [parse_scenario(family_case(family, 0).toml(), family) for family in (
 @pytest.mark.parametrize("scenario", WORLDS, ids=[scenario.name for scenario in WORLDS])
 def test_every_world_has_the_top_and_chase_cameras_and_the_goal_marker(scenario):
     model = build_model(scenario, rangefinders=False)
-    top, chase = model.camera(TOP_CAMERA), model.camera(CHASE_CAMERA)
+    top, chase = model.camera(TOP_CAMERA), model.camera(CHASE_NAME)
     assert top.bodyid[0] == 0 and model.cam_projection[top.id] == mujoco.mjtProjection.mjPROJ_ORTHOGRAPHIC
     assert np.allclose(top.pos[:2], np.array(scenario.world.size) / 2)
     assert (
@@ -161,7 +163,7 @@ def test_the_top_camera_frames_the_whole_arena_at_any_aspect(name, height, width
 
 def test_the_offscreen_buffer_holds_renders_up_to_its_size_in_every_world():
     env = VPlaneNavDmEnv(parse_scenario(family_case("barn", 0).toml(), "barn"))  # 4.2 x 10.5 m: narrow
-    frame = env.physics.render(OFFSCREEN_PX, OFFSCREEN_PX, camera_id=CHASE_CAMERA)
+    frame = env.physics.render(OFFSCREEN_PX, OFFSCREEN_PX, camera_id=CHASE_NAME)
     assert frame.shape == (OFFSCREEN_PX, OFFSCREEN_PX, 3) and frame.dtype == np.uint8
     env.close()
 
@@ -173,7 +175,7 @@ def wrapped(env, height=48, width=64):
     )
     size = {"height": height, "width": width}
     return pixels.Wrapper(
-        top, pixels_only=False, render_kwargs={**size, "camera_id": CHASE_CAMERA}, observation_key="chase"
+        top, pixels_only=False, render_kwargs={**size, "camera_id": CHASE_NAME}, observation_key="chase"
     )
 
 
