@@ -4,6 +4,7 @@ writes its results (their numbers are the docs' business, not the tests')."""
 from __future__ import annotations
 
 import csv
+import importlib.util
 import math
 import re
 import subprocess
@@ -137,3 +138,47 @@ def test_barn_protocol_sweeps_the_planners_beside_barns_published_figures(tmp_pa
     assert set(rows) == {"vplane_plus", "apf"} and all(row["runs"] == "1" for row in rows.values())
     assert table_rows(out, "BARN: DWA baseline") and table_rows(out, "BARN: best entries")
     assert (tmp_path / "barn" / "barn_protocol.png").stat().st_size > 1000
+
+
+def run_peer_irsim(cwd: Path) -> subprocess.CompletedProcess:
+    """benchmarks/peer_irsim.py with its smallest arguments."""
+    arguments = ("--count", "1", "--time-limit", "0.1", "--repeat", "1", "--planners", "dwa")
+    return subprocess.run(
+        [sys.executable, str(BENCHMARKS / "peer_irsim.py"), *arguments],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+
+
+# Looked up, not imported: importing IR-SIM sets Matplotlib's backend for the whole test process.
+@pytest.mark.skipif(
+    importlib.util.find_spec("irsim") is None, reason="IR-SIM (the `peers` extra) not installed"
+)
+def test_peer_irsim_times_both_simulators_on_the_same_world(tmp_path):
+    done = run_peer_irsim(tmp_path)
+    assert done.returncode == 0, done.stderr[-2000:]
+    rows = table_rows(done.stdout, "barn_protocol_0_000")
+    ((_, cylinders, difference_mm),) = [row for row in rows if len(row) == 3]
+    assert int(cylinders) > 100 and float(difference_mm) < 2.0  # IR-SIM's world scans as this project's
+    timings = {(row[1], row[2]): row for row in rows if len(row) == 10}
+    simulators = ("IR-SIM `dash`", "vplane-mj `dwa`")
+    assert set(timings) == {(simulator, beams) for simulator in simulators for beams in ("16", "720")}
+    for row in timings.values():
+        assert float(row[4]) == pytest.approx(0.1) and float(row[6]) > 0  # simulated s, sim s per CPU s
+    overall = [table_rows(done.stdout, simulator) for simulator in simulators]
+    assert [[row[1] for row in rows] for rows in overall] == [["16", "720"], ["16", "720"]]
+
+
+def test_peer_irsim_without_irsim_says_what_to_install(tmp_path):
+    script = str(BENCHMARKS / "peer_irsim.py")
+    hide_irsim = (
+        "import runpy, sys; sys.modules['irsim'] = None; sys.argv = [sys.argv[1]]; "
+        "runpy.run_path(sys.argv[0], run_name='__main__')"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", hide_irsim, script], cwd=tmp_path, capture_output=True, text=True, timeout=600
+    )
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert "pip install 'vplane-mj[peers]'" in done.stderr and "(irsim)" in done.stderr
