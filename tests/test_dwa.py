@@ -10,6 +10,7 @@ from vplane_mj import shapes
 from vplane_mj.control import ControllerGains, heading_command
 from vplane_mj.families import random_barn
 from vplane_mj.planning import dwa
+from vplane_mj.planning.body import HeadingGains, RobotBody
 from vplane_mj.planning.types import Observation
 from vplane_mj.robot import robot_radius_m
 from vplane_mj.scenario import parse_scenario
@@ -46,21 +47,23 @@ def drive(planner, footprints, speed, ticks, yaw=0.0, start=(0.0, 0.0)):
     return decision, position - speed * PERIOD * heading
 
 
-def test_the_heading_law_is_the_controllers():
-    gains = ControllerGains()
-    assert (gains.speed_gain, gains.turn_gain) == (dwa.SPEED_GAIN, dwa.TURN_GAIN)
-    assert (gains.max_speed, gains.max_turn_rate) == (dwa.CONTROLLER_MAX_SPEED, dwa.CONTROLLER_MAX_TURN_RATE)
+def test_the_default_robots_window_is_the_controllers():
+    gains, limits = ControllerGains(), planner().limits
+    assert (limits.max_speed_mps, limits.max_turn_rate_radps) == (gains.max_speed, gains.max_turn_rate)
+    assert (limits.max_accel_mps2, limits.max_turn_accel_radps2) == (4.0, 30.0)
+    assert planner().lookahead == 1.0
 
 
 @pytest.mark.parametrize("yaw", [0.0, 2.0, -3.0, 1e6])
 def test_the_force_maps_back_to_the_command_through_the_heading_controller(yaw):
     for speed in (0.0, 0.05, 0.3, 0.5):
         for turn in (-2.5, -1.0, 0.0, 0.4, 2.5):
-            v, omega = heading_command(*dwa.force_for_command(speed, turn, yaw), yaw, ControllerGains())
+            force = dwa.force_for_command(speed, turn, yaw, HeadingGains())
+            v, omega = heading_command(*force, yaw, ControllerGains())
             assert v == pytest.approx(speed, abs=2 * dwa.CREEP_SPEED) and omega == pytest.approx(
                 turn, abs=1e-9
             )
-    assert np.all(dwa.force_for_command(0.0, 0.0, yaw) == 0.0)  # stop: no force at all
+    assert np.all(dwa.force_for_command(0.0, 0.0, yaw, HeadingGains()) == 0.0)  # stop: no force at all
 
 
 @pytest.mark.parametrize(
@@ -76,7 +79,8 @@ def test_the_window_holds_the_commands_reachable_in_one_period(
     speed, turn, slowest, fastest, leftmost, rightmost
 ):
     params = dwa.DwaParams()  # 4 m/s^2 and 30 rad/s^2: +-0.2 m/s and +-1.5 rad/s in 0.05 s
-    speeds, turns = dwa.dynamic_window(speed, turn, PERIOD, params)
+    limits = dwa.window_limits(params, RobotBody.round(RADIUS))
+    speeds, turns = dwa.dynamic_window(speed, turn, PERIOD, limits, params.speed_samples, params.turn_samples)
     assert (speeds[0], speeds[-1]) == pytest.approx((slowest, fastest))
     assert (turns[0], turns[-1]) == pytest.approx((leftmost, rightmost))
     assert len(speeds) == params.speed_samples and len(turns) == params.turn_samples
@@ -127,7 +131,7 @@ def test_an_arc_into_a_wall_is_not_chosen():
     v, omega = command(decision, 0.0)
     assert v > 0.0 and abs(omega) > 1.0
     chosen = ground_truth_free_length(wall, position, 0.0, v, omega)
-    assert chosen > straight and v * PERIOD + v * v / (2 * dwa_planner.params.accel_mps2) < chosen
+    assert chosen > straight and v * PERIOD + v * v / (2 * dwa_planner.limits.max_accel_mps2) < chosen
 
 
 POCKET = shapes.Footprints(
