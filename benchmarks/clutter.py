@@ -1,11 +1,11 @@
 """Every planner on every scenario family, the paper's scenarios included: the clutter comparison.
 
 Families: `paper` (the four built-in scenarios of the paper's figures), `suite` (the 34 cases
-of the trap suite, `vplane_mj.families.trap_suite`), and the generated
+of the trap suite, `vplane_mj.worlds.families.trap_suite`), and the generated
 `traps`, `clutter`, `corridors` (`--count` each, seed `--seed`) and `barn` (`--barn` worlds,
 seed 0, like `vplane-mj generate barn`). Each family also runs with noisy sonar when
 `--noise`/`--dropout` are given (by default 3 cm and 10% on `barn`, as `barn_noisy`). The
-scenario files are written to `OUT/cases/`; the runs go through `vplane_mj.bench.run_sweep`,
+scenario files are written to `OUT/cases/`; the runs go through `vplane_mj.bench.sweep.run_sweep`,
 so `OUT/bench.jsonl` journals them and the same command run again only does what is missing.
 
 Writes `OUT/clutter.csv` (per family and planner: runs, success rate, runs with a collision,
@@ -28,11 +28,11 @@ from pathlib import Path
 
 import numpy as np
 
-from vplane_mj.bench import plan_jobs, run_sweep
+from vplane_mj.bench.sweep import plan_jobs, run_sweep
 from vplane_mj.errors import VPlaneError
-from vplane_mj.families import generate, trap_suite
-from vplane_mj.outputs import prepare_out_dir, write_atomically
+from vplane_mj.files import prepare_out_dir, write_atomically
 from vplane_mj.planning.registry import PLANNERS
+from vplane_mj.worlds.families import generate, trap_suite
 
 PAPER = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")
 NOISY_SUFFIX = "_noisy"
@@ -115,7 +115,7 @@ def markdown(table: list[dict]) -> str:
 
 def plot(table: list[dict], path: Path) -> None:
     """Success, mean BARN score and median path ratio per planner (rows) and family (columns)."""
-    from vplane_mj.bench_report import annotated_heatmap, plt
+    from vplane_mj.bench.report import annotated_heatmap, plt
 
     families = list(dict.fromkeys(row["family"] for row in table))
     planners = list(dict.fromkeys(row["planner"] for row in table))

@@ -3,9 +3,9 @@
 Each sensor level is a pair (noise_std in m, dropout probability): a noise curve (dropout 0;
 by default noise 0, 0.02, 0.05, 0.1 m), a dropout curve (noise 0; by default 0.1, 0.2, 0.4)
 and one reference point with both (by default 0.03 m and 0.1). Every trap case
-(`vplane_mj.families.trap_suite`, 34 cases) runs with every planner and seed at every level,
+(`vplane_mj.worlds.families.trap_suite`, 34 cases) runs with every planner and seed at every level,
 with the simulated time limit `--time-limit` (s): by default 8 x 34 x 5 = 1360 runs. The cases
-are written to `OUT/cases/`; the runs go through `vplane_mj.bench.run_sweep`, so
+are written to `OUT/cases/`; the runs go through `vplane_mj.bench.sweep.run_sweep`, so
 `OUT/bench.jsonl` journals them and the same command run again only does what is missing. The
 level is part of each run's scenario name (`u_front_0_noise_0p03_dropout_0p1`: noise 0.03 m,
 dropout 0.1), so every journal row says which level it belongs to. A run succeeds when it reaches
@@ -28,11 +28,11 @@ import io
 import sys
 from pathlib import Path
 
-from vplane_mj.bench import parse_seeds, plan_jobs, run_sweep
+from vplane_mj.bench.sweep import parse_seeds, plan_jobs, run_sweep
 from vplane_mj.errors import VPlaneError
-from vplane_mj.families import trap_suite
-from vplane_mj.outputs import prepare_out_dir, write_atomically
+from vplane_mj.files import prepare_out_dir, write_atomically
 from vplane_mj.planning.registry import PLANNERS
+from vplane_mj.worlds.families import trap_suite
 
 COLUMNS = (
     "planner",

@@ -23,12 +23,12 @@ import time
 
 import numpy as np
 
-from vplane_mj.barn_protocol import generate_protocol
 from vplane_mj.planning.dwa import DwaPlanner
 from vplane_mj.planning.footprint_clearance import footprint_clearance
 from vplane_mj.planning.types import Observation
-from vplane_mj.robot import robot_body
+from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario import parse_scenario
+from vplane_mj.worlds.barn_protocol import generate_protocol
 
 CHUNK = 2048
 """Poses per distance matrix in the numpy version (a chunk's matrix: CHUNK x occupied cells)."""

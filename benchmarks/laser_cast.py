@@ -1,6 +1,6 @@
-"""Laser scans: the 2D cast of `vplane_mj.laser` against MuJoCo's ray caster, side by side.
+"""Laser scans: the 2D cast of `vplane_mj.sim.laser` against MuJoCo's ray caster, side by side.
 
-Two worlds, both built by `vplane_mj.world`: a BARN-size world (the BARN challenge's layout,
+Two worlds, both built by `vplane_mj.sim.world`: a BARN-size world (the BARN challenge's layout,
 a 4.2 x 14 m arena with its border and 150-250 cylinders of radius 0.075 m on the 0.15 m
 grid filling y in [4.95, 9.6], drawn with `--seed`) and a paper-size world (the paper's
 9.84 x 10.46 m arena with its border, the C trap of paper_c_escape and four boxes). From
@@ -15,7 +15,7 @@ scan (us), their ratio, and the largest difference between their ranges (mm).
 
 Last, the kernel's first call in a new process, in two processes run one after the other
 with an empty numba cache: the first compiles the kernel and writes the cache, the second
-loads it. Importing `vplane_mj.laser` (numba with it) is timed apart.
+loads it. Importing `vplane_mj.sim.laser` (numba with it) is timed apart.
 
     python benchmarks/laser_cast.py [--origins 200] [--repeat 20] [--seed 0]
 """
@@ -35,10 +35,10 @@ import time
 import mujoco
 import numpy as np
 
-from vplane_mj import shapes
-from vplane_mj.laser import MOUNT_HEIGHT_M, RayCaster
+from vplane_mj.geometry import shapes
 from vplane_mj.scenario import Scenario, box, build_scenario, cup, cylinder
-from vplane_mj.world import OBSTACLES_BODY, build_model
+from vplane_mj.sim.laser import MOUNT_HEIGHT_M, RayCaster
+from vplane_mj.sim.world import OBSTACLES_BODY, build_model
 
 BARN_CELL_M, BARN_RADIUS_M = 0.15, 0.075
 BARN_FIELD_Y_M = (4.95, 9.6)
@@ -54,8 +54,8 @@ OBSTACLES_ONLY = np.array([1, 1, 1, 1, 1, 0], dtype=np.uint8)
 FIRST_CALL = """
 import json, time
 started = time.perf_counter()
-from vplane_mj.laser import RayCaster
-from vplane_mj.shapes import Disc
+from vplane_mj.sim.laser import RayCaster
+from vplane_mj.geometry.shapes import Disc
 imported = time.perf_counter()
 RayCaster([Disc((1.0, 0.0), 0.1)]).cast((0.0, 0.0), 0.0, 0.01, 10, 5.0)
 print(json.dumps({"import_s": imported - started, "first_cast_s": time.perf_counter() - imported}))
@@ -208,7 +208,7 @@ def main() -> None:
     compiled, loaded = first_calls()
     print(
         f"\nFirst cast in a new process: {compiled['first_cast_s']:.3f} s with an empty numba cache "
-        f"(compile), {loaded['first_cast_s']:.3f} s with the cache (load); importing vplane_mj.laser: "
+        f"(compile), {loaded['first_cast_s']:.3f} s with the cache (load); importing vplane_mj.sim.laser: "
         f"{compiled['import_s']:.3f} s and {loaded['import_s']:.3f} s."
     )
 

@@ -35,12 +35,12 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from vplane_mj.log_mcap import McapLog
+from vplane_mj.logs.writer import McapLog
 from vplane_mj.planning import Decision, Observation, Planner, PlannerParams
 from vplane_mj.planning.registry import register_planner
 from vplane_mj.scenario import load_scenario
-from vplane_mj.sim import run_scenario
-from vplane_mj.world import SonarLayout, build_model
+from vplane_mj.sim.loop import run_scenario
+from vplane_mj.sim.world import SonarLayout, build_model
 
 DEFAULT_SCENARIOS = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")
 HARNESS_SCENARIO = "open_field"

@@ -25,14 +25,14 @@ from collections.abc import Callable
 
 import numpy as np
 
-from vplane_mj.families import random_barn
 from vplane_mj.planning.groups import LocalMapParams
 from vplane_mj.planning.registry import PLANNERS, make_planner
 from vplane_mj.planning.types import Observation
-from vplane_mj.robot import robot_radius_m
+from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import load_scenario, parse_scenario
-from vplane_mj.sim import run_scenario
-from vplane_mj.world import SonarLayout
+from vplane_mj.sim.loop import run_scenario
+from vplane_mj.sim.world import SonarLayout
+from vplane_mj.worlds.families import random_barn
 
 BARN_SEED = 8
 """The generated BARN-like world of the default set (47 boxes; tests/test_dwa.py drives it)."""

@@ -26,13 +26,13 @@ import mujoco
 import numpy as np
 import tomli_w
 
-from vplane_mj.bench import plan_jobs, run_sweep
-from vplane_mj.cache import CACHE_ENV
-from vplane_mj.families import generate
+from vplane_mj.bench.sweep import plan_jobs, run_sweep
+from vplane_mj.geometry.cache import CACHE_ENV
 from vplane_mj.planning.registry import PLANNERS
 from vplane_mj.scenario import parse_scenario
-from vplane_mj.sim import run_scenario
-from vplane_mj.world import build_model
+from vplane_mj.sim.loop import run_scenario
+from vplane_mj.sim.world import build_model
+from vplane_mj.worlds.families import generate
 
 PAPER = ["paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape"]
 

@@ -1,7 +1,7 @@
 """Soak test: generated scenarios with random sensor and actuation faults, all planners, no crash.
 
 `--count` scenarios (default 1000) are generated in turn from the families traps, clutter and
-corridors (`vplane_mj.families.generate`, seed `--seed`, only cases with a reference path),
+corridors (`vplane_mj.worlds.families.generate`, seed `--seed`, only cases with a reference path),
 the planners are assigned round-robin, and each run gets its own random faults, each fault
 turned on independently with probability 1/2 (the odometry pose 1/4), drawn from the same
 seed so the soak is reproducible:
@@ -18,7 +18,7 @@ seed so the soak is reproducible:
 | dead-reckoned pose | sensors.pose = "odometry", sensors.odometry_noise | 0-0.02 per tick |
 
 Each run has the simulated time limit `--time-limit` (s). The runs go through the sweep of
-`vplane-mj bench` (`vplane_mj.bench.run_sweep`) with `--jobs` worker processes. A run that
+`vplane-mj bench` (`vplane_mj.bench.sweep.run_sweep`) with `--jobs` worker processes. A run that
 raises is a crash: its row has outcome `error` and the exception with where it was raised,
 its traceback goes to `OUT/failed/<scenario>-<planner>-<seed>.traceback.txt`, and the soak
 goes on. A worker process that dies (segfault, out of memory) fails only the run it had under
@@ -49,14 +49,15 @@ from pathlib import Path
 
 import numpy as np
 
-from vplane_mj.bench import Job, family_of, run_sweep
+from vplane_mj.bench.failures import FAILURE_KEY, FailureKind
+from vplane_mj.bench.job import Job
+from vplane_mj.bench.sweep import family_of, run_sweep
 from vplane_mj.errors import VPlaneError
-from vplane_mj.failures import FAILURE_KEY, FailureKind
-from vplane_mj.families import generate
+from vplane_mj.files import prepare_out_dir, write_atomically, write_json
 from vplane_mj.interrupts import Interrupted, signals_raise_interrupted
-from vplane_mj.outputs import prepare_out_dir, write_atomically, write_json
 from vplane_mj.planning.registry import PLANNERS
 from vplane_mj.scenario import SensorSpec, parse_scenario
+from vplane_mj.worlds.families import generate
 
 JOURNAL = "soak.jsonl"
 PLAN = "plan.json"

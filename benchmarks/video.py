@@ -18,12 +18,12 @@ import tempfile
 import time
 from pathlib import Path
 
-from vplane_mj.log_mcap import McapLog
-from vplane_mj.log_read import read_log
+from vplane_mj.logs.reader import read_log
+from vplane_mj.logs.writer import McapLog
 from vplane_mj.scenario import load_scenario
-from vplane_mj.sim import run_scenario
-from vplane_mj.video import FORMATS, frame_count, write_video
-from vplane_mj.world import SonarLayout
+from vplane_mj.sim.loop import run_scenario
+from vplane_mj.sim.world import SonarLayout
+from vplane_mj.viz.video import FORMATS, frame_count, write_video
 
 DEFAULT_SCENARIOS = ("paper_c_escape", "paper_h_escape")
 MP4_SPEED, GIF_SPEED = 1.0, 2.0

@@ -19,15 +19,15 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from vplane_mj import shapes
+from vplane_mj.geometry import shapes
+from vplane_mj.geometry.synthetic import BEAM, BEARINGS, scan
 from vplane_mj.planning import histogram
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Observation
 from vplane_mj.planning.vplane_geometry import plane_force
-from vplane_mj.render import render_top_view, write_png
 from vplane_mj.scenario import load_scenario
-from vplane_mj.sim import run_scenario
-from vplane_mj.synthetic import BEAM, BEARINGS, scan
+from vplane_mj.sim.loop import run_scenario
+from vplane_mj.viz.render import render_top_view, write_png
 
 RADIUS = 0.11
 CUP = shapes.Cup((5.0, 5.0), width=1.6, depth=1.2, thickness=0.1)

@@ -28,7 +28,7 @@ import matplotlib.pyplot as plt
 
 import vplane_mj
 from vplane_mj import Scenario, ScenarioError, box, build_scenario, cup, cylinder, wall
-from vplane_mj.plots import draw_path, draw_world, label_modes
+from vplane_mj.viz.plots import draw_path, draw_world, label_modes
 
 
 def parse_args() -> argparse.Namespace:

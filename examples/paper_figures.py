@@ -25,7 +25,7 @@ import numpy as np
 
 import vplane_mj
 from vplane_mj import EventKind, RunRecord
-from vplane_mj.plots import draw_path, draw_world, label_modes
+from vplane_mj.viz.plots import draw_path, draw_world, label_modes
 
 PAPER_SCENARIOS = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")
 PLANE_EVENTS = (EventKind.ESCAPE_FINISHED, EventKind.PLANE_CREATED)

@@ -17,11 +17,11 @@ import numpy as np
 import pytest
 from hypothesis import settings
 
-from vplane_mj.cache import CACHE_ENV
 from vplane_mj.cli import main
+from vplane_mj.geometry.cache import CACHE_ENV
 from vplane_mj.planning import registry
 from vplane_mj.planning.registry import make_planner
-from vplane_mj.robot import robot_radius_m
+from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import build_scenario, load_scenario, parse_scenario, wall
 
 # The tests keep their cached reference paths apart from the user's (and start without any).

@@ -28,10 +28,10 @@ from vplane_mj import (
 )
 from vplane_mj.cli import main
 from vplane_mj.interrupts import Interrupted
-from vplane_mj.log_read import read_log
-from vplane_mj.metrics import trajectory_digest
+from vplane_mj.logs.reader import read_log
 from vplane_mj.scenario import parse_scenario
-from vplane_mj.summary import without_timing
+from vplane_mj.sim.metrics import trajectory_digest
+from vplane_mj.sim.summary import without_timing
 
 TRAP = """
 format = 1
@@ -276,7 +276,7 @@ def test_an_interruption_while_writing_keeps_the_whole_files_and_says_so(tmp_pat
     def interrupted(image, path):
         raise Interrupted(signal.SIGINT)
 
-    monkeypatch.setattr("vplane_mj.render.write_png", interrupted)
+    monkeypatch.setattr("vplane_mj.viz.render.write_png", interrupted)
     assert main(["run", "single_box", "--out", str(tmp_path)]) == 130
     err = capsys.readouterr().err.splitlines()
     assert err == [
@@ -356,8 +356,8 @@ def test_the_drawing_helpers_draw_the_world_and_a_path_by_mode():
     from matplotlib.collections import LineCollection
     from matplotlib.colors import to_rgba
 
-    from vplane_mj.plots import draw_path, draw_world, label_modes
-    from vplane_mj.render import MODE_RGBA, OTHER_MODE_RGBA
+    from vplane_mj.viz.plots import draw_path, draw_world, label_modes
+    from vplane_mj.viz.render import MODE_RGBA, OTHER_MODE_RGBA
 
     scenario = load_scenario("paper_c_escape")
     figure, axes = plt.subplots()

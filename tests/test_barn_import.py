@@ -12,12 +12,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vplane_mj.barn_import import barn_path_length, import_worlds
-from vplane_mj.barn_layout import JACKAL_RADIUS_M, to_arena
 from vplane_mj.cli import main
+from vplane_mj.geometry.shapes import scene_footprints
 from vplane_mj.scenario import parse_document
-from vplane_mj.sdf_world import read_world_shapes
-from vplane_mj.shapes import scene_footprints
+from vplane_mj.worlds.barn_import import barn_path_length, import_worlds
+from vplane_mj.worlds.barn_layout import JACKAL_RADIUS_M, to_arena
+from vplane_mj.worlds.sdf import read_world_shapes
 
 SAMPLE = Path(__file__).parent / "data" / "barn"
 

@@ -6,11 +6,11 @@ import tomllib
 import numpy as np
 import pytest
 
-from vplane_mj.barn_layout import JACKAL_RADIUS_M
-from vplane_mj.barn_protocol import JACKAL_CELLS, connect_ends, field_cylinders, open_windows
 from vplane_mj.cli import main
-from vplane_mj.reference import shortest_path_length
+from vplane_mj.geometry.reference import shortest_path_length
 from vplane_mj.scenario import parse_document
+from vplane_mj.worlds.barn_layout import JACKAL_RADIUS_M
+from vplane_mj.worlds.barn_protocol import JACKAL_CELLS, connect_ends, field_cylinders, open_windows
 
 
 def _generate(out, seed, count=12):

@@ -16,7 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vplane_mj.bench import (
+from vplane_mj.bench.failures import FAILED_SCENARIO_KEY
+from vplane_mj.bench.sweep import (
     JOURNAL,
     PATH_KEY,
     error_lines,
@@ -29,9 +30,8 @@ from vplane_mj.bench import (
 )
 from vplane_mj.cli import main
 from vplane_mj.errors import VPlaneError
-from vplane_mj.failures import FAILED_SCENARIO_KEY
 from vplane_mj.scenario import load_scenario
-from vplane_mj.summary import without_timing
+from vplane_mj.sim.summary import without_timing
 
 OUTPUTS = ("bench.csv", "bench.json", "bench.png", "bench-scenarios.png", "bench.html")
 ARGS = ["bench", "open_field", "paper_c_escape", "--planners", "apf,vplane", "--seeds", "0-1", "--jobs", "2"]

@@ -6,8 +6,8 @@ from html.parser import HTMLParser
 import numpy as np
 import pytest
 
-from vplane_mj import bench_report
-from vplane_mj.bench import family_of
+from vplane_mj.bench import report as bench_report
+from vplane_mj.bench.sweep import family_of
 from vplane_mj.scenario import load_scenario
 
 

@@ -5,13 +5,14 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj import shapes, synthetic
-from vplane_mj.control import ControllerGains, heading_command
+from vplane_mj.geometry import shapes, synthetic
 from vplane_mj.planning import bug2
 from vplane_mj.planning.types import Observation
-from vplane_mj.robot import robot_radius_m
+from vplane_mj.robots.facts import robot_radius_m
+from vplane_mj.robots.profiles import ControllerGains
 from vplane_mj.scenario import load_scenario
-from vplane_mj.sim import run_scenario
+from vplane_mj.sim.control import heading_command
+from vplane_mj.sim.loop import run_scenario
 
 ENCLOSURE = (  # a closed square of walls around (4, 3): x, y in [3.4, 4.6] x [2.4, 3.6]
     shapes.Wall((3.4, 2.4), (3.4, 3.6), 0.1),

@@ -12,9 +12,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from vplane_mj.cache import CACHE_ENV
+import vplane_mj
 from vplane_mj.cli import main
-from vplane_mj.log_read import read_log
+from vplane_mj.geometry.cache import CACHE_ENV
+from vplane_mj.logs.reader import read_log
 
 BAD_SCENARIO = """
 format = 1
@@ -304,3 +305,10 @@ def test_a_run_with_its_render_and_log_loads_no_plotting_library(tmp_path):
     assert done.returncode == 0, done.stderr
     assert done.stdout.split("\n")[-2] == "0 ['OpenGL', 'scipy']"  # the render needs OpenGL only
     assert (tmp_path / "single_box-vplane-0.png").stat().st_size > 0
+
+
+def test_version_names_the_package_and_the_contract(capsys):
+    assert main(["--version"]) == 0
+    out = capsys.readouterr().out
+    assert out.strip() == f"vplane-mj {vplane_mj.__version__} (contract v{vplane_mj.CONTRACT_VERSION})"
+    assert vplane_mj.CONTRACT_VERSION == "1.2"

@@ -6,13 +6,13 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 import pytest
 
-from vplane_mj import shapes
-from vplane_mj.families import generate
+from vplane_mj.geometry import shapes
+from vplane_mj.geometry.reference import shortest_path
 from vplane_mj.planning.events import EventKind
-from vplane_mj.reference import shortest_path
-from vplane_mj.robot import robot_radius_m
+from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import parse_scenario
-from vplane_mj.sim import run_scenario
+from vplane_mj.sim.loop import run_scenario
+from vplane_mj.worlds.families import generate
 
 RADIUS = robot_radius_m()
 

@@ -4,7 +4,8 @@ import math
 
 import pytest
 
-from vplane_mj.control import ControllerGains, WheelPI, heading_command, wheel_targets, wrap_angle
+from vplane_mj.robots.profiles import ControllerGains
+from vplane_mj.sim.control import WheelPI, heading_command, wheel_targets, wrap_angle
 
 GAINS = ControllerGains()
 

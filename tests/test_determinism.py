@@ -10,8 +10,8 @@ import pytest
 
 from vplane_mj.cli import main
 from vplane_mj.scenario import load_scenario
-from vplane_mj.sim import run_scenario
-from vplane_mj.summary import without_timing
+from vplane_mj.sim.loop import run_scenario
+from vplane_mj.sim.summary import without_timing
 
 EVERY_FAULT = [
     "sensors.noise_std=0.02",

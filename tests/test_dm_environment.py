@@ -12,9 +12,9 @@ from dm_env import test_utils
 
 from vplane_mj import ScenarioError, VPlaneError
 from vplane_mj.cli import main
-from vplane_mj.dm_environment import VPlaneNavDmEnv
-from vplane_mj.gym_env import VPlaneNavEnv
-from vplane_mj.summary import without_timing
+from vplane_mj.envs.dm_environment import VPlaneNavDmEnv
+from vplane_mj.envs.gym_env import VPlaneNavEnv
+from vplane_mj.sim.summary import without_timing
 
 
 class ForceActionsContract(test_utils.EnvironmentTestMixin, unittest.TestCase):

@@ -6,18 +6,18 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj import shapes
-from vplane_mj.barn_protocol import generate_protocol
-from vplane_mj.control import ControllerGains, heading_command
-from vplane_mj.families import random_barn
+from vplane_mj.geometry import shapes
+from vplane_mj.geometry.synthetic import BEAM, BEARINGS, scan
 from vplane_mj.planning import dwa
 from vplane_mj.planning.body import DriveLimits, HeadingGains, RobotBody
 from vplane_mj.planning.types import Observation
-from vplane_mj.profiles import PROFILES
-from vplane_mj.robot import robot_body, robot_radius_m
+from vplane_mj.robots.facts import robot_body, robot_radius_m
+from vplane_mj.robots.profiles import PROFILES, ControllerGains
 from vplane_mj.scenario import parse_scenario
-from vplane_mj.sim import Run, run_scenario
-from vplane_mj.synthetic import BEAM, BEARINGS, scan
+from vplane_mj.sim.control import heading_command
+from vplane_mj.sim.loop import Run, run_scenario
+from vplane_mj.worlds.barn_protocol import generate_protocol
+from vplane_mj.worlds.families import random_barn
 
 PERIOD = 0.05
 RADIUS = robot_radius_m()

@@ -6,10 +6,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from vplane_mj import sim
 from vplane_mj.errors import ScenarioError
-from vplane_mj.odometry import WheelOdometry
-from vplane_mj.world import ROBOT_PREFIX, build_model, standalone_xml
+from vplane_mj.sim import loop as sim
+from vplane_mj.sim.odometry import WheelOdometry
+from vplane_mj.sim.world import ROBOT_PREFIX, build_model, standalone_xml
 
 WHEEL_RADIUS, TRACK = 0.04, 0.15
 SENSOR_AND_ACTUATION_FAULTS = (

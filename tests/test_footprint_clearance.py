@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from vplane_mj.planning.footprint_clearance import footprint_clearance
-from vplane_mj.robot import robot_body
+from vplane_mj.robots.facts import robot_body
 
 
 def signed_distance(polygon, points):

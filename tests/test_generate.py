@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from vplane_mj.cli import main
-from vplane_mj.families import BARN_CELL_M, FAMILIES, barn_cells, cell_rectangles
-from vplane_mj.reference import shortest_path_length
-from vplane_mj.robot import robot_radius_m
+from vplane_mj.geometry.reference import shortest_path_length
+from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import load_scenario
+from vplane_mj.worlds.families import BARN_CELL_M, FAMILIES, barn_cells, cell_rectangles
 
 
 @pytest.mark.parametrize("family", ["traps", "clutter", "corridors", "barn"])

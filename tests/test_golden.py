@@ -26,10 +26,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from vplane_mj.families import generate, trap_suite
 from vplane_mj.planning.registry import PLANNERS
 from vplane_mj.scenario import load_scenario, parse_scenario
-from vplane_mj.sim import run_scenario
+from vplane_mj.sim.loop import run_scenario
+from vplane_mj.worlds.families import generate, trap_suite
 
 GOLDEN = Path(__file__).with_name("golden_digests.json")
 GOLDEN_TIME_LIMIT_S = 40.0

@@ -11,8 +11,8 @@ from gymnasium.utils.env_checker import check_env
 
 from vplane_mj import ScenarioError, VPlaneError
 from vplane_mj.cli import main
-from vplane_mj.gym_env import ENV_ID, VPlaneNavEnv
-from vplane_mj.summary import without_timing
+from vplane_mj.envs.gym_env import ENV_ID, VPlaneNavEnv
+from vplane_mj.sim.summary import without_timing
 
 
 def episode(env, actions, seed):

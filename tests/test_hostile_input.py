@@ -29,14 +29,14 @@ from hypothesis import strategies as st
 
 from vplane_mj import run
 from vplane_mj.cli import main
-from vplane_mj.log_read import read_log
+from vplane_mj.geometry.reference import shortest_path
+from vplane_mj.logs.reader import read_log
 from vplane_mj.planning import register_planner, registry
 from vplane_mj.planning.params import Param
-from vplane_mj.reference import shortest_path
-from vplane_mj.robot import robot_radius_m
+from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import Field, keys, load_scenario, parse_scenario
-from vplane_mj.sim import run_scenario
-from vplane_mj.summary import RunSummary
+from vplane_mj.sim.loop import run_scenario
+from vplane_mj.sim.summary import RunSummary
 
 FUZZ = settings(
     deadline=None,
@@ -971,7 +971,7 @@ MISTAKES = [
     ),
     (
         ["run", "paper_c_escape", "--set", "robot.gaol=[8, 2]"],
-        "error: --set robot.gaol: unknown key (allowed here: start, ",
+        "error: --set robot.gaol: unknown key (allowed here: profile, start, ",
         "; did you mean 'goal'? (applied to SCENARIO)",
     ),
     (

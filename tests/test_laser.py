@@ -9,11 +9,11 @@ import mujoco
 import numpy as np
 import pytest
 
-from vplane_mj import shapes
-from vplane_mj.laser import MOUNT_HEIGHT_M, LaserScanner, RayCaster
-from vplane_mj.robot import robot_radius_m
+from vplane_mj.geometry import shapes
+from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import box, build_scenario, cup, cylinder, h_shape, wall
-from vplane_mj.world import OBSTACLE_HEIGHT_M, OBSTACLES_BODY, build_model
+from vplane_mj.sim.laser import MOUNT_HEIGHT_M, LaserScanner, RayCaster
+from vplane_mj.sim.world import OBSTACLE_HEIGHT_M, OBSTACLES_BODY, build_model
 
 JACKAL_STEP = math.radians(270) / 719
 """The Jackal's laser: 720 beams over 270 degrees."""
@@ -287,7 +287,7 @@ def test_importing_the_package_does_not_import_numba():
     code = (
         "import sys, vplane_mj\n"
         "assert 'numba' not in sys.modules\n"
-        "import vplane_mj.laser\n"
+        "import vplane_mj.sim.laser\n"
         "assert 'numba' in sys.modules\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True)

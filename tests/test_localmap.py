@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj import shapes
+from vplane_mj.geometry import shapes
+from vplane_mj.geometry.synthetic import BEAM, BEARINGS, scan
 from vplane_mj.planning.localmap import LocalMap, angular_extremes
-from vplane_mj.synthetic import BEAM, BEARINGS, scan
 
 WALL = shapes.Footprints(shapes.Wall((2.0, -1.0), (2.0, 1.0), 0.1).footprint())
 

@@ -20,7 +20,10 @@ from mcap.reader import make_reader
 from mcap.records import Chunk
 from mcap.stream_reader import StreamReader
 
-from vplane_mj.log_mcap import (
+from vplane_mj.geometry.polyline import distances_to_segment
+from vplane_mj.logs.reader import iter_messages, read_log
+from vplane_mj.logs.scene import ARROW_M_PER_UNIT, ARROW_MAX_M, PATH_ID
+from vplane_mj.logs.writer import (
     EVENTS_JSON_SCHEMA,
     FLUSH_PERIOD_S,
     METADATA_NAME,
@@ -30,14 +33,11 @@ from vplane_mj.log_mcap import (
     McapLog,
     time_ns,
 )
-from vplane_mj.log_read import iter_messages, read_log
-from vplane_mj.log_scene import ARROW_M_PER_UNIT, ARROW_MAX_M, PATH_ID
 from vplane_mj.planning.events import Event, EventKind
-from vplane_mj.polyline import distances_to_segment
-from vplane_mj.robot import robot_radius_m
+from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import load_scenario, parse_scenario
-from vplane_mj.sim import run_scenario
-from vplane_mj.world import OBSTACLE_HEIGHT_M, SonarLayout
+from vplane_mj.sim.loop import run_scenario
+from vplane_mj.sim.world import OBSTACLE_HEIGHT_M, SonarLayout
 
 TIME_LIMIT_S = 12.0  # vplane detects the trap at ~5.5 s and finishes its escape at ~10.5 s
 
@@ -384,11 +384,11 @@ _CHILD = textwrap.dedent(
     """
     import sys, time
     from pathlib import Path
-    from vplane_mj.log_mcap import McapLog
-    from vplane_mj.robot import robot_radius_m
+    from vplane_mj.logs.writer import McapLog
+    from vplane_mj.robots.facts import robot_radius_m
     from vplane_mj.scenario import load_scenario
-    from vplane_mj.sim import run_scenario
-    from vplane_mj.world import SonarLayout
+    from vplane_mj.sim.loop import run_scenario
+    from vplane_mj.sim.world import SonarLayout
 
     class Slow:  # keep the run going until it is killed
         def on_tick(self, tick):

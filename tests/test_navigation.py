@@ -9,11 +9,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from vplane_mj import shapes
-from vplane_mj.families import cup_case, rotated, trap_suite
+from vplane_mj.geometry import shapes
 from vplane_mj.planning.events import EventKind
 from vplane_mj.scenario import parse_scenario
-from vplane_mj.sim import run_scenario
+from vplane_mj.sim.loop import run_scenario
+from vplane_mj.worlds.families import cup_case, rotated, trap_suite
 
 PAPER = ["paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape"]
 

@@ -7,13 +7,14 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from vplane_mj import control, sim
 from vplane_mj.planning import fields, registry
 from vplane_mj.planning.params import PlannerParams
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.planning.vplane_geometry import escape_direction, make_plane, plane_force, virtual_objective
-from vplane_mj.robot import robot_radius_m
-from vplane_mj.world import build_model
+from vplane_mj.robots.facts import robot_radius_m
+from vplane_mj.sim import control
+from vplane_mj.sim import loop as sim
+from vplane_mj.sim.world import build_model
 
 BEARINGS = np.arange(16) * (2 * math.pi / 16)
 coordinate = st.sampled_from([0.0, 1e-12, -1e-12, 5.0, 5.0 + 1e-9, 1e6])

@@ -9,11 +9,11 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj import sim
 from vplane_mj.cli import main
 from vplane_mj.planning.params import PlannerParams
 from vplane_mj.planning.types import Decision
-from vplane_mj.world import build_model
+from vplane_mj.sim import loop as sim
+from vplane_mj.sim.world import build_model
 
 ALL_SONARS_DEAD = "sensors.dead=[" + ",".join(str(i) for i in range(16)) + "]"
 

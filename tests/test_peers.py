@@ -3,7 +3,7 @@
 import pytest
 
 from vplane_mj.planning.registry import PLANNERS
-from vplane_mj.sim import run_scenario
+from vplane_mj.sim.loop import run_scenario
 
 
 @pytest.mark.parametrize(

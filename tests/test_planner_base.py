@@ -14,7 +14,7 @@ from vplane_mj.planning.base import Planner
 from vplane_mj.planning.params import ParamError
 from vplane_mj.planning.registry import PLANNERS, make_planner
 from vplane_mj.planning.vectors import unit, wrap_angle
-from vplane_mj.robot import robot_radius_m
+from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import load_scenario
 
 

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vplane_mj.bench import plan_jobs, run_job
+from vplane_mj.bench.sweep import plan_jobs, run_job
 from vplane_mj.errors import ScenarioError, VPlaneError
 from vplane_mj.planning import (
     DetectorParams,
@@ -32,8 +32,8 @@ from vplane_mj.planning import (
     register_planner,
 )
 from vplane_mj.planning.plugins import canonical_spec
-from vplane_mj.robot import robot_radius_m
-from vplane_mj.sim import run_scenario
+from vplane_mj.robots.facts import robot_radius_m
+from vplane_mj.sim.loop import run_scenario
 from vplane_mj.sweeps import sweep
 
 ROOT = Path(__file__).resolve().parent.parent

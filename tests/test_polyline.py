@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj.polyline import PathSimplifier, distances_to_segment
+from vplane_mj.geometry.polyline import PathSimplifier, distances_to_segment
 
 
 def simplify(points: np.ndarray, tolerance_m: float = 0.01, max_pending: int = 200) -> np.ndarray:

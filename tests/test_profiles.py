@@ -12,11 +12,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from vplane_mj.control import ControllerGains, WheelPI, wheel_targets
 from vplane_mj.errors import VPlaneError
-from vplane_mj.profiles import DRIVES, PROFILES, RobotProfile, robot_profile
-from vplane_mj.resources import model_path
-from vplane_mj.robot import (
+from vplane_mj.files import model_path
+from vplane_mj.robots.facts import (
     BASE_BODY,
     SONAR_MOUNT_HEIGHT_M,
     WHEEL_JOINTS,
@@ -24,7 +22,9 @@ from vplane_mj.robot import (
     read_robot_facts,
     robot_facts,
 )
+from vplane_mj.robots.profiles import DRIVES, PROFILES, ControllerGains, RobotProfile, robot_profile
 from vplane_mj.scenario.spec import SensorSpec
+from vplane_mj.sim.control import WheelPI, wheel_targets
 
 PREFIX = "robot/"
 OUTLINE_TOLERANCE_M = 1e-6
@@ -207,7 +207,7 @@ class Run:
 def drive_from_standing(profile: RobotProfile, speed: float, turn: float, ramp: bool, seconds: float) -> Run:
     """Command (speed m/s, turn rad/s) from standing, ramped at the profile's accelerations or
     stepped (as today's drive does), through a wheel-speed PI loop per side at the motor rate
-    (as vplane_mj.drive runs it), the wheel targets from the track times the track_scale."""
+    (as vplane_mj.sim.drive runs it), the wheel targets from the track times the track_scale."""
     model = attached_model(profile)
     data = mujoco.MjData(model)
     gains, limits = profile.gains, profile.limits

@@ -8,11 +8,11 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 import pytest
 
-from vplane_mj import cache, reference
-from vplane_mj.reference import ReferencePath, shortest_path, shortest_path_length, world_key
+from vplane_mj.geometry import cache, reference
+from vplane_mj.geometry.reference import ReferencePath, shortest_path, shortest_path_length, world_key
 from vplane_mj.scenario import load_scenario, parse_scenario
 
-RADIUS = 0.11  # vplane_mj.robot.robot_radius_m(), fixed here so the hand values are explicit
+RADIUS = 0.11  # vplane_mj.robots.facts.robot_radius_m(), fixed here so the hand values are explicit
 PAPER = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")
 
 
@@ -50,7 +50,7 @@ def tangent_and_arc(point, centre, r, leave_angle):
 
 
 def assert_path_is_clear(sc, ref, radius=RADIUS):
-    from vplane_mj.shapes import scene_footprints
+    from vplane_mj.geometry.shapes import scene_footprints
 
     fp = scene_footprints(sc.world.obstacles, sc.world.size)
     pts = np.concatenate(

@@ -4,7 +4,7 @@ import matplotlib.image
 import numpy as np
 import pytest
 
-from vplane_mj.render import png_bytes, write_png
+from vplane_mj.viz.render import png_bytes, write_png
 
 
 @pytest.mark.parametrize("shape", [(1, 1, 3), (1, 7, 3), (5, 1, 3), (37, 53, 3)])

@@ -11,8 +11,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from vplane_mj.resources import model_path
-from vplane_mj.robot import BASE_BODY, RobotFacts, read_robot_facts, robot_facts, robot_geometry
+from vplane_mj.files import model_path
+from vplane_mj.robots.facts import BASE_BODY, RobotFacts, read_robot_facts, robot_facts, robot_geometry
 
 SHIPPED = model_path("robot.xml")
 

@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 
 from vplane_mj import scenario as scenario_module
 from vplane_mj.errors import ScenarioError
+from vplane_mj.geometry.shapes import Box, Cup, Cylinder, HShape, Wall
 from vplane_mj.planning import registry
 from vplane_mj.scenario import (
     RunSpec,
@@ -24,7 +25,6 @@ from vplane_mj.scenario import (
     parse_scenario,
     resolve_path,
 )
-from vplane_mj.shapes import Box, Cup, Cylinder, HShape, Wall
 
 HEAD = 'format = 1\nname = "t"\n'
 WORLD = "[world]\nsize = [10.0, 10.0]\n"

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj import shapes
+from vplane_mj.geometry import shapes
 
 
 def distance(pieces, point):

@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj.metrics import barn_score
-from vplane_mj.sim import run_scenario
-from vplane_mj.summary import TIMING_KEYS
+from vplane_mj.sim.loop import run_scenario
+from vplane_mj.sim.metrics import barn_score
+from vplane_mj.sim.summary import TIMING_KEYS
 
 OPEN = """
 format = 1

@@ -7,11 +7,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from vplane_mj import shapes
+from vplane_mj.geometry import shapes
+from vplane_mj.geometry.synthetic import BEAM, BEARINGS, scan
 from vplane_mj.planning.events import EventKind
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Observation
-from vplane_mj.synthetic import BEAM, BEARINGS, scan
 
 RADIUS = 0.11
 

@@ -6,14 +6,14 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj import shapes
+from vplane_mj.geometry import shapes
+from vplane_mj.geometry.synthetic import BEAM, BEARINGS, scan
 from vplane_mj.planning import gridsearch
 from vplane_mj.planning.events import EventKind
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Observation
 from vplane_mj.planning.vplane_geometry import make_plane
 from vplane_mj.scenario import parse_scenario
-from vplane_mj.synthetic import BEAM, BEARINGS, scan
 
 RADIUS = 0.11
 

@@ -6,10 +6,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from vplane_mj.resources import data_dir
-from vplane_mj.robot import SONAR_MOUNT_RADIUS_M, robot_geometry
-from vplane_mj.sonar import SonarRays, SonarRing
-from vplane_mj.world import BUMP_SENSOR, ROBOT_PREFIX, SonarLayout, build_model, standalone_xml
+from vplane_mj.files import data_dir
+from vplane_mj.robots.facts import SONAR_MOUNT_RADIUS_M, robot_geometry
+from vplane_mj.sim.sonar import SonarRays, SonarRing
+from vplane_mj.sim.world import BUMP_SENSOR, ROBOT_PREFIX, SonarLayout, build_model, standalone_xml
 
 RING_16 = np.full(16, SONAR_MOUNT_RADIUS_M)
 """Each sonar of the default ring reaches this far along its bearing (m)."""

@@ -14,16 +14,16 @@ from typing import TYPE_CHECKING
 
 import vplane_mj
 from vplane_mj.errors import VPlaneError
-from vplane_mj.families import FAMILIES
+from vplane_mj.files import DEFAULT_OUT, prepare_out_dir, write_atomically
 from vplane_mj.interrupts import Interrupted, signals_raise_interrupted
-from vplane_mj.outputs import DEFAULT_OUT, prepare_out_dir, write_atomically
 from vplane_mj.planning.plugins import PlannerError
 from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
+from vplane_mj.worlds.families import FAMILIES
 
 if TYPE_CHECKING:
     from vplane_mj.scenario import Scenario
     from vplane_mj.scenario.overrides import Override
-    from vplane_mj.summary import RunSummary
+    from vplane_mj.sim.summary import RunSummary
 
 EXIT_REACHED, EXIT_NOT_REACHED, EXIT_INVALID = 0, 1, 2
 EXIT_PLANNER_RAISED = 3
@@ -93,6 +93,11 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="vplane-mj",
         description="Artificial potential fields and the virtual-plane escape, in MuJoCo.",
+    )
+    parser.add_argument(
+        "--version",
+        action="version",
+        version=f"vplane-mj {vplane_mj.__version__} (contract v{vplane_mj.CONTRACT_VERSION})",
     )
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -277,7 +282,7 @@ def _summary_line(scenario: Scenario, s: RunSummary) -> str:
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from vplane_mj.bench import error_lines, format_table, parse_seeds
+    from vplane_mj.bench.sweep import error_lines, format_table, parse_seeds
     from vplane_mj.sweeps import SweepErrorWarning, sweep
 
     if args.jobs < 1:
@@ -310,7 +315,7 @@ def _bench(args: argparse.Namespace) -> int:
 
 def _generate(args: argparse.Namespace) -> int:
     """Write `count` valid scenario files of a family, each with a reference path."""
-    from vplane_mj.families import generate
+    from vplane_mj.worlds.families import generate
 
     if args.count < 1:
         raise VPlaneError(f"--count: must be at least 1, got {args.count}")
@@ -320,7 +325,7 @@ def _generate(args: argparse.Namespace) -> int:
         raise VPlaneError(f"--protocol: only the barn family has the challenge's layout, not {args.family}")
     out_dir = prepare_out_dir(args.out)
     if args.protocol:
-        from vplane_mj.barn_protocol import generate_protocol
+        from vplane_mj.worlds.barn_protocol import generate_protocol
 
         cases = generate_protocol(args.count, args.seed)
     else:
@@ -334,7 +339,7 @@ def _generate(args: argparse.Namespace) -> int:
 def _import(args: argparse.Namespace) -> int:
     """Convert BARN's world files into scenario files of the challenge's layout: every file is
     read and converted before anything is written."""
-    from vplane_mj.barn_import import import_worlds, report_line
+    from vplane_mj.worlds.barn_import import import_worlds, report_line
 
     imported = import_worlds(args.paths)
     out_dir = prepare_out_dir(args.out)
@@ -365,7 +370,7 @@ def _mjcf(args: argparse.Namespace) -> int:
     import mujoco
 
     from vplane_mj.scenario import load_scenario
-    from vplane_mj.world import standalone_xml
+    from vplane_mj.sim.world import standalone_xml
 
     scenario = load_scenario(args.scenario)
     xml = standalone_xml(scenario)
@@ -379,7 +384,7 @@ def _mjcf(args: argparse.Namespace) -> int:
 
 def _summary(args: argparse.Namespace) -> int:
     """Print the summary recomputed from the log; exit 1 if it disagrees with the stored one."""
-    from vplane_mj.replay import disagreements, load_log, summarize
+    from vplane_mj.logs.replay import disagreements, load_log, summarize
 
     contents, scenario = load_log(args.log)
     recomputed = summarize(contents, scenario)
@@ -401,20 +406,22 @@ def _summary(args: argparse.Namespace) -> int:
 
 
 def _render(args: argparse.Namespace) -> int:
-    from vplane_mj.render import render_top_view, write_png
-    from vplane_mj.replay import load_log, track_from_log
+    from vplane_mj.logs.replay import load_log, track_from_log
+    from vplane_mj.sim.summary import RunSummary
+    from vplane_mj.viz.render import render_top_view, run_caption, write_png
 
     contents, scenario = load_log(args.log)
     _check_parent(args.output)
-    image = render_top_view(scenario, track_from_log(args.log, contents))
+    caption = run_caption(RunSummary.from_dict(contents.summary)) if contents.summary else scenario.name
+    image = render_top_view(scenario, track_from_log(args.log, contents), caption)
     write_atomically(args.output, lambda tmp: write_png(image, tmp))
     print(f"wrote {args.output}")
     return 0
 
 
 def _plot(args: argparse.Namespace) -> int:
-    from vplane_mj.plots import plot_log
-    from vplane_mj.replay import load_log, track_from_log
+    from vplane_mj.logs.replay import load_log, track_from_log
+    from vplane_mj.viz.plots import plot_log
 
     contents, scenario = load_log(args.log)
     _check_parent(args.output)
@@ -425,7 +432,7 @@ def _plot(args: argparse.Namespace) -> int:
 
 
 def _video(args: argparse.Namespace) -> int:
-    from vplane_mj.video import check_speed, video_format, write_video
+    from vplane_mj.viz.video import check_speed, video_format, write_video
 
     video_format(args.output)
     check_speed(args.speed)
@@ -459,8 +466,8 @@ def _list(args: argparse.Namespace) -> int:
 
 def _print_profiles() -> None:
     """The robot profiles of `vplane-mj list`: size, top speed and sensor of each."""
-    from vplane_mj.profiles import PROFILES
-    from vplane_mj.robot import robot_body
+    from vplane_mj.robots.facts import robot_body
+    from vplane_mj.robots.profiles import PROFILES
 
     print("\nRobot profiles ([robot] profile = NAME):")
     for name, profile in PROFILES.items():

@@ -16,15 +16,15 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from vplane_mj.errors import VPlaneError
+from vplane_mj.files import DEFAULT_OUT, prepare_out_dir, write_atomically, write_json
 from vplane_mj.interrupts import Interrupted
-from vplane_mj.outputs import DEFAULT_OUT, prepare_out_dir, write_atomically, write_json
 from vplane_mj.planning.events import Event, EventKind
 from vplane_mj.scenario import Scenario, load_scenario
-from vplane_mj.sim import RunResult, Tick, run_scenario
-from vplane_mj.summary import RunSummary
+from vplane_mj.sim.loop import RunResult, Tick, run_scenario
+from vplane_mj.sim.summary import RunSummary
 
 if TYPE_CHECKING:
-    from vplane_mj.log_mcap import McapLog
+    from vplane_mj.logs.writer import McapLog
 
 
 @dataclass(frozen=True)
@@ -117,12 +117,12 @@ def run(
     try:
         files["summary"] = write_json(base.with_suffix(".json"), result.summary.to_dict())
         if render:
-            from vplane_mj.render import render_top_view, write_png
+            from vplane_mj.viz.render import render_top_view, run_caption, write_png
 
-            image = render_top_view(scenario, result.track())
+            image = render_top_view(scenario, result.track(), run_caption(result.summary))
             files["render"] = write_atomically(base.with_suffix(".png"), lambda tmp: write_png(image, tmp))
         if video:
-            from vplane_mj.video import write_video
+            from vplane_mj.viz.video import write_video
 
             files["video"] = write_video(files["log"], base.with_suffix(".mp4"))
     except Interrupted as exc:
@@ -159,10 +159,10 @@ def _open_log(scenario: Scenario, target: Path) -> McapLog:
     """An MCAP log written under a temporary name beside `target` (renamed when finished).
 
     A process killed outright leaves that `.partial` file: its flushed part (all but
-    about the last simulated second) is readable with `vplane_mj.log_read.read_log`.
+    about the last simulated second) is readable with `vplane_mj.logs.reader.read_log`.
     """
-    from vplane_mj.log_mcap import McapLog
-    from vplane_mj.sensors import scan_bearings
+    from vplane_mj.logs.writer import McapLog
+    from vplane_mj.sim.sensors import scan_bearings
 
     partial = target.with_name(f".{target.name}.partial")
     return McapLog(partial, scenario, scan_bearings(scenario), {})

@@ -1,5 +1,5 @@
 """Many runs from Python (`vplane_mj.sweep`): scenarios x planners x seeds, as `vplane-mj bench`
-runs them (`vplane_mj.bench`: the jobs, the resumable journal, the process pool or a Dask
+runs them (`vplane_mj.bench.sweep`: the jobs, the resumable journal, the process pool or a Dask
 cluster, the table and the report); the command line's `bench` is this call with its flags.
 """
 
@@ -12,24 +12,23 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from vplane_mj.bench import (
-    Job,
+from vplane_mj.bench.job import Job
+from vplane_mj.bench.sweep import (
     format_table,
     job_choice,
     parse_seeds,
     plan_jobs,
     run_sweep,
     summarize,
-    write_outputs,
 )
 from vplane_mj.errors import VPlaneError
-from vplane_mj.outputs import DEFAULT_OUT, output_directory
+from vplane_mj.files import DEFAULT_OUT, output_directory
 from vplane_mj.planning import registry
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.plugins import PlannerError, is_import_spec
 from vplane_mj.planning.registry import for_worker, load_planner, register_planner, unknown_planner
 from vplane_mj.scenario import Scenario, parse_scenario
-from vplane_mj.summary import Outcome, RunSummary
+from vplane_mj.sim.summary import Outcome, RunSummary
 
 
 class SweepErrorWarning(UserWarning):
@@ -41,7 +40,7 @@ class SweepErrorWarning(UserWarning):
 class SweepResult:
     """A sweep's rows (one per run, in the order scenario, planner, seed: the run's summary as
     a dict, its journal `key` and its simplified path `path_xy`), its table (one row per
-    planner, the columns of `vplane_mj.bench.TABLE_COLUMNS`) and the report files written."""
+    planner, the columns of `vplane_mj.bench.sweep.TABLE_COLUMNS`) and the report files written."""
 
     rows: list[dict]
     table: list[dict]
@@ -96,7 +95,11 @@ def sweep(
         planned = _plan(scenarios, chosen, seed_list, overrides)
         rows = run_sweep(planned, out_dir, workers, scheduler)
         table = summarize(rows)
-        files = tuple(write_outputs(rows, table, out_dir, planned)) if report else ()
+        files: tuple[Path, ...] = ()
+        if report:
+            from vplane_mj.bench.report import write_outputs  # matplotlib: only when a report is written
+
+            files = tuple(write_outputs(rows, table, out_dir, planned))
         return SweepResult(rows, table, files)
 
     if out is None:

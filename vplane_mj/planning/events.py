@@ -3,7 +3,7 @@
 Planners report their decisions as events (a local minimum, an escape, a plane created or
 retired, ...); the run loop adds its own (a collision, the goal reached, the time limit, an
 error). The log stores each with its kind and data, so a run's summary can be recomputed
-from the log without reading the text (`vplane_mj.replay`).
+from the log without reading the text (`vplane_mj.logs.replay`).
 """
 
 from __future__ import annotations

@@ -16,8 +16,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Self
 
-from vplane_mj.errors import VPlaneError
-from vplane_mj.suggestions import did_you_mean
+from vplane_mj.errors import VPlaneError, did_you_mean
 
 MAX_MAGNITUDE = 1e6
 """No planner parameter may exceed this in absolute value: a larger one is surely a mistake,

@@ -16,11 +16,11 @@ from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from vplane_mj.errors import did_you_mean
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.params import PlannerInfo
 from vplane_mj.planning.plugins import PlannerError, canonical_spec, import_planner, planner_problem
-from vplane_mj.suggestions import did_you_mean
 
 if TYPE_CHECKING:
     from importlib.metadata import EntryPoint

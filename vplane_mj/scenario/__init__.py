@@ -21,8 +21,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from vplane_mj.errors import ScenarioError
-from vplane_mj.resources import data_dir
+from vplane_mj.errors import ScenarioError, did_you_mean
+from vplane_mj.files import data_dir
 from vplane_mj.scenario.build import CODE_SOURCE, box, build_scenario, cup, cylinder, h_shape, wall
 from vplane_mj.scenario.fields import Field
 from vplane_mj.scenario.keys import (
@@ -37,7 +37,6 @@ from vplane_mj.scenario.keys import (
 from vplane_mj.scenario.overrides import Override
 from vplane_mj.scenario.parse import parse_document, parse_scenario
 from vplane_mj.scenario.spec import RobotSpec, RunSpec, Scenario, SensorSpec, WorldSpec
-from vplane_mj.suggestions import did_you_mean
 
 __all__ = [
     "CODE_SOURCE",

@@ -16,7 +16,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, TypeGuard
 
-from vplane_mj.suggestions import did_you_mean
+from vplane_mj.errors import did_you_mean
 
 
 class Invalid(Exception):

@@ -13,9 +13,9 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from vplane_mj.profiles import PROFILES
+from vplane_mj.geometry.shapes import Box, Cup, Cylinder, HShape, Obstacle, Wall
+from vplane_mj.robots.profiles import PROFILES
 from vplane_mj.scenario.fields import Field, Invalid, join_key
-from vplane_mj.shapes import Box, Cup, Cylinder, HShape, Obstacle, Wall
 
 FORMAT = 1
 """The only value of `format` this version reads."""

@@ -1,7 +1,7 @@
 """Where the robot may start and end: inside the arena, its footprint clear of walls and obstacles.
 
 A round robot (the default profile) is its disc of the model's radius, as it always was; a
-robot with an outline polygon (`vplane_mj.profiles`) is that polygon: at the start in its
+robot with an outline polygon (`vplane_mj.robots.profiles`) is that polygon: at the start in its
 start heading, at the goal in at least one heading (the heading of arrival is the planner's).
 Distances in metres.
 """
@@ -13,11 +13,11 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from vplane_mj.geometry.shapes import scene_footprints
 from vplane_mj.planning.body import RobotBody
-from vplane_mj.robot import robot_body
+from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario.fields import Invalid
 from vplane_mj.scenario.spec import RobotSpec, WorldSpec
-from vplane_mj.shapes import scene_footprints
 
 GOAL_HEADINGS = 72
 """Headings tried for the footprint at the goal (every 5 degrees)."""

@@ -14,11 +14,13 @@ from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Any
 
+from vplane_mj.errors import did_you_mean
+from vplane_mj.geometry.shapes import Obstacle
 from vplane_mj.planning import registry
 from vplane_mj.planning.params import ParamError
 from vplane_mj.planning.plugins import is_import_spec
-from vplane_mj.profiles import PROFILES
-from vplane_mj.robot import robot_facts
+from vplane_mj.robots.facts import robot_facts
+from vplane_mj.robots.profiles import PROFILES
 from vplane_mj.scenario.fields import (
     Invalid,
     checked,
@@ -44,8 +46,6 @@ from vplane_mj.scenario.keys import (
     WORLD_FIELDS,
 )
 from vplane_mj.scenario.spec import RobotSpec, RunSpec, SensorSpec, WorldSpec
-from vplane_mj.shapes import Obstacle
-from vplane_mj.suggestions import did_you_mean
 
 
 def _check_format(doc: Mapping[str, Any]) -> None:

@@ -1,7 +1,7 @@
 """A validated scenario as frozen dataclasses (the file format: docs/interface.md section 1).
 
 Units: metres and seconds; degrees in the file, radians here. Obstacles are the shapes of
-`vplane_mj.shapes`.
+`vplane_mj.geometry.shapes`.
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ from typing import Any
 
 import tomli_w
 
-from vplane_mj.outputs import write_atomically
-from vplane_mj.shapes import Obstacle
+from vplane_mj.files import write_atomically
+from vplane_mj.geometry.shapes import Obstacle
 
 
 @dataclass(frozen=True)
@@ -29,7 +29,7 @@ class WorldSpec:
 
 @dataclass(frozen=True)
 class RobotSpec:
-    """The robot's profile (`vplane_mj.profiles`); start and goal (m); start_yaw in radians,
+    """The robot's profile (`vplane_mj.robots.profiles`); start and goal (m); start_yaw in radians,
     resolved (default: facing the goal).
 
     Actuation faults: `wheel_friction` is the tyres' sliding friction coefficient (lower

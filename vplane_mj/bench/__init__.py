@@ -1,0 +1,3 @@
+"""Sweeps: scenarios x planners x seeds as jobs in a resumable journal (`sweep`), on a local pool
+that outlives its workers (`pool`) or a Dask cluster, runs that failed as rows (`failures`), and
+the report: table, figures and HTML (`report`)."""

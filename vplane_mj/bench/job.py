@@ -1,0 +1,32 @@
+"""One run of a sweep, as the journal keys it and a worker receives it."""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+
+from vplane_mj.planning.registry import WorkerPlanner
+
+
+@dataclass(frozen=True)
+class Job:
+    """One run of a sweep: the resolved scenario text and where it came from.
+
+    `registered_planner` is the job's planner when it was registered in the calling process,
+    as the worker registers it before it reads the scenario (`registry.for_worker`: an import
+    spec such as `module:Class` or `/abs/path/file.py:Class`, or a class of the calling
+    script); None for a built-in or installed one. It is not part of the key: a run is the
+    same run whichever way its planner was found.
+    """
+
+    scenario: str
+    planner: str
+    seed: int
+    toml: str
+    registered_planner: WorkerPlanner | None = None
+
+    @property
+    def key(self) -> str:
+        """Identifies a run across invocations: scenario content, planner and seed."""
+        digest = hashlib.sha256(self.toml.encode()).hexdigest()[:16]
+        return f"{self.scenario}|{self.planner}|{self.seed}|{digest}"

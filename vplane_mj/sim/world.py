@@ -1,0 +1,230 @@
+"""Build the MuJoCo world of a scenario with MjSpec: arena, border, obstacles, robot, sonar.
+
+The robot is its profile's model (`vplane_mj.robots.profiles`, models/*.xml). Element names are
+predictable: obstacle geoms are `obstacle<i>_<part>` (parts per kind in PART_NAMES) and
+border walls `border_<side>`, all in the static body `obstacles`; sonar ray sites are
+`robot/sonar<k>_ray<j>`, in order, so their poses are contiguous, and so are the readings of
+the rangefinders of the same names. A laser is not a MuJoCo sensor: `vplane_mj.sim.laser` casts
+it in 2D against the same pieces the obstacles are built from.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from vplane_mj.files import model_path
+from vplane_mj.geometry import shapes
+from vplane_mj.robots.facts import BASE_BODY, SONAR_MOUNT_RADIUS_M, WHEEL_JOINTS, WHEEL_MOTORS, robot_facts
+from vplane_mj.robots.profiles import PROFILES
+from vplane_mj.scenario import RobotSpec, Scenario, SensorSpec
+
+OBSTACLE_HEIGHT_M = 0.5
+ROBOT_PREFIX = "robot/"
+OBSTACLES_BODY = "obstacles"
+"""The static body that holds every obstacle and border geom."""
+BUMP_SENSOR = "bump"
+"""Contact sensor: number of contacts between the robot's subtree and the obstacles body."""
+PART_NAMES: dict[type, tuple[str, ...]] = {
+    shapes.Box: ("body",),
+    shapes.Wall: ("wall",),
+    shapes.Cylinder: ("body",),
+    shapes.Cup: ("back", "arm_left", "arm_right"),
+    shapes.HShape: ("post_left", "post_right", "crossbar"),
+}
+BORDER_SIDES = ("west", "east", "south", "north")
+RENDER_PIXELS = 800
+"""Longest side (px) of the offscreen buffer that the top camera renders into."""
+SONAR_SITE_SIZE_M = 0.004
+SONAR_SITE_RGBA = (0.1, 0.7, 0.2, 0.6)
+
+
+@dataclass(frozen=True)
+class SonarLayout:
+    """Geometry of the sonars: each one's bearing (rad, robot frame) and mount (x, y in m,
+    base_link), their height above base_link's origin (m), and the rays' offsets (rad) about a
+    sonar's bearing. `reach` is each mount's distance (m) along its own bearing: a range
+    measured from the sonar plus its reach is measured from the robot's centre, along the
+    bearing (exact on the ring, whose mounts lie on their bearings; for mounts off their
+    bearing, the echo is placed on the bearing through the centre, off by the mount's
+    distance from that line)."""
+
+    bearings: np.ndarray
+    mounts: np.ndarray
+    reach: np.ndarray
+    height_m: float
+    ray_offsets: np.ndarray
+
+    @classmethod
+    def from_spec(cls, spec: SensorSpec, profile: str = "default") -> SonarLayout:
+        """The profile's sonars at their places, or the evenly spaced ring of `spec.count` on a
+        circle of SONAR_MOUNT_RADIUS_M."""
+        robot = PROFILES[profile]
+        if robot.sonar_mounts is None:
+            bearings = np.arange(spec.count) * (2 * math.pi / spec.count)
+            mounts = np.array(
+                [(SONAR_MOUNT_RADIUS_M * math.cos(b), SONAR_MOUNT_RADIUS_M * math.sin(b)) for b in bearings]
+            )
+            reach = np.full(spec.count, SONAR_MOUNT_RADIUS_M)
+        else:
+            mounts = np.array([(x, y) for x, y, _ in robot.sonar_mounts])
+            bearings = np.radians([heading for _, _, heading in robot.sonar_mounts])
+            reach = mounts[:, 0] * np.cos(bearings) + mounts[:, 1] * np.sin(bearings)
+        if spec.rays_per_sonar == 1:
+            offsets = np.zeros(1)
+        else:
+            half = math.radians(spec.beam_deg) / 2
+            offsets = np.linspace(-half, half, spec.rays_per_sonar)
+        return cls(bearings, mounts, reach, robot.sensor_height_m, offsets)
+
+
+def build_spec(scenario: Scenario, rangefinders: bool = True) -> mujoco.MjSpec:
+    """The scenario's whole world as an MjSpec (not yet compiled).
+
+    With `rangefinders`, every sonar ray site carries a MuJoCo rangefinder (the exported
+    world). The run loop builds the world without them: MuJoCo would cast every ray at
+    every physics step, while the sonar pings only at its rate (`vplane_mj.sim.sonar`).
+    """
+    arena = mujoco.MjSpec.from_file(str(model_path("arena.xml")))
+    arena.option.timestep = scenario.run.physics_dt_s
+    _size_camera(arena, scenario.world.size)
+    statics = arena.worldbody.add_body(name=OBSTACLES_BODY)
+    if scenario.world.border:
+        for side, rect in zip(BORDER_SIDES, shapes.border_footprint(scenario.world.size), strict=True):
+            _add_piece(statics, f"border_{side}", rect, "border")
+    for index, obstacle in enumerate(scenario.world.obstacles):
+        parts = PART_NAMES[type(obstacle)]
+        for part, piece in zip(parts, obstacle.footprint(), strict=True):
+            _add_piece(statics, f"obstacle{index}_{part}", piece, "obstacle")
+    # Counts robot-obstacle contacts inside MuJoCo, so the run loop reads one number per check.
+    arena.add_sensor(
+        name=BUMP_SENSOR,
+        type=mujoco.mjtSensor.mjSENS_CONTACT,
+        objtype=mujoco.mjtObj.mjOBJ_XBODY,  # the subtree of base_link
+        objname=ROBOT_PREFIX + BASE_BODY,
+        reftype=mujoco.mjtObj.mjOBJ_BODY,
+        refname=OBSTACLES_BODY,
+        intprm=[1, 1, 1],  # data "found", reduce "mindist", one contact
+    )
+
+    robot = mujoco.MjSpec.from_file(str(model_path(PROFILES[scenario.robot.profile].model_file)))
+    if scenario.sensors.kind == "sonar":
+        layout = SonarLayout.from_spec(scenario.sensors, scenario.robot.profile)
+        _add_sonar_ring(robot, layout, scenario.sensors, rangefinders)
+    _apply_actuation_faults(robot, scenario.robot)
+    x, y = scenario.robot.start
+    yaw = scenario.robot.start_yaw
+    mount = arena.worldbody.add_body(
+        name=ROBOT_PREFIX, pos=[x, y, 0.0], quat=[math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]
+    )
+    mount.add_freejoint(name=ROBOT_PREFIX)
+    arena.attach(robot, prefix=ROBOT_PREFIX, frame=mount.add_frame())
+    return arena
+
+
+def build_model(scenario: Scenario, rangefinders: bool = True) -> mujoco.MjModel:
+    """The compiled MuJoCo model of a scenario (see `build_spec` for `rangefinders`)."""
+    return build_spec(scenario, rangefinders).compile()
+
+
+def standalone_xml(scenario: Scenario) -> str:
+    """One self-contained MJCF document of the world, rangefinders included (assets are
+    built-in textures only; numbers at MuJoCo's XML precision of 6 significant digits)."""
+    return build_spec(scenario).to_xml()
+
+
+def _size_camera(arena: mujoco.MjSpec, size: tuple[float, float]) -> None:
+    """Centre the orthographic top camera on the arena and fit the arena plus its border."""
+    w, h = size
+    margin = 2 * shapes.BORDER_THICKNESS_M + 0.1
+    camera = arena.camera("top")
+    camera.pos = [w / 2, h / 2, 20.0]
+    camera.fovy = h + margin  # orthographic: the vertical extent in metres
+    scale = RENDER_PIXELS / max(w + margin, h + margin)
+    arena.visual.global_.offwidth = max(64, round((w + margin) * scale))
+    arena.visual.global_.offheight = max(64, round((h + margin) * scale))
+
+
+def _add_piece(body: mujoco.MjsBody, name: str, piece: shapes.Piece, material: str) -> None:
+    """One footprint piece as a vertical geom standing on the floor."""
+    half_z = OBSTACLE_HEIGHT_M / 2
+    if isinstance(piece, shapes.Disc):
+        body.add_geom(
+            name=name,
+            type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+            size=[piece.radius, half_z, 0.0],
+            pos=[*piece.center, half_z],
+            material=material,
+        )
+        return
+    geom = body.add_geom(
+        name=name,
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[*piece.half, half_z],
+        pos=[*piece.center, half_z],
+        material=material,
+    )
+    geom.alt.type = mujoco.mjtOrientation.mjORIENTATION_EULER
+    geom.alt.euler = [0.0, 0.0, piece.yaw]
+
+
+def _add_sonar_ring(robot: mujoco.MjSpec, layout: SonarLayout, spec: SensorSpec, rangefinders: bool) -> None:
+    """Sonar k emulates a beam of `beam_deg` with `rays_per_sonar` rays.
+
+    All rays of one sonar start at the same site position, its mount; each ray is a
+    site whose +z axis points along the ray. With `rangefinders`, each site carries a
+    rangefinder cut off at the range limit, with the sonar's period as its interval.
+    """
+    base = robot.body(BASE_BODY)
+    for k, bearing in enumerate(layout.bearings):
+        pos = [float(layout.mounts[k, 0]), float(layout.mounts[k, 1]), layout.height_m]
+        for j, offset in enumerate(layout.ray_offsets):
+            angle = bearing + offset
+            name = f"sonar{k}_ray{j}"
+            site = base.add_site(name=name, pos=pos, rgba=list(SONAR_SITE_RGBA))
+            site.size[0] = SONAR_SITE_SIZE_M
+            site.alt.type = mujoco.mjtOrientation.mjORIENTATION_ZAXIS
+            site.alt.zaxis = [math.cos(angle), math.sin(angle), 0.0]
+            if rangefinders:
+                robot.add_sensor(
+                    name=name,
+                    type=mujoco.mjtSensor.mjSENS_RANGEFINDER,
+                    objtype=mujoco.mjtObj.mjOBJ_SITE,
+                    objname=name,
+                    cutoff=spec.range_max,
+                    interval=[1.0 / spec.rate_hz, 0.0],
+                    intprm=[1, 0, 0],  # data "dist"
+                )
+
+
+def _apply_actuation_faults(robot: mujoco.MjSpec, spec: RobotSpec) -> None:
+    """Wheel slip and motor faults as model properties, so an exported world keeps them.
+
+    The wheels' sliding friction becomes `wheel_friction` (the wheel geoms take priority
+    over the floor in the contact, so theirs is the friction used). A motor with gain g
+    and bias b becomes an affine actuator of gear g: torque = g * clamp(ctrl + b / g),
+    i.e. g times the commanded torque plus b, saturating at g times the torque limit.
+    """
+    for geom in robot.geoms:
+        if geom.classname.name == "wheel":
+            geom.friction[0] = spec.wheel_friction
+    limit = robot_facts(spec.profile).torque_limit_nm
+    for motor_name, joint, gain, bias in zip(
+        WHEEL_MOTORS, WHEEL_JOINTS, spec.motor_gain, spec.motor_bias_nm, strict=True
+    ):
+        if gain == 1.0 and bias == 0.0:
+            continue
+        robot.delete(robot.actuator(motor_name))
+        robot.add_actuator(
+            name=motor_name,
+            trntype=mujoco.mjtTrn.mjTRN_JOINT,
+            target=joint,
+            gear=[gain, 0.0, 0.0, 0.0, 0.0, 0.0],
+            ctrlrange=[-limit, limit],
+            forcerange=[-limit, limit],
+            biastype=mujoco.mjtBias.mjBIAS_AFFINE,
+            biasprm=[bias / gain] + [0.0] * 9,
+        )

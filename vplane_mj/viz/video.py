@@ -1,0 +1,344 @@
+"""A run replayed from its MCAP log alone as a top-down video (H.264 MP4 or GIF).
+
+Each frame shows the arena and its obstacles around the start, the goal and the path
+(the whole arena when that is most of it), start and goal, the path so far coloured by
+planner mode (as in the render), the virtual planes and objective, the sonar echoes, the
+force arrows as logged (attractive green, repulsive red, virtual purple, total blue),
+the robot's disc and heading, the latest events as a caption and the simulated time.
+Frame k shows the last control tick at or before k * speed / fps simulated seconds; the
+last frame is held for `END_HOLD_S` so the end can be seen. Matplotlib (Agg) draws
+the frames, blitting everything that moves over a cached background; imageio-ffmpeg's
+own ffmpeg encodes them, so no system package is needed.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")  # files only, never a window
+import imageio_ffmpeg
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.artist import Artist
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import LineCollection
+from matplotlib.patches import Circle, Polygon
+from matplotlib.transforms import Bbox
+
+from vplane_mj.errors import VPlaneError
+from vplane_mj.files import write_atomically
+from vplane_mj.geometry import shapes
+from vplane_mj.logs.replay import load_log
+from vplane_mj.logs.timeline import FORCE_NAMES, Timeline, timeline_from_log
+from vplane_mj.logs.writer import METADATA_NAME
+from vplane_mj.scenario import Scenario
+from vplane_mj.viz.render import MODE_RGBA, OTHER_MODE_RGBA
+
+
+@dataclass(frozen=True)
+class VideoFormat:
+    """How one kind of file is encoded: frame rate, frame width (px) and ffmpeg options."""
+
+    fps: int
+    width_px: int
+    codec: str
+    pix_fmt: str
+    options: tuple[str, ...]
+
+
+FORMATS = {
+    ".mp4": VideoFormat(25, 720, "libx264", "yuv420p", ("-preset", "veryfast", "-crf", "26", "-f", "mp4")),
+    # One palette for the whole GIF (the frames differ little), a dither without noise.
+    ".gif": VideoFormat(
+        10,
+        480,
+        "gif",
+        "pal8",
+        (
+            "-filter_complex",
+            "split[a][b];[a]palettegen=max_colors=64:stats_mode=diff[p];"
+            "[b][p]paletteuse=dither=bayer:bayer_scale=5:diff_mode=rectangle",
+            "-loop",
+            "0",
+            "-f",
+            "gif",
+        ),
+    ),
+}
+"""Supported output suffixes."""
+MAX_SPEED = 1000.0
+MAX_FRAMES = 40_000
+"""About 27 minutes of MP4: a longer video needs a higher --speed."""
+END_HOLD_S = 1.0
+"""Video seconds for which the last frame is held."""
+CAPTION_HOLD_S = 2.5
+"""Video seconds for which an event stays in the caption."""
+CAPTION_LINES = 2
+VIEW_MARGIN_M = 1.2
+"""Shown around the start, the goal and the path."""
+WALL_MARGIN_M = 0.3
+"""Shown beyond the arena's sides (where the border walls stand)."""
+_FORCE_COLOURS = {
+    "attractive": "#26bf40",
+    "repulsive": "#e6332a",
+    "virtual": "#b340e6",
+    "total": "#2673ff",
+}
+_OBSTACLE_COLOUR = "#5a5f6e"
+_ECHO_COLOUR = "#ff7f0e"
+_PLANE_COLOUR = "#8e24aa"
+
+
+def video_format(path: Path) -> VideoFormat:
+    """The format of an output file by its suffix; VPlaneError for any other."""
+    fmt = FORMATS.get(path.suffix.lower())
+    if fmt is None:
+        raise VPlaneError(f"{path}: -o must end in {' or '.join(FORMATS)}")
+    return fmt
+
+
+def check_speed(speed: float) -> float:
+    """A playback speed (simulated seconds per video second) in (0, MAX_SPEED]."""
+    if not (math.isfinite(speed) and 0 < speed <= MAX_SPEED):
+        raise VPlaneError(f"--speed: must be greater than 0 and at most {MAX_SPEED:g}, got {speed:g}")
+    return speed
+
+
+def frame_count(duration_s: float, speed: float, fps: int) -> tuple[int, int]:
+    """(frames of the run, frames of the final hold) for a run of `duration_s` simulated seconds."""
+    return math.floor(duration_s / speed * fps + 1e-9) + 1, round(END_HOLD_S * fps)
+
+
+def write_video(log: Path, target: Path, speed: float = 1.0, show_progress: bool = True) -> Path:
+    """Replay the run of `log` into `target` (.mp4 or .gif), written atomically."""
+    fmt = video_format(target)
+    check_speed(speed)
+    contents, scenario = load_log(log)
+    timeline = timeline_from_log(log, contents)
+    frames, hold = frame_count(float(timeline.times_s[-1]), speed, fmt.fps)
+    if frames > MAX_FRAMES:
+        raise VPlaneError(
+            f"--speed: {frames} frames at {speed:g}x is too long a video (at most {MAX_FRAMES}); "
+            "raise --speed"
+        )
+    radius = float(contents.metadata[METADATA_NAME]["robot_radius_m"])
+    canvas = FrameCanvas(scenario, timeline, radius, fmt.width_px, speed)
+    progress = Progress(frames + hold, target.name) if show_progress else None
+
+    def encode(temporary: Path) -> None:
+        writer = imageio_ffmpeg.write_frames(
+            str(temporary),
+            canvas.size,
+            fps=fmt.fps,
+            codec=fmt.codec,
+            pix_fmt_in="rgba",
+            pix_fmt_out=fmt.pix_fmt,
+            quality=None,
+            macro_block_size=1,
+            output_params=list(fmt.options),
+        )
+        writer.send(None)
+        try:
+            frame = b""
+            for k in range(frames + hold):
+                if k < frames:
+                    frame = canvas.frame(k * speed / fmt.fps)
+                writer.send(frame)
+                if progress:
+                    progress.advance()
+        finally:
+            writer.close()  # ffmpeg finishes the file (or is stopped, on an interruption)
+
+    try:
+        return write_atomically(target, encode)
+    finally:
+        plt.close(canvas.figure)
+
+
+class Progress:
+    """A progress bar of frames on stderr (a line every 10% when it is not a terminal)."""
+
+    def __init__(self, total: int, name: str):
+        self.total, self.done, self.name = total, 0, name
+        self.tty = sys.stderr.isatty()
+        self._last_decile = -1
+
+    def advance(self) -> None:
+        self.done += 1
+        filled = round(30 * self.done / self.total)
+        line = f"{self.name}: [{'#' * filled}{'.' * (30 - filled)}] {self.done}/{self.total} frames"
+        if self.tty:
+            print(f"\r{line}", end="" if self.done < self.total else "\n", file=sys.stderr, flush=True)
+        elif (decile := 10 * self.done // self.total) != self._last_decile:
+            self._last_decile = decile
+            print(line, file=sys.stderr, flush=True)
+
+
+class FrameCanvas:
+    """The figure of one run: a static background drawn once, the moving parts per frame."""
+
+    def __init__(
+        self, scenario: Scenario, timeline: Timeline, robot_radius_m: float, width_px: int, speed: float
+    ):
+        self.timeline = timeline
+        self.speed = speed
+        (x0, x1), (y0, y1) = view = _view(scenario, timeline)
+        aspect = min(max((y1 - y0) / (x1 - x0), 0.5), 1.6)
+        top_px, bottom_px = round(0.06 * width_px), round(0.09 * width_px)  # title and time; caption
+        plot_px = 0.98 * width_px * aspect
+        height_px = 2 * round((top_px + plot_px + bottom_px) / 2)  # even, as H.264 wants
+        self.size = (width_px, height_px)
+        self.figure = plt.figure(figsize=(width_px / 100, height_px / 100), dpi=100)
+        top, bottom = 1 - top_px / height_px, bottom_px / height_px
+        axes = self.figure.add_axes((0.01, bottom, 0.98, top - bottom))
+        axes.set(xlim=view[0], ylim=view[1], aspect="equal", anchor="C")
+        axes.set_axis_off()
+        self.axes = axes
+        _draw_world(axes, scenario)
+        font = max(7.0, width_px / 70)
+        self.figure.text(
+            0.02,
+            (1 + top) / 2,
+            f"{scenario.name}, {scenario.planner}, seed {scenario.run.seed}",
+            va="center",
+            fontsize=font,
+            weight="bold",
+        )
+        self._animated: list[Artist] = []
+        self.path = self._add(LineCollection([], linewidths=2.2, capstyle="round"))
+        self.planes = self._add(LineCollection([], colors=_PLANE_COLOUR, linewidths=3))
+        (self.objective,) = axes.plot([], [], "*", color="#1a5ae6", ms=font * 1.6, zorder=6)
+        self._animated.append(self.objective)
+        self.echoes = self._add(axes.scatter([], [], s=font * 2.2, color=_ECHO_COLOUR, zorder=7))
+        self.body = self._add(Circle((0, 0), robot_radius_m, fc="#333d52", ec="white", lw=1, zorder=8))
+        (self.heading,) = axes.plot([], [], color="white", lw=2, zorder=9)
+        self._animated.append(self.heading)
+        self.forces = axes.quiver(
+            np.zeros(len(FORCE_NAMES)),
+            np.zeros(len(FORCE_NAMES)),
+            np.zeros(len(FORCE_NAMES)),
+            np.zeros(len(FORCE_NAMES)),
+            color=[_FORCE_COLOURS[name] for name in FORCE_NAMES],
+            angles="xy",
+            scale_units="xy",
+            scale=1.0,
+            units="xy",
+            width=0.05,
+            headwidth=3.0,
+            headlength=3.5,
+            headaxislength=3.0,
+            zorder=10,
+        )
+        self._animated.append(self.forces)
+        self.clock = self.figure.text(
+            0.98, (1 + top) / 2, "", ha="right", va="center", fontsize=font, family="monospace"
+        )
+        self._animated.append(self.clock)
+        self.caption = self.figure.text(0.5, bottom / 2, "", ha="center", va="center", fontsize=font * 0.9)
+        self.caption.set_animated(True)
+        self._caption_box = Bbox([[0, 0], [width_px, bottom_px]])
+        for artist in self._animated:
+            artist.set_animated(True)
+        self.robot_radius_m = robot_radius_m
+        canvas = self.figure.canvas
+        assert isinstance(canvas, FigureCanvasAgg)  # the backend chosen above: blitting, pixels
+        self.canvas = canvas
+        canvas.draw()
+        self._background = canvas.copy_from_bbox(self.figure.bbox)
+        self._path_drawn = 0  # path segments already in the background
+        self._caption_shown: tuple[str, object] | None = None  # the caption text and its pixels
+
+    def _add(self, artist):
+        if isinstance(artist, LineCollection):
+            self.axes.add_collection(artist)
+        elif isinstance(artist, Circle):
+            self.axes.add_patch(artist)
+        self._animated.append(artist)
+        return artist
+
+    def frame(self, time_s: float) -> bytes:
+        """The RGBA frame (height x width x 4 bytes) at simulated time `time_s`."""
+        tl = self.timeline
+        k = tl.index_at(time_s)
+        canvas = self.canvas
+        canvas.restore_region(self._background)
+        self._extend_path(k)
+        x, y, yaw = tl.poses[k]
+        self.planes.set_segments([np.array(plane) for plane in tl.planes[k]])
+        objective = tl.objectives[k]
+        self.objective.set_data([objective[0]] if objective else [], [objective[1]] if objective else [])
+        self.echoes.set_offsets(tl.echoes[k] if len(tl.echoes[k]) else np.empty((0, 2)))
+        self.body.center = (x, y)
+        r = self.robot_radius_m
+        self.heading.set_data([x, x + r * math.cos(yaw)], [y, y + r * math.sin(yaw)])
+        arrows = np.array([tl.forces[k].get(name, (x, y, np.nan, np.nan)) for name in FORCE_NAMES])
+        self.forces.set_offsets(arrows[:, :2])
+        self.forces.set_UVC(arrows[:, 2], arrows[:, 3])
+        self.clock.set_text(f"{tl.modes[k]}  {self.speed:g}x  t = {tl.times_s[k]:6.2f} s")
+        for artist in self._animated:
+            if artist is not self.path:
+                self.figure.draw_artist(artist)
+        self._draw_caption(self._caption(time_s))
+        return bytes(canvas.buffer_rgba())
+
+    def _draw_caption(self, text: str) -> None:
+        """The caption strip: its pixels are kept while its text stays the same (text is slow)."""
+        canvas = self.canvas
+        if self._caption_shown is None or self._caption_shown[0] != text:
+            self.caption.set_text(text)
+            self.figure.draw_artist(self.caption)
+            self._caption_shown = (text, canvas.copy_from_bbox(self._caption_box))
+        else:
+            canvas.restore_region(self._caption_shown[1])
+
+    def _extend_path(self, k: int) -> None:
+        """Draw the path segments up to tick k into the background (they never change)."""
+        if k <= self._path_drawn:
+            return
+        points = self.timeline.poses[self._path_drawn : k + 1, :2]
+        modes = self.timeline.modes[self._path_drawn : k]
+        self.path.set_segments(np.stack([points[:-1], points[1:]], axis=1))
+        self.path.set_color([MODE_RGBA.get(mode, OTHER_MODE_RGBA) for mode in modes])
+        self.axes.draw_artist(self.path)
+        self._background = self.canvas.copy_from_bbox(self.figure.bbox)
+        self._path_drawn = k
+
+    def _caption(self, time_s: float) -> str:
+        """The latest events within the last CAPTION_HOLD_S of video."""
+        since = time_s - CAPTION_HOLD_S * self.speed
+        recent = [e.text for e in self.timeline.events if since < e.time_s <= time_s]
+        return "\n".join(recent[-CAPTION_LINES:])
+
+
+def _view(scenario: Scenario, timeline: Timeline) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The x and y ranges (m) shown: start, goal and path with VIEW_MARGIN_M around them,
+    within the arena and its walls; the whole arena when that is nearly all of it."""
+    w, h = scenario.world.size
+    points = np.vstack([timeline.poses[:, :2], scenario.robot.start, scenario.robot.goal])
+    low = np.maximum(points.min(axis=0) - VIEW_MARGIN_M, -WALL_MARGIN_M)
+    high = np.minimum(points.max(axis=0) + VIEW_MARGIN_M, (w + WALL_MARGIN_M, h + WALL_MARGIN_M))
+    if np.prod(high - low) > 0.7 * (w + 2 * WALL_MARGIN_M) * (h + 2 * WALL_MARGIN_M):
+        low, high = np.array([-WALL_MARGIN_M] * 2), np.array([w + WALL_MARGIN_M, h + WALL_MARGIN_M])
+    return (float(low[0]), float(high[0])), (float(low[1]), float(high[1]))
+
+
+def _draw_world(axes, scenario: Scenario) -> None:
+    """Arena floor, obstacles, border walls, start and goal."""
+    w, h = scenario.world.size
+    axes.add_patch(Polygon([(0, 0), (w, 0), (w, h), (0, h)], color="#f2f2f2", zorder=0))
+    pieces = [piece for obstacle in scenario.world.obstacles for piece in obstacle.footprint()]
+    if scenario.world.border:
+        pieces += list(shapes.border_footprint(scenario.world.size))
+    for piece in pieces:
+        if isinstance(piece, shapes.Disc):
+            axes.add_patch(Circle(piece.center, piece.radius, color=_OBSTACLE_COLOUR, zorder=1))
+        else:
+            axes.add_patch(Polygon(piece.corners(), color=_OBSTACLE_COLOUR, zorder=1))
+    robot = scenario.robot
+    axes.add_patch(Circle(robot.goal, robot.goal_tolerance, color="#ffbf1a", alpha=0.8, zorder=2))
+    axes.add_patch(Circle(robot.start, 0.08, color="#26bf40", zorder=2))

@@ -1,0 +1,174 @@
+"""`vplane-mj import barn`: BARN's Gazebo worlds as scenarios of the challenge's layout.
+
+Each world file's static cylinders and boxes (`vplane_mj.worlds.sdf`) move from Gazebo's frame to
+the arena's by the translation of `vplane_mj.worlds.barn_layout.to_arena`, which takes BARN's start
+(-2.25, 3) to [2.1, 2.85] and its goal (-2.25, 13) to [2.1, 12.85]. BARN's obstacle field then
+fills cells of the layout's field, and its wall cylinders stand just outside the arena, against
+the arena's border walls (both are kept: the wall cylinders are what BARN's robot sees, the
+border closes the side BARN leaves open beyond the goal). A world whose start or goal is closer
+than the Jackal's half diagonal to an obstacle is refused.
+
+BARN ships its own path with each world (`path_N.npy` beside `world_N.world`): the cells of the
+0.15 m grid its generator's A* went through. Its length (the polyline (-2, 3), the cells at
+Gazebo (0.15 r - 4.575, 0.15 c + 5.075), (-2, 13)) is the challenge's optimal path, and is
+reported beside the project's reference path for the Jackal; the scenario's score uses the
+latter, as for every other scenario (docs/barn.md says why).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from vplane_mj.errors import ScenarioError, WorldFileError
+from vplane_mj.geometry.shapes import scene_footprints
+from vplane_mj.scenario import parse_document
+from vplane_mj.worlds.barn_layout import (
+    JACKAL_RADIUS_M,
+    jackal_reference_length,
+    layout_document,
+    to_arena,
+)
+from vplane_mj.worlds.families import Case
+from vplane_mj.worlds.sdf import WorldShape, read_world_shapes
+
+if TYPE_CHECKING:
+    from vplane_mj.scenario import Scenario
+
+WORLD_FILE = re.compile(r"world_(\d+)\.world")
+"""How BARN names its world files; `path_N.npy` beside one is its path."""
+BARN_PATH_START_M, BARN_PATH_END_M = (-2.0, 3.0), (-2.0, 13.0)
+"""The ends of BARN's optimal-path polyline, in Gazebo's frame (m)."""
+
+
+@dataclass(frozen=True)
+class ImportedWorld:
+    """One converted world: the scenario, BARN's own path length (m; None without its
+    path_N.npy) and the project's reference path length for the Jackal (m; None: no way through)."""
+
+    case: Case
+    barn_path_m: float | None
+    reference_m: float | None
+
+
+def world_files(paths: list[Path]) -> list[Path]:
+    """The world files `paths` name: each a file, or a directory of world_N.world files (in
+    the order of N)."""
+    files: list[Path] = []
+    for path in paths:
+        if path.is_dir():
+            numbered = {}
+            for candidate in path.iterdir():
+                match = WORLD_FILE.fullmatch(candidate.name)
+                if match and candidate.is_file():
+                    numbered[int(match.group(1))] = candidate
+            if not numbered:
+                raise WorldFileError(str(path), "", "holds no world_N.world file")
+            files.extend(numbered[n] for n in sorted(numbered))
+        elif path.is_file():
+            files.append(path)
+        else:
+            raise WorldFileError(str(path), "", "no such file or directory")
+    return files
+
+
+def scenario_name(path: Path) -> str:
+    """`barn_` and the file's stem in the scenario name's alphabet: world_7.world -> barn_world_7."""
+    return "barn_" + re.sub(r"[^a-z0-9_]", "_", path.stem.lower())
+
+
+def obstacle(shape: WorldShape) -> dict:
+    """A shape as a scenario obstacle in arena coordinates."""
+    center = list(to_arena(shape.x, shape.y))
+    if shape.kind == "cylinder":
+        return {"kind": "cylinder", "center": center, "radius": shape.radius}
+    yaw_deg = round(float(np.degrees(shape.yaw)), 6)
+    return {"kind": "box", "center": center, "size": list(shape.size), "yaw_deg": yaw_deg}
+
+
+def barn_path_file(world: Path) -> Path | None:
+    """BARN's path_N.npy beside world_N.world, if it is there."""
+    match = WORLD_FILE.fullmatch(world.name)
+    path = world.with_name(f"path_{match.group(1)}.npy") if match else None
+    return path if path is not None and path.is_file() else None
+
+
+def barn_path_length(path: Path) -> float:
+    """Length (m) of BARN's optimal-path polyline for the (row, column) cells in `path`."""
+    try:
+        cells = np.load(path, allow_pickle=False)
+    except (OSError, ValueError) as exc:
+        raise WorldFileError(str(path), "", f"cannot read BARN's path: {exc}") from None
+    if cells.ndim != 2 or cells.shape[1] != 2 or not len(cells) or cells.dtype.kind not in "iu":
+        reason = f"must hold (row, column) integer pairs, got {cells.dtype} array of shape {cells.shape}"
+        raise WorldFileError(str(path), "", reason)
+    gazebo = np.column_stack([0.15 * cells[:, 0] - 0.075 - 4.5, 0.15 * cells[:, 1] + 0.075 + 5.0])
+    polyline = np.vstack([BARN_PATH_START_M, gazebo, BARN_PATH_END_M])
+    return float(np.sum(np.hypot(*np.diff(polyline, axis=0).T)))
+
+
+def _check_jackal_clear(scenario: Scenario) -> None:
+    """The Jackal's disc at the start and at the goal touches no obstacle (nor the border)."""
+    world = scenario.world
+    scene = scene_footprints(world.obstacles, world.size)
+    for key, point in (("start", scenario.robot.start), ("goal", scenario.robot.goal)):
+        gap = float(scene.distance(np.array([point]))[0])
+        if gap < JACKAL_RADIUS_M:
+            reason = (
+                f"the {key} {list(point)} is {gap:.3f} m from an obstacle, closer than the "
+                f"Jackal's half diagonal ({JACKAL_RADIUS_M:.3f} m)"
+            )
+            raise WorldFileError(scenario.source, "", reason)
+
+
+def import_world(path: Path) -> ImportedWorld:
+    """One BARN world file as a scenario of the challenge's layout (a WorldFileError if it
+    cannot be converted)."""
+    source = str(path)
+    shapes = read_world_shapes(path, source)
+    name = scenario_name(path)
+    path_file = barn_path_file(path)
+    barn_path_m = None if path_file is None else barn_path_length(path_file)
+    description = f"BARN world {path.name} (Gazebo), {len(shapes)} obstacles in the challenge's layout"
+    if path_file is not None:
+        description += f"; BARN's own path ({path_file.name}) is {barn_path_m:.3f} m"
+    document = layout_document(name, description, [obstacle(shape) for shape in shapes])
+    try:
+        scenario = parse_document(document, source)
+    except ScenarioError as exc:
+        raise WorldFileError(source, "", f"does not make a valid scenario: {exc.key}: {exc.reason}") from None
+    _check_jackal_clear(scenario)
+    return ImportedWorld(Case(name, document), barn_path_m, jackal_reference_length(scenario))
+
+
+def import_worlds(paths: list[Path]) -> list[ImportedWorld]:
+    """Every world `paths` name, converted, or the first error: nothing is written here."""
+    files = world_files(paths)
+    first: dict[str, Path] = {}
+    for path in files:
+        name = scenario_name(path)
+        if name in first:
+            raise WorldFileError(str(path), "", f"gives the scenario name {name!r}, as {first[name]} does")
+        first[name] = path
+    return [import_world(path) for path in files]
+
+
+def report_line(world: ImportedWorld) -> str:
+    """One line on a converted world: its obstacles and its path lengths, BARN's and the project's."""
+    name = world.case.name
+    count = len(world.case.document["world"]["obstacles"])
+    reference = (
+        "no reference path for the Jackal's disc"
+        if world.reference_m is None
+        else f"reference path {world.reference_m:.3f} m for the Jackal's disc ({JACKAL_RADIUS_M:.3f} m)"
+    )
+    if world.barn_path_m is None:
+        return f"{name}: {count} obstacles; {reference}"
+    versus = ""
+    if world.reference_m is not None:
+        versus = f" ({100 * (world.barn_path_m / world.reference_m - 1):+.1f}% against the reference)"
+    return f"{name}: {count} obstacles; {reference}; BARN's own path {world.barn_path_m:.3f} m{versus}"
