@@ -286,15 +286,24 @@ GAP = [(1.05, 0.25), (1.05, -0.25)]
 
 def test_the_jackal_drives_through_a_gap_narrower_than_its_diagonal():
     jackal, obs = at_rest_on(GAP, margin_m=0.02)
-    speeds, turns = np.array([0.5, 2.0]), np.array([0.0])
+    speeds, turns = np.array([0.1, 0.2]), np.array([0.0])  # margins 2.5 and 3 cm
     dist = jackal.free_distance(obs, speeds, turns)
-    assert np.all(dist == jackal.lookahead)  # 3.5 cm either side, more than the margin
+    assert np.all(dist == jackal.lookahead)  # 3.5 cm either side
     assert np.all(jackal.stopping_length(speeds, turns) <= dist)
     disc = RobotBody.round(JACKAL.radius_m, limits=JACKAL.limits, gains=JACKAL.gains)
     round_jackal, obs = at_rest_on(GAP, body=disc, margin_m=0.02)
     assert np.all(round_jackal.free_distance(obs, speeds, turns) < 1.05 - JACKAL.radius_m)
     decision = jackal.step(observe(None, PERIOD, (0.0, 0.0), 0.0))
     assert decision.mode == "normal" and command(decision, 0.0)[0] > 0  # on its way through
+
+
+def test_the_faster_the_wider_the_berth():
+    """The margin grows by a control period's travel: at 1 m/s, 2 + 5 cm, more than the gap's
+    3.5 cm either side."""
+    jackal, obs = at_rest_on(GAP, margin_m=0.02)
+    dist = jackal.free_distance(obs, np.array([0.2, 1.0]), np.array([0.0]))[:, 0]
+    ahead = 1.05 - JACKAL_HALF_LENGTH  # where the front reaches the posts' line
+    assert dist[0] == jackal.lookahead and ahead - 0.1 < dist[1] < ahead
 
 
 POST = (0.65, -0.05)
@@ -305,17 +314,19 @@ half width and margin, but the front-right corner, which swings out on a left tu
 
 
 def test_an_arc_whose_corner_would_clip_a_post_is_not_admissible():
-    jackal, obs = at_rest_on([POST], margin_m=0.02)
-    speeds, turns = np.array([0.5, 2.0]), np.array([0.5, 2.0]) * BEND
+    jackal, obs = at_rest_on([POST], margin_m=0.01)
+    speeds, turns = np.array([0.1, 2.0]), np.array([0.1, 2.0]) * BEND
+    margins = 0.01 + speeds * PERIOD
     dist = jackal.free_distance(obs, speeds, turns).diagonal()
     travel = np.linspace(0.0, 1.0, 20001)
     points, headings = dwa.arc_poses(obs.position, obs.yaw, travel, BEND * travel)
     centre_gap = np.hypot(*(points - POST).T).min() - JACKAL_HALF_WIDTH
     clearance = rectangle_clearance(np.column_stack((points, headings)), POST)
-    assert centre_gap > 0.02 > clearance.min()  # a disc of the half width would pass
-    clipping = travel[np.argmax(clearance < 0.02)]  # where the corner comes within the margin
+    assert centre_gap > margins[0] > clearance.min()  # a disc of the half width would pass
     sample = jackal.step_m / (1 + jackal.radius * BEND)  # the centre's travel between two poses
-    assert np.all((clipping - sample < dist) & (dist <= clipping))
+    for margin, free in zip(margins, dist, strict=True):
+        clipping = travel[np.argmax(clearance < margin)]  # where the outline comes within it
+        assert clipping - sample < free <= clipping
     admissible = jackal.stopping_length(speeds, turns).diagonal() <= dist
     assert list(admissible) == [True, False]  # at 2 m/s the robot cannot stop before it
 

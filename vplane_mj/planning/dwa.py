@@ -31,11 +31,13 @@ control tick:
    - A polygon robot: its footprint at poses along the arc, no point of it moving more than
      half a cell between two, and the signed distance from the footprint to the obstacle
      cells' centres there (footprint_clearance.py). dist is the length the centre travels
-     before that distance falls below `margin_m`; an arc is followed at most one full circle,
-     after which it repeats. A turn on the spot sweeps the sector that the footprint turns
-     through, up to the whole circumscribed disc: its dist is the length the outermost point
-     (at the circumscribed radius R) travels, turning that way, before the footprint comes
-     within the margin of a cell.
+     before that distance falls below the margin, `margin_m` plus v T: between two decisions
+     the robot drifts from the arc it was asked for (its drive lags the command; a skid-steer
+     turns faster than asked), the more the faster it goes. An arc is followed at most one
+     full circle, after which it repeats. A turn on the spot sweeps the sector that the
+     footprint turns through, up to the whole circumscribed disc: its dist is the length the
+     outermost point (at the circumscribed radius R) travels, turning that way, before the
+     footprint comes within `margin_m` of a cell.
    When the map already puts a cell within the margin, an arc is blocked only where the robot
    comes closer to a cell than it already is.
 4. Admissible: the robot stops within dist, a command holding until the next tick. A round
@@ -345,20 +347,23 @@ class DwaPlanner(Planner):
         assert origin is not None, "the map's update places its origin"
         first_cell = (int(origin[0]), int(origin[1]))
 
+        margins = p.margin_m + speeds * self.period  # wider the faster (step 3)
+        cap = float(margins.max())
+
         def clearance(poses: np.ndarray) -> np.ndarray:
             flat = self.footprint_clearance(
-                occupied, first_cell, self.map.cell_m, self.robot.footprint, poses.reshape(-1, 3), p.margin_m
+                occupied, first_cell, self.map.cell_m, self.robot.footprint, poses.reshape(-1, 3), cap
             )
             return flat.reshape(poses.shape[:-1])
 
         here = clearance(np.array([obs.position[0], obs.position[1], obs.yaw]))
-        limit = min(p.margin_m, float(here[()]))  # never closer than the robot already is
+        limits = np.minimum(margins, float(here[()]))  # never closer than the robot already is
         dist = np.full((len(speeds), len(turns)), reach)
         moving = speeds > 0
         if moving.any():
-            dist[moving] = self._arcs_free_distance(obs, speeds[moving], turns, clearance, limit)
+            dist[moving] = self._arcs_free_distance(obs, speeds[moving], turns, clearance, limits[moving])
         if not moving[0]:
-            dist[0] = self._turns_free_distance(obs, turns, clearance, limit)
+            dist[0] = self._turns_free_distance(obs, turns, clearance, float(limits[0]))
         return dist
 
     def _arcs_free_distance(
@@ -367,9 +372,10 @@ class DwaPlanner(Planner):
         speeds: np.ndarray,
         turns: np.ndarray,
         clearance: Callable[[np.ndarray], np.ndarray],
-        limit: float,
+        limits: np.ndarray,
     ) -> np.ndarray:
-        """dist (speeds, turns) of a polygon robot's arcs, all speeds > 0."""
+        """dist (speeds, turns) of a polygon robot's arcs, all speeds > 0, each speed's arcs
+        blocked where the clearance falls below its limit (speeds,) in m."""
         reach, radius = self.lookahead, self.radius
         curvature = turns / speeds[:, None]
         bend = np.abs(curvature)
@@ -380,7 +386,7 @@ class DwaPlanner(Planner):
         steps = self.step_m * np.arange(1, count + 1)
         travel = np.minimum(steps / spread[..., None], end[..., None])  # (speeds, turns, count)
         points, headings = arc_poses(obs.position, obs.yaw, travel, curvature[..., None] * travel)
-        hits = clearance(np.concatenate((points, headings[..., None]), axis=-1)) < limit
+        hits = clearance(np.concatenate((points, headings[..., None]), axis=-1)) < limits[:, None, None]
         hits = self._past_the_goal_free(obs, points, hits)
         first = np.argmax(hits, axis=-1)
         before = np.take_along_axis(travel, np.maximum(first - 1, 0)[..., None], axis=-1)[..., 0]
