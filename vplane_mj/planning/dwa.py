@@ -70,6 +70,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vplane_mj.planning import gridsearch
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.body import DriveLimits, HeadingGains, RobotBody
 from vplane_mj.planning.events import Event, EventKind
@@ -90,6 +91,9 @@ times this, since the controller's speed k_v |F| cos e vanishes as e nears pi / 
 0.17). It binds for no robot whose top turn rate is below 1.4 k_w (the default: 2.5 < 4.2)."""
 CREEP_SPEED = 1e-6
 """Speed (m/s) that a turn on the spot asks for: the force needs a length to have a direction."""
+WAY_INFLATION_M, WAY_INFLATION_WEIGHT = 0.3, 4.0
+"""The map's ways (`follow_way`) pay for passing closer than this (m) beyond the passage radius,
+up to this much more per metre right at it (a costmap's inflation, as `vplane_plus`'s)."""
 FIRST_PERIOD_S = 0.05
 """Control period (s) assumed on the first tick, before two observations give it (20 Hz)."""
 ROBOTS = "0: the robot's, else at most this"
@@ -122,6 +126,14 @@ class DwaParams(LocalMapParams, MinimumParams):
         0.05, "m", "clearance kept between the robot's outline and obstacle cells", ge=0, le=1.0
     )
     heading_weight: float = param(2.0, "", "alpha: weight of the heading to the goal", ge=0)
+    follow_way: int = param(
+        0,
+        "",
+        "the heading's aim: 0 the goal (Fox); 1 a look-ahead along the map's shortest way to it",
+        ge=0,
+        le=1,
+        integer=True,
+    )
     clearance_weight: float = param(0.2, "", "beta: weight of the free distance along the arc", ge=0)
     velocity_weight: float = param(0.2, "", "gamma: weight of the forward speed", ge=0)
     smoothing: float = param(1.0, "", "sigma: Gaussian smoothing of G across samples (0: none)", ge=0, le=10)
@@ -254,7 +266,8 @@ class DwaPlanner(Planner):
         admissible = self.stopping_length(speeds, turns) <= dist
         decision = Decision(force=np.zeros(2), mode="normal")
         if admissible.any():
-            score = np.where(admissible, self._objective(obs, speeds, turns, dist), 0.0)
+            aim = self._way_point(obs) if p.follow_way else obs.goal
+            score = np.where(admissible, self._objective(obs, aim, speeds, turns, dist), 0.0)
             score = self.smooth_speeds @ score @ self.smooth_turns.T
             i, j = np.unravel_index(np.argmax(np.where(admissible, score, -np.inf)), score.shape)
             command = float(speeds[i]), float(turns[j])
@@ -428,16 +441,39 @@ class DwaPlanner(Planner):
             hits &= ~np.logical_or.accumulate(arrived, axis=-1)
         return hits
 
+    def _way_point(self, obs: Observation) -> np.ndarray:
+        """The point (m) a look-ahead along the map's shortest way from the robot to the goal,
+        for the robot's centre kept a passage radius (half the width, plus the margin) from the
+        obstacle cells; the goal when the way is shorter, or when the map holds none."""
+        p, cell = self.params, self.map.cell_m
+        origin = self.map.origin
+        assert origin is not None, "the map's update places its origin"
+        passage = self.robot.half_width_m + p.margin_m
+        occupied = self.map.grid >= p.map_threshold
+        cost = gridsearch.step_costs(
+            occupied, np.zeros_like(occupied), cell, passage, WAY_INFLATION_M, WAY_INFLATION_WEIGHT, 0.0
+        )
+        window = gridsearch.Window(cost, origin * cell, cell, np.zeros_like(occupied))
+        window.clear_disc(obs.position, passage)  # the robot stands there
+        cells = gridsearch.way_to(window, obs.position, obs.goal, passage)
+        if cells is None:
+            return obs.goal
+        way = np.array([window.centre(c) for c in cells[1:]]).reshape(-1, 2)
+        travelled = np.cumsum(np.hypot(*np.diff(np.vstack((obs.position, way)), axis=0).T))
+        ahead = np.flatnonzero(travelled >= self.lookahead)
+        return way[ahead[0]] if len(ahead) else obs.goal
+
     def _objective(
-        self, obs: Observation, speeds: np.ndarray, turns: np.ndarray, dist: np.ndarray
+        self, obs: Observation, aim: np.ndarray, speeds: np.ndarray, turns: np.ndarray, dist: np.ndarray
     ) -> np.ndarray:
-        """alpha heading + beta dist + gamma velocity (speeds, turns), each term in [0, 1]."""
+        """alpha heading + beta dist + gamma velocity (speeds, turns), each term in [0, 1]; the
+        heading toward `aim` (m)."""
         p, limits = self.params, self.limits
         travel = (speeds * self.period + speeds**2 / (2 * limits.max_accel_mps2))[:, None]
         turned = (turns * self.period + turns * np.abs(turns) / (2 * limits.max_turn_accel_radps2))[None, :]
         points, headings = arc_poses(obs.position, obs.yaw, travel, turned)
-        to_goal = obs.goal - points
-        theta = wrap_angle(np.arctan2(to_goal[..., 1], to_goal[..., 0]) - headings)
+        to_aim = aim - points
+        theta = wrap_angle(np.arctan2(to_aim[..., 1], to_aim[..., 0]) - headings)
         return (
             p.heading_weight * (1 - np.abs(theta) / math.pi)
             + p.clearance_weight * dist / self.lookahead
