@@ -286,7 +286,7 @@ GAP = [(1.05, 0.25), (1.05, -0.25)]
 
 def test_the_jackal_drives_through_a_gap_narrower_than_its_diagonal():
     jackal, obs = at_rest_on(GAP, margin_m=0.02)
-    speeds, turns = np.array([0.1, 0.2]), np.array([0.0])  # margins 2.5 and 3 cm
+    speeds, turns = np.array([0.05, 0.1]), np.array([0.0])  # margins 2.5 and 3 cm
     dist = jackal.free_distance(obs, speeds, turns)
     assert np.all(dist == jackal.lookahead)  # 3.5 cm either side
     assert np.all(jackal.stopping_length(speeds, turns) <= dist)
@@ -298,10 +298,11 @@ def test_the_jackal_drives_through_a_gap_narrower_than_its_diagonal():
 
 
 def test_the_faster_the_wider_the_berth():
-    """The margin grows by a control period's travel: at 1 m/s, 2 + 5 cm, more than the gap's
-    3.5 cm either side."""
+    """The margin grows by two control periods' travel: at 0.5 m/s, 2 + 5 cm, more than the
+    gap's 3.5 cm either side."""
     jackal, obs = at_rest_on(GAP, margin_m=0.02)
-    dist = jackal.free_distance(obs, np.array([0.2, 1.0]), np.array([0.0]))[:, 0]
+    assert dwa.DRIFT_PERIODS * PERIOD * 0.5 == 0.05
+    dist = jackal.free_distance(obs, np.array([0.1, 0.5]), np.array([0.0]))[:, 0]
     ahead = 1.05 - JACKAL_HALF_LENGTH  # where the front reaches the posts' line
     assert dist[0] == jackal.lookahead and ahead - 0.1 < dist[1] < ahead
 
@@ -315,8 +316,8 @@ half width and margin, but the front-right corner, which swings out on a left tu
 
 def test_an_arc_whose_corner_would_clip_a_post_is_not_admissible():
     jackal, obs = at_rest_on([POST], margin_m=0.01)
-    speeds, turns = np.array([0.1, 2.0]), np.array([0.1, 2.0]) * BEND
-    margins = 0.01 + speeds * PERIOD
+    speeds, turns = np.array([0.05, 2.0]), np.array([0.05, 2.0]) * BEND
+    margins = 0.01 + dwa.DRIFT_PERIODS * PERIOD * speeds
     dist = jackal.free_distance(obs, speeds, turns).diagonal()
     travel = np.linspace(0.0, 1.0, 20001)
     points, headings = dwa.arc_poses(obs.position, obs.yaw, travel, BEND * travel)
@@ -362,3 +363,28 @@ def test_a_turn_on_the_spot_is_free_until_a_corner_would_reach_a_post():
         turning = dist[turns * side > 0]
         assert np.all((length - jackal.step_m < turning) & (turning <= length))
     assert dist[turns == 0.0] == jackal.lookahead  # standing still sweeps nothing
+
+
+# -- Following the map's way ------------------------------------------------------------------
+
+WALL_BUT_ABOVE = [(1.55, y) for y in np.arange(-1.45, 0.6, 0.1)]
+"""A wall of cells across the way 1.5 m ahead, from y = -1.45 m to 0.55 m: open above it."""
+
+
+@pytest.mark.parametrize("body", [JACKAL, RobotBody.round(RADIUS)])
+def test_with_follow_way_it_aims_along_the_maps_way_round_a_wall(body):
+    fox, obs = at_rest_on(WALL_BUT_ABOVE, body=body, goal=(4.0, 0.0))
+    assert np.all(fox.aim(obs) == obs.goal)  # Fox's heading: straight at the wall
+    way, obs = at_rest_on(WALL_BUT_ABOVE, body=body, goal=(4.0, 0.0), follow_way=1)
+    aim = way.aim(obs)
+    # one metre along a way that passes above the wall's end, its centre a passage radius off
+    assert np.hypot(*aim) == pytest.approx(1.0, abs=0.15) and aim[1] > 0.5
+    decision = way.step(observe(None, PERIOD, (0.0, 0.0), 0.0, goal=(4.0, 0.0)))
+    assert command(decision, 0.0)[1] > 0  # it turns toward the opening
+
+
+def test_with_follow_way_it_aims_at_the_goal_when_the_map_holds_no_way():
+    box = [(x, y) for x in np.arange(-1.25, 1.3, 0.1) for y in (-1.25, 1.25)]
+    box += [(x, y) for x in (-1.25, 1.25) for y in np.arange(-1.15, 1.2, 0.1)]
+    way, obs = at_rest_on(box, goal=(4.0, 0.0), follow_way=1)
+    assert np.all(way.aim(obs) == obs.goal)

@@ -31,9 +31,9 @@ control tick:
    - A polygon robot: its footprint at poses along the arc, no point of it moving more than
      half a cell between two, and the signed distance from the footprint to the obstacle
      cells' centres there (footprint_clearance.py). dist is the length the centre travels
-     before that distance falls below the margin, `margin_m` plus v T: between two decisions
-     the robot drifts from the arc it was asked for (its drive lags the command; a skid-steer
-     turns faster than asked), the more the faster it goes. An arc is followed at most one
+     before that distance falls below the margin, `margin_m` plus DRIFT_PERIODS T v: the
+     robot drifts from the arc it was asked for while its drive catches up with the command
+     (a skid-steer also turns faster than asked), the more the faster it goes. An arc is followed at most one
      full circle, after which it repeats. A turn on the spot sweeps the sector that the
      footprint turns through, up to the whole circumscribed disc: its dist is the length the
      outermost point (at the circumscribed radius R) travels, turning that way, before the
@@ -47,8 +47,13 @@ control tick:
    stays on its circle: a length v (T + t_b / 2); turning on the spot, its outermost point
    travels R |omega| (T + |omega| / (2 alpha)).
 5. Objective: G = sigma(alpha_h heading + beta dist + gamma velocity), each term in [0, 1]:
-   heading = 1 - |theta| / pi, theta the goal's bearing from the pose reached after one
-   control period at (v, omega) and braking at both limits; dist / L; v / top speed. sigma
+   heading = 1 - |theta| / pi, theta the aim's bearing from the pose reached after one
+   control period at (v, omega) and braking at both limits; dist / L; v / top speed. The
+   aim is the goal (Fox), or with `follow_way` a point along the map's shortest way to it
+   (as the global planner under BARN's DWA baseline, move_base, gives its local planner;
+   Brock and Khatib's global dynamic window approach): the way keeps the robot's centre half
+   its width plus the margin from the obstacle cells (gridsearch.py, with a costmap's
+   inflation), and the aim lies `look_ahead_m` of the last command's speed along it. sigma
    is a Gaussian over neighbouring samples (`smoothing`, in samples) in which inadmissible
    samples count 0, so the choice keeps off blocked arcs. The admissible sample of greatest
    G is the command.
@@ -94,6 +99,10 @@ CREEP_SPEED = 1e-6
 WAY_INFLATION_M, WAY_INFLATION_WEIGHT = 0.3, 4.0
 """The map's ways (`follow_way`) pay for passing closer than this (m) beyond the passage radius,
 up to this much more per metre right at it (a costmap's inflation, as `vplane_plus`'s)."""
+DRIFT_PERIODS = 2
+"""A polygon robot's margin grows by its travel in this many control periods: its drive ramps
+to a command within a period, and its wheels follow a period later (the Jackal model's true
+speed and turn rate trail the command so), while it stays on the arc it was asked for."""
 FIRST_PERIOD_S = 0.05
 """Control period (s) assumed on the first tick, before two observations give it (20 Hz)."""
 ROBOTS = "0: the robot's, else at most this"
@@ -159,12 +168,16 @@ def window_limits(params: DwaParams, robot: RobotBody) -> DriveLimits:
 
 
 def lookahead(params: DwaParams, limits: DriveLimits) -> float:
-    """The arcs' length L (m): `lookahead_m`, or when that is 0 the larger of MIN_LOOKAHEAD_M and
-    LOOKAHEAD_BRAKINGS braking distances from the top speed."""
+    """The arcs' length L (m): `lookahead_m`, or when that is 0 `look_ahead_m` of the top speed."""
     if params.lookahead_m > 0:
         return params.lookahead_m
-    braking = limits.max_speed_mps**2 / (2 * limits.max_accel_mps2)
-    return max(MIN_LOOKAHEAD_M, LOOKAHEAD_BRAKINGS * braking)
+    return look_ahead_m(limits.max_speed_mps, limits.max_accel_mps2)
+
+
+def look_ahead_m(speed: float, accel: float) -> float:
+    """How far ahead (m) a robot at `speed` (m/s) that brakes at `accel` (m/s^2) looks: the larger
+    of MIN_LOOKAHEAD_M and LOOKAHEAD_BRAKINGS braking distances."""
+    return max(MIN_LOOKAHEAD_M, LOOKAHEAD_BRAKINGS * speed**2 / (2 * accel))
 
 
 def dynamic_window(
@@ -266,8 +279,7 @@ class DwaPlanner(Planner):
         admissible = self.stopping_length(speeds, turns) <= dist
         decision = Decision(force=np.zeros(2), mode="normal")
         if admissible.any():
-            aim = self._way_point(obs) if p.follow_way else obs.goal
-            score = np.where(admissible, self._objective(obs, aim, speeds, turns, dist), 0.0)
+            score = np.where(admissible, self._objective(obs, self.aim(obs), speeds, turns, dist), 0.0)
             score = self.smooth_speeds @ score @ self.smooth_turns.T
             i, j = np.unravel_index(np.argmax(np.where(admissible, score, -np.inf)), score.shape)
             command = float(speeds[i]), float(turns[j])
@@ -360,7 +372,7 @@ class DwaPlanner(Planner):
         assert origin is not None, "the map's update places its origin"
         first_cell = (int(origin[0]), int(origin[1]))
 
-        margins = p.margin_m + speeds * self.period  # wider the faster (step 3)
+        margins = p.margin_m + DRIFT_PERIODS * self.period * speeds  # wider the faster (step 3)
         cap = float(margins.max())
 
         def clearance(poses: np.ndarray) -> np.ndarray:
@@ -441,11 +453,15 @@ class DwaPlanner(Planner):
             hits &= ~np.logical_or.accumulate(arrived, axis=-1)
         return hits
 
-    def _way_point(self, obs: Observation) -> np.ndarray:
-        """The point (m) a look-ahead along the map's shortest way from the robot to the goal,
-        for the robot's centre kept a passage radius (half the width, plus the margin) from the
-        obstacle cells; the goal when the way is shorter, or when the map holds none."""
+    def aim(self, obs: Observation) -> np.ndarray:
+        """The point (m) the heading term aims at (step 5 of the module docstring): the goal; with
+        `follow_way`, the point `look_ahead_m` of the last command's speed along the map's
+        shortest way to it for the robot's centre kept a passage radius (half the width, plus
+        the margin) from the obstacle cells, or the goal when the way is shorter or the map
+        holds none."""
         p, cell = self.params, self.map.cell_m
+        if not p.follow_way:
+            return obs.goal
         origin = self.map.origin
         assert origin is not None, "the map's update places its origin"
         passage = self.robot.half_width_m + p.margin_m
@@ -460,7 +476,8 @@ class DwaPlanner(Planner):
             return obs.goal
         way = np.array([window.centre(c) for c in cells[1:]]).reshape(-1, 2)
         travelled = np.cumsum(np.hypot(*np.diff(np.vstack((obs.position, way)), axis=0).T))
-        ahead = np.flatnonzero(travelled >= self.lookahead)
+        limits = self.limits
+        ahead = np.flatnonzero(travelled >= look_ahead_m(self.command[0], limits.max_accel_mps2))
         return way[ahead[0]] if len(ahead) else obs.goal
 
     def _objective(

@@ -204,7 +204,9 @@ def cost_to_go(cost: np.ndarray, targets: np.ndarray, target_costs: np.ndarray, 
     return costs[:n].reshape(nx, ny)
 
 
-def way_to(window: Window, start: np.ndarray, end: np.ndarray, radius_m: float) -> list[tuple[int, int]] | None:
+def way_to(
+    window: Window, start: np.ndarray, end: np.ndarray, radius_m: float
+) -> list[tuple[int, int]] | None:
     """The cells of the window's shortest way from `start` toward `end` (m), the start's first:
     to the end's cell when the window holds it (made passable within `radius_m` of the end),
     else to the window's edge, each edge cell starting at its straight distance to the end.
