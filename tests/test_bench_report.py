@@ -53,13 +53,30 @@ def test_success_per_planner_and_scenario():
     np.testing.assert_allclose(grid.rates, [[1.0, 0.0, 1.0], [0.5, np.nan, np.nan]])
 
 
-def test_the_scenario_heatmap_grows_with_the_scenarios():
-    many = [row(f"traps_1_{i:03d}", p, 0, i % 3 > 0) for i in range(100) for p in ("apf", "vplane")]
-    figure = bench_report.scenario_figure(many)
+def test_the_scenario_heatmap_grows_with_the_scenarios_up_to_its_limit():
+    few = [row(f"traps_1_{i:03d}", p, 0, i % 3 > 0) for i in range(30) for p in ("apf", "vplane")]
+    figure = bench_report.scenario_figure(few)
     width, height = figure.get_size_inches()
-    assert height >= 0.24 * 100 and width < height  # one row of about 0.24 in per scenario
+    assert height >= 0.24 * 30 and width < height  # one row of about 0.24 in per scenario
     texts = [t.get_text() for t in figure.axes[0].texts]
-    assert len(texts) == 200 and set(texts) == {"yes", "no"}  # one seed: each cell says it
+    assert len(texts) == 60 and set(texts) == {"yes", "no"}  # one seed: each cell says it
+    bench_report.png_bytes(figure)
+
+
+def test_of_300_scenarios_the_heatmap_shows_the_hardest_and_says_so():
+    # Scenario i fails with both planners when i is a multiple of 7 (43 of them), with one when i % 7 == 1.
+    rows = [
+        row(f"barn_{i:03d}", p, 0, not (i % 7 == 0 or (i % 7 == 1 and p == "apf")))
+        for i in range(300)
+        for p in ("apf", "vplane")
+    ]
+    figure = bench_report.scenario_figure(rows)
+    limit = bench_report.MAX_SCENARIO_ROWS
+    assert figure.get_size_inches()[1] < 1.6 + 0.24 * limit + 1  # readable: at most `limit` rows tall
+    assert figure.axes[0].get_title() == f"the {limit} of 300 scenarios with the lowest success"
+    shown = [label.get_text() for label in figure.axes[0].get_yticklabels()]
+    assert shown == [f"barn_{i:03d}" for i in range(0, 300, 7)][:limit]  # the first 40 that both failed
+    assert {t.get_text() for t in figure.axes[0].texts} == {"no"}
     bench_report.png_bytes(figure)
 
 

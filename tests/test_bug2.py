@@ -86,6 +86,21 @@ def test_goes_to_goal_in_the_open_and_follows_near_a_wall():
     assert near.force[1] > 0.5 and near.force[1] > abs(near.force[0])
 
 
+@pytest.mark.parametrize("open_side", [1, -1])
+def test_a_laser_turns_toward_the_side_it_hears_nothing_from(open_side):
+    # A post right ahead; on one side walls 4 m off, on the other nothing within the laser's
+    # 30 m but an echo 6 m off: the side without echoes is the freer one.
+    laser = synthetic.LAYOUTS["jackal_laser"]
+    side = np.sign(laser.bearings)
+    ranges = np.where(side == -open_side, 4.0, np.nan)
+    ranges[np.flatnonzero(side == open_side)[::50]] = 6.0
+    ranges[np.abs(laser.bearings) < 0.2] = 0.3
+    obs = Observation(0.0, np.zeros(2), 0.0, np.array([5.0, 0.0]), 0.15, laser.bearings, ranges, laser.beam)
+    decision = planner(follow_side=0).step(obs)
+    assert decision.mode == "following"
+    assert ("turning left" if open_side == 1 else "turning right") in decision.events[0].text
+
+
 def test_follows_a_wall_around_its_end_and_leaves_on_the_m_line():
     wall = shapes.scene_footprints([shapes.Wall((3.0, 1.5), (3.0, 4.5), 0.1)])
     _, decisions = drive(wall, (1.0, 3.0), (5.0, 3.0), 60.0)

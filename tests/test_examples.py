@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.slow  # a long suite: `python -m pytest -m slow` runs it
+
 EXAMPLES = Path(__file__).parents[1] / "examples"
 SUMMARY_LINE = re.compile(
     r"^(?P<scenario>\w+) \[(?P<planner>\w+), seed (?P<seed>\d+)\]: (?P<outcome>\w+) after "
@@ -170,7 +172,7 @@ def test_compare_planners_sweeps_the_custom_planner_with_built_in_ones(tmp_path)
     assert png_size(tmp_path / "bench.png")[0] > 500
 
 
-def test_the_readme_drawing_example_runs(tmp_path, monkeypatch, readme_examples):
+def test_the_documented_drawing_example_runs(tmp_path, monkeypatch, doc_examples):
     monkeypatch.chdir(tmp_path)
-    exec(compile(readme_examples("Examples"), "README.md", "exec"), {})
+    exec(compile(doc_examples("python-api.md", "Examples"), "docs/python-api.md", "exec"), {})
     assert png_size(tmp_path / "paper_c_escape.png")[0] >= 600

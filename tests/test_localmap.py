@@ -1,12 +1,16 @@
-"""The sonar certainty grid: beam arcs, free-cone carving, clusters and extreme points."""
+"""The certainty grid from range scans: beam arcs, free-cone carving, any sensor layout (sonar
+rings and arrays, lasers), clusters and extreme points."""
 
+import hashlib
 import math
+import tracemalloc
 
 import numpy as np
 import pytest
 
 from vplane_mj.geometry import shapes
-from vplane_mj.geometry.synthetic import BEAM, BEARINGS, scan
+from vplane_mj.geometry.synthetic import BEAM, BEARINGS, LAYOUTS, scan
+from vplane_mj.planning import beams, localmap
 from vplane_mj.planning.localmap import LocalMap, angular_extremes
 
 WALL = shapes.Footprints(shapes.Wall((2.0, -1.0), (2.0, 1.0), 0.1).footprint())
@@ -167,6 +171,14 @@ def dense_update(
     np.clip(window, 0, top, out=window)
 
 
+@pytest.fixture(params=["table", "walk"])
+def path(request, monkeypatch):
+    """How the map finds the cells a scan may change: the cone table (a sonar's few beams) or
+    the compiled walk through each cone (a laser's many, or a far echo). The grid is the same."""
+    monkeypatch.setattr(localmap, "TABLE_MAX_BEAMS", 10**6 if request.param == "table" else 0)
+    return request.param
+
+
 @pytest.mark.parametrize(
     "count, beam_deg, cell, size, range_max, yaw_scale",
     [
@@ -178,7 +190,7 @@ def dense_update(
     ],
 )
 def test_the_update_equals_a_pass_over_every_cell_within_reach(
-    count, beam_deg, cell, size, range_max, yaw_scale
+    count, beam_deg, cell, size, range_max, yaw_scale, path
 ):
     rng = np.random.default_rng(count)
     bearings = np.arange(count) * (2 * math.pi / count)
@@ -230,3 +242,371 @@ def test_clusters_are_the_regions_of_the_grown_obstacle_cells(seed):
     pairs = set(zip(label_grid.ravel().tolist(), expected.ravel().tolist(), strict=True))
     assert len(pairs) == len(set(label_grid.ravel().tolist())) == len(set(expected.ravel().tolist()))
     np.testing.assert_array_equal(labels, label_grid[occupied])
+
+
+# -- any scan: sonar rings and arrays, lasers ---------------------------------------------------
+
+RING_WORLD = shapes.Footprints(
+    [
+        *shapes.Wall((-3.0, -2.5), (5.0, -2.5), 0.1).footprint(),
+        *shapes.Wall((-3.0, 2.5), (5.0, 2.5), 0.1).footprint(),
+        *shapes.Box((1.5, 0.6), (0.4, 0.8)).footprint(),
+        *shapes.Box((3.2, -1.0), (0.3, 0.3), 0.4).footprint(),
+    ]
+)
+RING_MAPS = {
+    "vplane_plus": {
+        "cell_m": 0.05,
+        "size_m": 16.0,
+        "hit": 1,
+        "miss": 2,
+        "hit_range_m": 1.5,
+        "track_seen": True,
+        "silent_free_m": 1.0,
+    },
+    "vplane": {"cell_m": 0.1, "size_m": 8.0},
+    "small": {"cell_m": 0.1, "size_m": 3.0},  # shifts often
+}
+RING_DIGESTS = {
+    "vplane_plus": "b40a103448aa34bcc556789d76ac9bf5ced5a04179a2ffa7fbc617fc6d161092",
+    "vplane": "7f0df0c60cf1dfe25344bf13624f3446cf76f4645712a5b9e0fab8ff240c4c10",
+    "small": "07fb678b39e0b5c51819358e630015106a4381cf5ef5ecfcdb9604414b01c757",
+}
+"""Digests of `ring_sequence`, recorded from the map as it was before it took any scan but the
+evenly spaced 16-sonar ring's."""
+
+
+def ring_sequence(options: dict) -> str:
+    """The digest of the grid, the seen mask and the origin after each of 120 ring scans of a
+    room, the robot driving and turning through it (some readings lost, some sweeps)."""
+    grid = LocalMap(**options)
+    rng = np.random.default_rng(7)
+    digest = hashlib.sha256()
+    for step in range(120):
+        t = step / 119
+        position = np.array([-2.0 + 6.0 * t, 1.2 * math.sin(3 * t)])
+        yaw = 2.5 * math.sin(5 * t)
+        ranges = scan(RING_WORLD, position, yaw)
+        ranges[rng.random(16) < 0.15] = np.nan
+        grid.update(position, yaw, BEARINGS, ranges, BEAM)
+        if step % 3 == 0:
+            grid.sweep(position, 0.2)
+        for layer in (grid.grid, grid.seen, np.asarray(grid.origin)):
+            digest.update(layer.tobytes())
+    return digest.hexdigest()
+
+
+@pytest.mark.parametrize("nearest", ["ring arithmetic", "search"])
+@pytest.mark.parametrize("name", RING_MAPS)
+def test_the_ring_gives_the_grid_it_gave_before_any_other_scan_was_possible(name, path, nearest, monkeypatch):
+    if nearest == "search":  # no ring is even enough for the arithmetic: every cell's beam is searched
+        monkeypatch.setattr(beams, "RING_TOLERANCE_RAD", -1.0)
+    assert ring_sequence(RING_MAPS[name]) == RING_DIGESTS[name]
+
+
+@pytest.mark.parametrize("yaw", [0.3, -2.9, 40.0])
+@pytest.mark.parametrize("count", [1, 3, 16, 360])
+def test_the_ring_arithmetic_and_the_search_give_every_angle_the_same_beam(count, yaw):
+    rng = np.random.default_rng(count)
+    bearings = rng.uniform(-math.pi, math.pi) + np.arange(count) * (2 * math.pi / count)
+    fan = beams.BeamFan(rng.permutation(bearings), math.radians(360.0 / count))
+    assert fan.spacing is not None
+    axis = yaw + fan.directions[0]
+    # As the map asks: a cell centre's world angle (atan2, in [-pi, pi]) less the first axis.
+    on_axes = np.repeat(fan.relative, 3) + np.tile([-1e-7, 0.0, 1e-7], count)
+    near_bounds = np.repeat(fan.bounds, 2) + np.tile([-1e-9, 1e-9], count)  # either side of a tie
+    world = np.concatenate(
+        [rng.uniform(-math.pi, math.pi, 50_000), wrapped(np.r_[on_axes, near_bounds] + axis)]
+    )
+    ring_beam, ring_offset = fan.nearest_in_ring(world - axis, axis)
+    search_beam, search_offset = fan.nearest_by_search(world - axis)
+    np.testing.assert_array_equal(ring_beam, search_beam)
+    np.testing.assert_allclose(ring_offset, search_offset, rtol=0, atol=1e-9)
+    assert np.abs(ring_offset).max() <= math.pi / count + 1e-9  # the nearest: at most half the spacing
+
+
+def shifted(layer: np.ndarray, old: np.ndarray | None, new: np.ndarray) -> np.ndarray:
+    """`layer` (the grid's, at origin `old`; None: not placed yet) moved to origin `new`; what
+    falls off is zero."""
+    out = np.zeros_like(layer)
+    if old is None:
+        return out
+    n, s = layer.shape[0], new - old
+    if np.max(np.abs(s)) < n:
+        src = [slice(max(0, k), n + min(0, k)) for k in s]
+        dst = [slice(max(0, -k), n + min(0, -k)) for k in s]
+        out[dst[0], dst[1]] = layer[src[0], src[1]]
+    return out
+
+
+def wrapped(angle):
+    """Angles (rad) wrapped to [-pi, pi)."""
+    return (angle + math.pi) % (2 * math.pi) - math.pi
+
+
+def beam_of_each_cell(centres, position, yaw, bearings, ranges, beam):
+    """The map's rule written out plainly, for every cell centre (..., 2): the nearest of the
+    scan's distinct bearings (the shortest echo of the beams that share one), whether the centre
+    lies within half a beam of it, and that direction's range (NaN: no echo)."""
+    directions = np.unique(np.mod(bearings, 2 * math.pi))
+    readings = np.full(len(directions), np.nan)
+    for k, direction in enumerate(directions):
+        echoes = ranges[(np.mod(bearings, 2 * math.pi) == direction) & np.isfinite(ranges)]
+        if len(echoes):
+            readings[k] = echoes.min()
+    rel = centres - position
+    gaps = wrapped(np.arctan2(rel[..., 1], rel[..., 0])[..., None] - yaw - directions)
+    nearest = np.argmin(np.abs(gaps), axis=-1)
+    offset = np.take_along_axis(gaps, nearest[..., None], axis=-1)[..., 0]
+    return np.abs(offset) <= beam / 2, readings[nearest], np.hypot(rel[..., 0], rel[..., 1])
+
+
+def reference_update(grid, seen, origin, cell, position, yaw, bearings, ranges, beam, rule):
+    """The grid and seen mask after one scan, the rule applied to every cell of the grid."""
+    n = grid.shape[0]
+    centres = (np.asarray(origin) + np.stack(np.indices((n, n)), axis=-1) + 0.5) * cell
+    in_cone, reading, distance = beam_of_each_cell(centres, position, yaw, bearings, ranges, beam)
+    echo = in_cone & np.isfinite(reading)
+    marks = (reading <= rule.get("hit_range_m", math.inf)) | (reading <= cell / beam)
+    arc = echo & marks & (np.abs(distance - reading) <= 0.75 * cell)
+    free = echo & (distance < reading - cell)
+    hit, miss = rule.get("hit", 3), rule.get("miss", 1)
+    grid = np.clip(grid + hit * arc - miss * free, 0, rule.get("max_certainty", 15)).astype(grid.dtype)
+    if rule.get("track_seen"):
+        seen = seen | free | (in_cone & np.isnan(reading) & (distance < rule.get("silent_free_m", 0.0)))
+    return grid, seen
+
+
+def uneven_partial_layout(rng):
+    """Bearings over 200 degrees, in no order, uneven, some shared; beams wider than some gaps."""
+    bearings = np.radians(rng.uniform(-100.0, 100.0, 23))
+    return np.concatenate([bearings, bearings[:4]]), math.radians(12.0), 4.0
+
+
+SCANS = {
+    **{name: (layout.bearings, layout.beam, layout.range_max) for name, layout in LAYOUTS.items()},
+    "uneven_partial": uneven_partial_layout(np.random.default_rng(5)),
+    "one_wide_beam": (np.array([0.7]), math.radians(300.0), 3.0),
+}
+RULES = {
+    "default": {},
+    "vplane_plus": {"hit": 1, "miss": 2, "hit_range_m": 1.5, "track_seen": True, "silent_free_m": 1.0},
+}
+
+
+@pytest.mark.parametrize("rule", RULES)
+@pytest.mark.parametrize("name", SCANS)
+def test_any_scan_updates_the_grid_as_the_rule_says_cell_by_cell(name, rule, path):
+    bearings, beam, range_max = SCANS[name]
+    options = RULES[rule]
+    rng = np.random.default_rng(len(bearings))
+    fast = LocalMap(cell_m=0.1, size_m=5.0, **options)
+    position = np.array([1.0, -2.0])
+    for step in range(30 if len(bearings) < 100 else 12):
+        position = position + rng.normal(0.0, 0.3, 2) if step % 8 else rng.uniform(-9, 9, 2)
+        yaw = float(rng.uniform(-math.pi, math.pi)) * (1 if step % 5 else 300)  # now and then far out
+        ranges = rng.uniform(0.05, range_max, len(bearings))
+        ranges[rng.random(len(bearings)) < 0.25] = np.nan
+        ranges[rng.random(len(bearings)) < 0.03] = 30.0  # far beyond the grid
+        old_origin = None if fast.origin is None else fast.origin.copy()
+        grid, seen = fast.grid.copy(), fast.seen.copy()
+        fast.update(position, yaw, bearings, ranges, beam)
+        expected = reference_update(
+            shifted(grid, old_origin, fast.origin),
+            shifted(seen, old_origin, fast.origin),
+            fast.origin,
+            0.1,
+            position,
+            yaw,
+            bearings,
+            ranges,
+            beam,
+            options,
+        )
+        np.testing.assert_array_equal(fast.grid, expected[0])
+        np.testing.assert_array_equal(fast.seen, expected[1])
+    assert fast.grid.max() > 0  # the scans did mark cells
+
+
+POSTS = ((1.6, 1.0), (0.2, -1.25), (-0.9, 0.25))
+"""Post centres (m): ahead and to the left, to the right, and behind the robot."""
+POST_RADIUS = 0.075
+WALL_ENDS = ((2.3, -1.0), (2.3, 0.9))
+"""A thin wall across the way ahead (m)."""
+ROBOT, HEADING = np.array([0.1, 0.05]), 0.15
+
+
+def exact_ranges(position, yaw, bearings, beam, range_max, rays):
+    """Each beam's reading (m from `position`): the shortest over `rays` rays spread across the
+    beam of the distance to the posts' circles and the wall's segment; NaN beyond `range_max`.
+    Also which obstacle (index into POSTS, or len(POSTS) for the wall) each reading comes from."""
+    offsets = np.linspace(-0.4 * beam, 0.4 * beam, rays) if rays > 1 else np.zeros(1)
+    angles = yaw + np.asarray(bearings)[:, None] + offsets[None, :]
+    dx, dy = np.cos(angles), np.sin(angles)
+    found = np.full((*angles.shape, len(POSTS) + 1), np.inf)
+    for k, centre in enumerate(POSTS):
+        cx, cy = centre[0] - position[0], centre[1] - position[1]
+        along = cx * dx + cy * dy
+        across2 = cx * cx + cy * cy - along * along
+        entry = along - np.sqrt(np.maximum(POST_RADIUS**2 - across2, 0.0))
+        found[..., k] = np.where((across2 <= POST_RADIUS**2) & (entry > 0), entry, np.inf)
+    (ax, ay), (bx, by) = WALL_ENDS
+    ex, ey = bx - ax, by - ay
+    qx, qy = ax - position[0], ay - position[1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        denominator = dx * ey - dy * ex
+        t = (qx * ey - qy * ex) / denominator  # along the ray
+        s = (qx * dy - qy * dx) / denominator  # along the wall
+    found[..., -1] = np.where((t > 0) & (s >= 0) & (s <= 1), t, np.inf)
+    nearest = found.min(axis=-1)
+    ray = np.argmin(nearest, axis=1)
+    reading = nearest[np.arange(len(ray)), ray]
+    source = np.argmin(found[np.arange(len(ray)), ray], axis=-1)
+    return np.where(reading <= range_max, reading, np.nan), np.where(reading <= range_max, source, -1)
+
+
+def length(vectors):
+    """Lengths of vectors (..., 2)."""
+    return np.hypot(vectors[..., 0], vectors[..., 1])
+
+
+def outline_distance(points):
+    """Distance (m) from points (..., 2) to the nearest obstacle's outline (posts and wall)."""
+    best = np.full(points.shape[:-1], np.inf)
+    for centre in POSTS:
+        best = np.minimum(best, np.abs(length(points - centre) - POST_RADIUS))
+    a, b = np.array(WALL_ENDS[0]), np.array(WALL_ENDS[1])
+    t = np.clip(((points - a) @ (b - a)) / ((b - a) @ (b - a)), 0.0, 1.0)
+    return np.minimum(best, length(points - (a + t[..., None] * (b - a))))
+
+
+def test_the_synthetic_scan_sees_posts_and_walls_where_they_are():
+    layout = LAYOUTS["jackal_laser"]
+    pieces = [shapes.Disc(centre, POST_RADIUS) for centre in POSTS]
+    pieces += shapes.Wall(WALL_ENDS[0], WALL_ENDS[1], 1e-9).footprint()
+    cast = layout.scan(shapes.Footprints(pieces), ROBOT, HEADING)
+    exact, source = exact_ranges(ROBOT, HEADING, layout.bearings, layout.beam, layout.range_max, 1)
+    np.testing.assert_allclose(cast, exact, rtol=0, atol=1e-8)
+    assert set(source.tolist()) == {-1, 0, 1, 3}  # two posts and the wall seen; one post behind
+
+
+@pytest.mark.parametrize("name", LAYOUTS)
+def test_a_scan_of_known_obstacles_marks_them_clears_the_way_and_leaves_unseen_cells(name, path):
+    layout = LAYOUTS[name]
+    rays = 5 if len(layout.bearings) < 100 else 1  # a sonar's echo: the nearest anywhere in its beam
+    ranges, source = exact_ranges(ROBOT, HEADING, layout.bearings, layout.beam, layout.range_max, rays)
+    cell = 0.05
+    grid = LocalMap(cell_m=cell, size_m=8.0, track_seen=True)
+    grid.update(ROBOT, HEADING, layout.bearings, np.full(len(ranges), np.nan), layout.beam)  # places it
+    centres = (grid.origin + np.stack(np.indices(grid.grid.shape), axis=-1) + 0.5) * cell
+    in_cone, reading, distance = beam_of_each_cell(
+        centres, ROBOT, HEADING, layout.bearings, ranges, layout.beam
+    )
+    stale = (distance > 0.7) & (distance <= 0.8)  # a ring of old marks nearer than every obstacle
+    grid.grid[stale] = 5
+    for _ in range(6):
+        grid.update(ROBOT, HEADING, layout.bearings, ranges, layout.beam)
+
+    in_front = in_cone & (distance < reading - cell)
+    assert (stale & in_front).sum() > 20
+    assert not grid.grid[stale & in_front].any()  # the way to each echo is cleared
+    assert np.all(grid.grid[stale & ~in_cone] == 5)  # between the beams and out of view: untouched
+    assert not grid.seen[~in_cone].any()
+    assert grid.seen[in_front].all()
+    for obstacle in np.unique(source[source >= 0]):  # each obstacle an echo came from is on the map
+        if obstacle < len(POSTS):
+            near = np.abs(length(centres - POSTS[obstacle]) - POST_RADIUS) <= cell
+        else:
+            near = outline_distance(centres) <= cell
+        assert grid.grid[near].max() >= 4, obstacle
+    # What the scans marked lies on the obstacles, give or take the arc's band, a cell's half
+    # diagonal and, for a wide beam, how far the arc reaches beside the obstacle.
+    marked = (grid.grid > 0) & ~stale
+    beside = np.nanmax(ranges) * math.sin(layout.beam / 2) if rays > 1 else 0.0
+    assert outline_distance(centres[marked]).max() <= (0.75 + math.sqrt(0.5)) * cell + beside
+    if name == "jackal_laser":  # the post behind the robot is out of the laser's view
+        assert 2 not in source
+        behind = length(centres - POSTS[2]) < 0.5
+        assert not grid.grid[behind & ~stale].any() and not grid.seen[behind].any()
+    if name == "pioneer_sonars":  # 15 degree beams 20 degrees apart leave gaps, ahead too
+        rel = centres - ROBOT
+        ahead = np.abs(wrapped(np.arctan2(rel[..., 1], rel[..., 0]) - HEADING)) < 1.0
+        assert (stale & ~in_cone & ahead).any()
+
+
+@pytest.mark.parametrize("name", ["jackal_laser", "sonar_ring"])
+def test_a_return_far_beyond_the_grid_clears_its_cone_to_the_edge_and_allocates_little(name, path):
+    layout = LAYOUTS[name]
+    warm_up = LocalMap(cell_m=0.1, size_m=8.0)  # numba's kernel loads outside the measurement
+    warm_up.update(ROBOT, 0.0, layout.bearings, np.full(len(layout.bearings), 30.0), layout.beam)
+    grid = LocalMap(cell_m=0.1, size_m=8.0)
+    grid.update(ROBOT, HEADING, layout.bearings, np.full(len(layout.bearings), np.nan), layout.beam)
+    grid.grid[...] = 5
+    ranges = np.full(len(layout.bearings), np.nan)
+    ranges[: len(ranges) // 2] = 30.0  # half the beams echo from 30 m away, the rest hear nothing
+    ranges[1] = 1e300
+    tracemalloc.start()
+    grid.update(ROBOT, HEADING, layout.bearings, ranges, layout.beam)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    # The map as it was before it took any scan but the ring's padded its grid for a cone table
+    # out to 30 m: 11 MB for the ring here, 21 MB for the laser.
+    assert peak < 1_000_000
+    centres = (grid.origin + np.stack(np.indices(grid.grid.shape), axis=-1) + 0.5) * 0.1
+    in_cone, reading, _ = beam_of_each_cell(centres, ROBOT, HEADING, layout.bearings, ranges, layout.beam)
+    cleared = in_cone & np.isfinite(reading)
+    edge = np.zeros_like(cleared)
+    edge[[0, -1], :] = edge[:, [0, -1]] = True
+    assert (cleared & edge).sum() >= 3  # cleared out to the edge
+    np.testing.assert_array_equal(grid.grid, np.where(cleared, 4, 5))  # one miss each; no hit
+
+
+def test_beams_that_share_a_bearing_act_as_one_with_the_shortest_echo(path):
+    layout = LAYOUTS["pioneer_sonars"]
+    ranges, _ = exact_ranges(ROBOT, HEADING, layout.bearings, layout.beam, layout.range_max, 5)
+    ranges[[0, 15]] = (1.2, 0.9)  # the front and the rear sonar looking along +90 degrees
+    ranges[[7, 8]] = (np.nan, 1.4)  # and the two along -90: one hears nothing
+    merged = [k for k in range(16) if k not in (0, 8)]  # one beam per bearing, its shortest echo
+    merged_ranges = ranges.copy()
+    merged_ranges[7] = 1.4
+    grids = []
+    for bearings, readings in ((layout.bearings, ranges), (layout.bearings[merged], merged_ranges[merged])):
+        grid = LocalMap(cell_m=0.05, size_m=6.0, track_seen=True, silent_free_m=0.5)
+        for _ in range(3):
+            grid.update(ROBOT, HEADING, bearings, readings, layout.beam)
+        grids.append((grid.grid, grid.seen))
+    np.testing.assert_array_equal(grids[0][0], grids[1][0])
+    np.testing.assert_array_equal(grids[0][1], grids[1][1])
+    assert grids[0][0].max() > 0
+
+
+def test_the_order_of_the_beams_does_not_matter(path):
+    layout = LAYOUTS["jackal_laser"]
+    ranges, _ = exact_ranges(ROBOT, HEADING, layout.bearings, layout.beam, layout.range_max, 1)
+    order = np.random.default_rng(3).permutation(len(ranges))
+    grids = []
+    for bearings, readings in ((layout.bearings, ranges), (layout.bearings[order], ranges[order])):
+        grid = LocalMap(cell_m=0.05, size_m=6.0)
+        grid.update(ROBOT, HEADING, bearings, readings, layout.beam)
+        grids.append(grid.grid)
+    np.testing.assert_array_equal(*grids)
+
+
+def test_an_arc_no_wider_than_a_cell_marks_beyond_the_hit_range(path):
+    # A wall 3 m ahead, 0.6 m wide: a laser's 0.375 degree arc there is 2 cm wide and places
+    # its echo; a 20 degree sonar arc is a metre wide, and past the hit range it only clears.
+    marked = {}
+    for name in ("jackal_laser", "sonar_ring"):
+        layout = LAYOUTS[name]
+        rays = np.linspace(-0.4, 0.4, 5) if name == "sonar_ring" else np.zeros(1)
+        angles = layout.bearings[None, :] + rays[:, None] * layout.beam  # the robot facing +x
+        across = 3.0 * np.tan(angles)
+        hits = np.where((np.cos(angles) > 0) & (np.abs(across) <= 0.3), 3.0 / np.cos(angles), np.inf)
+        ranges = np.where(np.isfinite(hits.min(axis=0)), hits.min(axis=0), np.nan)
+        grid = LocalMap(cell_m=0.05, size_m=8.0, hit_range_m=1.5)
+        grid.update(np.array([0.01, 0.02]), 0.0, layout.bearings, ranges, layout.beam)
+        marked[name] = grid.cells(1)[0]
+    assert len(marked["sonar_ring"]) == 0
+    assert len(marked["jackal_laser"]) >= 8  # the wall's 12 cells, but for its ends
+    assert np.all(np.abs(marked["jackal_laser"][:, 0] - 3.0) <= 0.05)
+    assert np.all(np.abs(marked["jackal_laser"][:, 1]) <= 0.3 + 0.05)

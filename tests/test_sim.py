@@ -5,7 +5,10 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj.sim.loop import run_scenario
+from vplane_mj.planning import Decision, Observation, Planner, register_planner
+from vplane_mj.robots.profiles import ControllerGains
+from vplane_mj.sim.control import within_limits
+from vplane_mj.sim.loop import Run, run_scenario
 from vplane_mj.sim.metrics import barn_score
 from vplane_mj.sim.summary import TIMING_KEYS
 
@@ -157,3 +160,41 @@ def test_the_summary_scores_a_run_against_its_reference_path(shipped):
     assert 0.125 <= reached.score <= 0.5
     trapped = run_scenario(shipped("paper_c_escape", "planner.name=apf")).summary
     assert trapped.score == 0.0
+
+
+class _Reverser(Planner):
+    """Backs off at 0.3 m/s for its first second, then lets the force drive to the goal."""
+
+    name = "reverser"
+    summary = "backs off, then heads for the goal"
+    citation = ""
+
+    def step(self, obs: Observation) -> Decision:
+        self.seen = [*getattr(self, "seen", []), (obs.time_s, obs.velocity)]
+        decision = Decision(force=obs.goal - obs.position, mode="normal")
+        if obs.time_s < 1.0:
+            decision.command = (-0.3, 0.0)
+        return decision
+
+
+def test_a_planner_can_command_a_reverse_and_reads_the_wheels_speeds(scenario_from, own_registry):
+    register_planner(_Reverser)
+    run = Run(scenario_from(OPEN.format(yaw=0.0), ["planner.name=reverser"]))
+    while run.step() is None:
+        pass
+    result = run.result()
+    assert result.summary.reached
+    # Heading +x, backing off: x decreases below the start's 1.0 m during the first second.
+    backed = result.positions[result.times <= 1.0]
+    assert backed[:, 0].min() < 1.0 - 0.15 and np.max(np.abs(backed[:, 1] - 1.5)) < 0.02
+    # The wheels report the speed driven: -0.3 m/s once the motors have caught up, then forward.
+    _, (speed, turn) = min(run.planner.seen, key=lambda seen: abs(seen[0] - 0.5))
+    assert speed == pytest.approx(-0.3, abs=0.03) and abs(turn) < 0.05
+    assert max(v for t, (v, _) in run.planner.seen if t > 3.0) > 0.4
+
+
+def test_a_commanded_speed_and_turn_rate_are_held_within_the_robot_limits():
+    gains = ControllerGains()
+    assert within_limits((-9.0, 9.0), gains) == (-gains.max_speed, gains.max_turn_rate)
+    assert within_limits((0.2, -0.1), gains) == (0.2, -0.1)
+    assert within_limits((math.nan, 1.0), gains) == (0.0, 0.0)

@@ -1,13 +1,13 @@
 """vplane-mj: artificial potential fields and the virtual-plane escape from local minima in MuJoCo.
 
-The Python API (README "Python API"): `load_scenario` and `build_scenario` (with the obstacle
+The Python API (docs/python-api.md): `load_scenario` and `build_scenario` (with the obstacle
 helpers `box`, `wall`, `cylinder`, `cup`, `h_shape`), `run` and `sweep`. Each name is imported
 on first use, so `import vplane_mj` loads neither MuJoCo nor any plotting or OpenGL library.
 
 The package's layers, top down (each imports only from those below it; `pyproject.toml` holds
 them as an import-linter contract): `cli`; `runner` and `sweeps` (the run and the sweep as the
 API gives them); `envs` and `bench`; `viz`; `logs`; `sim` and `worlds`; `scenario`; `robots`;
-`planning` and `geometry`; `files` and `interrupts`; `errors`. Modules that stood at the top
+`planning` and `geometry`; `files` and `terminal`; `errors`. Modules that stood at the top
 before 0.2 keep their old import paths (`vplane_mj.gym_env`, say) as aliases of their new ones.
 """
 
@@ -104,6 +104,7 @@ MOVED_MODULES = {
     "failures": "bench.failures",
     "families": "worlds.families",
     "gym_env": "envs.gym_env",
+    "interrupts": "terminal",
     "laser": "sim.laser",
     "log_mcap": "logs.writer",
     "log_read": "logs.reader",

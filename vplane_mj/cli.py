@@ -1,4 +1,4 @@
-"""The `vplane-mj` command line (README "Commands"). `main(argv) -> exit status`."""
+"""The `vplane-mj` command line (docs/command-line.md). `main(argv) -> exit status`."""
 
 from __future__ import annotations
 
@@ -15,9 +15,9 @@ from typing import TYPE_CHECKING
 import vplane_mj
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import DEFAULT_OUT, prepare_out_dir, write_atomically
-from vplane_mj.interrupts import Interrupted, signals_raise_interrupted
 from vplane_mj.planning.plugins import PlannerError
 from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
+from vplane_mj.terminal import Interrupted, signals_raise_interrupted
 from vplane_mj.worlds.families import FAMILIES
 
 if TYPE_CHECKING:
@@ -100,7 +100,24 @@ def _parser() -> argparse.ArgumentParser:
         version=f"vplane-mj {vplane_mj.__version__} (contract v{vplane_mj.CONTRACT_VERSION})",
     )
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    _add_run(commands)
+    _add_bench(commands)
+    _add_world_commands(commands)
+    _add_log_commands(commands)
+    listing = commands.add_parser("list", help="built-in scenarios, robot profiles and planners")
+    listing.add_argument(
+        "--planner",
+        action="append",
+        metavar="NAME|module:Class",
+        help="show only this planner and its parameters (repeatable); module:Class or "
+        "path/to/file.py:Class imports it",
+    )
+    listing.set_defaults(handler=_list, draws=False)
+    return parser
 
+
+def _add_run(commands) -> None:
+    """`vplane-mj run`."""
     run = commands.add_parser("run", help="one headless run of a scenario")
     run.add_argument("scenario", metavar="SCENARIO", help="a TOML file or a built-in scenario name")
     run.add_argument(
@@ -123,6 +140,9 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--video", action="store_true", help="also write an .mp4 replay of the run")
     run.set_defaults(handler=_run)
 
+
+def _add_bench(commands) -> None:
+    """`vplane-mj bench`."""
     sweep = commands.add_parser("bench", help="many runs: scenarios x planners x seeds")
     sweep.add_argument("scenarios", nargs="+", metavar="SCENARIO")
     sweep.add_argument(
@@ -143,6 +163,9 @@ def _parser() -> argparse.ArgumentParser:
     sweep.add_argument("--out", type=Path, help=f"output directory (default {DEFAULT_OUT}/)")
     sweep.set_defaults(handler=_bench, draws=False)
 
+
+def _add_world_commands(commands) -> None:
+    """`vplane-mj generate`, `import`, `check` and `mjcf`: scenario files and worlds."""
     gen = commands.add_parser("generate", help="write seeded scenario files of a family")
     gen.add_argument("family", metavar="FAMILY", help=f"one of: {', '.join(sorted(FAMILIES))}")
     gen.add_argument("--count", type=int, default=10)
@@ -172,6 +195,9 @@ def _parser() -> argparse.ArgumentParser:
     export.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.xml")
     export.set_defaults(handler=_mjcf, draws=False)
 
+
+def _add_log_commands(commands) -> None:
+    """`vplane-mj summary`, `render`, `plot` and `video`: what a run's log gives again."""
     summary = commands.add_parser("summary", help="recompute a run's summary from its MCAP log")
     summary.add_argument("log", type=Path, metavar="LOG.mcap")
     summary.set_defaults(handler=_summary, draws=False)
@@ -193,17 +219,6 @@ def _parser() -> argparse.ArgumentParser:
         "--speed", type=float, default=1.0, help="simulated seconds per video second (default 1: real time)"
     )
     video.set_defaults(handler=_video)
-
-    listing = commands.add_parser("list", help="built-in scenarios and planners")
-    listing.add_argument(
-        "--planner",
-        action="append",
-        metavar="NAME|module:Class",
-        help="show only this planner and its parameters (repeatable); module:Class or "
-        "path/to/file.py:Class imports it",
-    )
-    listing.set_defaults(handler=_list, draws=False)
-    return parser
 
 
 def _planner_name(reference: str, option: str) -> str:

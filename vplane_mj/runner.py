@@ -17,11 +17,11 @@ import numpy as np
 
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import DEFAULT_OUT, prepare_out_dir, write_atomically, write_json
-from vplane_mj.interrupts import Interrupted
 from vplane_mj.planning.events import Event, EventKind
 from vplane_mj.scenario import Scenario, load_scenario
 from vplane_mj.sim.loop import RunResult, Tick, run_scenario
 from vplane_mj.sim.summary import RunSummary
+from vplane_mj.terminal import Interrupted
 
 if TYPE_CHECKING:
     from vplane_mj.logs.writer import McapLog

@@ -38,6 +38,8 @@ PICTURE_MARGIN_M = 1.0
 Point = tuple[float, float]
 Box = tuple[float, float, float, float]
 """x0, y0, x1, y1 (m)."""
+MAX_SCENARIO_ROWS = 40
+"""The most scenarios bench-scenarios.png shows, a row each (a taller picture is not read)."""
 WorldSymbol = tuple[str, Box, tuple[Point, Point]]
 """A scenario's world as drawn once in the page: its symbol id, its box, its start and goal."""
 _RUN_COLUMNS = (
@@ -138,32 +140,50 @@ def summary_figure(rows: list[dict]) -> plt.Figure:
     planners = family.planners
     width = max(18.0, 12 + 0.9 * len(family.columns))
     figure, (heat, times, ratios) = plt.subplots(
-        1, 3, figsize=(width, 4.8), gridspec_kw={"width_ratios": [max(2, len(family.columns)) * 0.8, 4, 4]}
+        1,
+        3,
+        figsize=(width, 4.8),
+        gridspec_kw={"width_ratios": [max(2, len(family.columns)) * 0.8, 4, 4]},
+        layout="constrained",
     )
     _heatmap(heat, family, transpose=False, fontsize=9)
     seeds = len({row["seed"] for row in rows})
-    heat.set_title(f"success (reached, no collision) per planner and family, {seeds} seed(s)")
+    heat.set_title(f"success (reached, no collision)\nper planner and family, {seeds} seed(s)")
     data = [[r["time_to_goal_s"] for r in rows if r["planner"] == p and r["reached"]] for p in planners]
     times.boxplot([d if d else [float("nan")] for d in data], tick_labels=planners)
     times.set(ylabel="time to goal (s)", title="time to goal of the runs that reached it")
     data = [[r["path_ratio"] for r in rows if r["planner"] == p and r.get("path_ratio")] for p in planners]
     ratios.boxplot([d if d else [float("nan")] for d in data], tick_labels=planners)
     ratios.set(ylabel="path length / shortest path", title="path ratio of the runs that reached the goal")
-    figure.tight_layout()
     return figure
 
 
 def scenario_figure(rows: list[dict]) -> plt.Figure:
-    """bench-scenarios.png: success per scenario (rows) and planner (columns), annotated."""
+    """bench-scenarios.png: success per scenario (rows) and planner (columns), annotated; of a
+    sweep over more than MAX_SCENARIO_ROWS scenarios, the MAX_SCENARIO_ROWS with the lowest
+    success over all planners (bench.csv has every run)."""
     grid = success_grid(rows, lambda row: row["scenario"])
+    title = "success per scenario and planner"
+    if (scenarios := len(grid.columns)) > MAX_SCENARIO_ROWS:
+        grid = _hardest(grid, MAX_SCENARIO_ROWS)
+        title = f"the {MAX_SCENARIO_ROWS} of {scenarios} scenarios with the lowest success"
     height = 1.6 + 0.24 * len(grid.columns)
-    width = 3.0 + 0.9 * len(grid.planners) + 0.07 * max(len(name) for name in grid.columns)
-    figure, axes = plt.subplots(figsize=(width, height))
+    width = 3.4 + 0.9 * len(grid.planners) + 0.07 * max(len(name) for name in grid.columns)
+    figure, axes = plt.subplots(figsize=(width, height), layout="constrained")
     _heatmap(axes, grid, transpose=True, fontsize=8)
     axes.xaxis.tick_top()
-    axes.set_title("success per scenario and planner", pad=24)
-    figure.tight_layout()
+    axes.set_title(title, pad=24, fontsize=10)
     return figure
+
+
+def _hardest(grid: SuccessGrid, count: int) -> SuccessGrid:
+    """The `count` columns (scenarios) of least success over every planner, in that order (ties by
+    their first-seen order)."""
+    rate = grid.successes.sum(axis=0) / np.maximum(grid.runs.sum(axis=0), 1)
+    keep = np.argsort(rate, kind="stable")[:count]
+    return SuccessGrid(
+        grid.planners, [grid.columns[j] for j in keep], grid.successes[:, keep], grid.runs[:, keep]
+    )
 
 
 def png_bytes(figure: plt.Figure) -> bytes:

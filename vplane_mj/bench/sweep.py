@@ -14,11 +14,11 @@ workers at once: the runs they had under way are done again by the next invocati
 from __future__ import annotations
 
 import contextlib
+import io
 import json
 import os
 import statistics
 import sys
-import time
 from collections.abc import Generator, Iterable
 from functools import partial
 from pathlib import Path
@@ -31,6 +31,7 @@ from vplane_mj.planning.registry import for_worker
 from vplane_mj.scenario import load_scenario
 from vplane_mj.scenario.overrides import Override
 from vplane_mj.sim.failure import FailureKind, RunFailure, failure_of
+from vplane_mj.terminal import Progress
 
 JOURNAL = "bench.jsonl"
 TABLE_COLUMNS = (
@@ -132,32 +133,6 @@ def read_journal(path: Path) -> dict[str, dict]:
     return rows
 
 
-class Progress:
-    """A one-line progress bar with an ETA on stderr (a line every 10% when not a terminal)."""
-
-    def __init__(self, total: int, done: int):
-        self.total, self.done, self.started = total, done, time.monotonic()
-        self.fresh = 0
-        self.tty = sys.stderr.isatty()
-        self._last_decile = -1
-
-    def advance(self) -> None:
-        self.done += 1
-        self.fresh += 1
-        elapsed = time.monotonic() - self.started
-        remaining = (self.total - self.done) * elapsed / self.fresh
-        filled = round(30 * self.done / self.total)
-        line = (
-            f"[{'#' * filled}{'.' * (30 - filled)}] {self.done}/{self.total} runs, "
-            f"{elapsed:.0f} s elapsed, ETA {remaining:.0f} s"
-        )
-        if self.tty:
-            print(f"\r{line}", end="" if self.done < self.total else "\n", file=sys.stderr, flush=True)
-        elif (decile := 10 * self.done // self.total) != self._last_decile:
-            self._last_decile = decile
-            print(line, file=sys.stderr, flush=True)
-
-
 def run_sweep(
     jobs: list[Job], out_dir: Path, workers: int, scheduler: str | None = None, journal_name: str = JOURNAL
 ) -> list[dict]:
@@ -184,8 +159,8 @@ def run_sweep(
     # Closed explicitly, so that the workers stop however the loop ends (an interruption, an error).
     with contextlib.closing(results):
         if pending:
-            progress = Progress(len(jobs), len(jobs) - len(pending))
-            with open(journal_path, "a", encoding="utf-8") as journal:
+            progress = Progress("sweep", len(jobs), "runs", done=len(jobs) - len(pending))
+            with progress, open(journal_path, "a", encoding="utf-8") as journal:
                 if not _ends_with_a_newline(journal_path):
                     journal.write("\n")  # a killed sweep's torn line stays a line apart from the new rows
                 for job, result in results:
@@ -206,6 +181,11 @@ def _ends_with_a_newline(path: Path) -> bool:
         return stream.read(1) == b"\n"
 
 
+SCHEDULER_TIMEOUT_S = 5.0
+"""How long a sweep tries to reach its Dask scheduler (s); Dask retries until then, even a
+refused connection."""
+
+
 def _dask_results(jobs: list[Job], scheduler: str) -> Generator[tuple[Job, dict | RunFailure], None, None]:
     """Jobs with their rows or failures as the workers of a Dask distributed cluster finish
     them (the [dask] extra).
@@ -219,7 +199,7 @@ def _dask_results(jobs: list[Job], scheduler: str) -> Generator[tuple[Job, dict 
     except ImportError as exc:
         raise VPlaneError("--scheduler needs Dask: pip install 'vplane-mj[dask]'") from exc
     try:
-        client = Client(scheduler, timeout=5)
+        client = Client(scheduler, timeout=SCHEDULER_TIMEOUT_S)
     except OSError as exc:
         raise VPlaneError(f"--scheduler: cannot reach a Dask scheduler at {scheduler}: {exc}") from exc
 
@@ -272,19 +252,25 @@ def _mean(values: list[float]) -> float | None:
 
 
 def format_table(table: list[dict]) -> str:
-    """The table as aligned text for the terminal."""
+    """The table as text for the terminal (rich's table, plain characters): one row per
+    planner, the columns of TABLE_COLUMNS; numbers with two decimals, "-" where none."""
+    from rich import box
+    from rich.console import Console
+    from rich.table import Table
 
     def cell(value) -> str:
         if value is None:
             return "-"
         return f"{value:.2f}" if isinstance(value, float) else str(value)
 
-    widths = [max(len(c), *(len(cell(row[c])) for row in table)) for c in TABLE_COLUMNS]
-    lines = ["  ".join(c.ljust(w) for c, w in zip(TABLE_COLUMNS, widths, strict=True))]
-    lines += [
-        "  ".join(cell(row[c]).ljust(w) for c, w in zip(TABLE_COLUMNS, widths, strict=True)) for row in table
-    ]
-    return "\n".join(lines)
+    grid = Table(box=box.SIMPLE_HEAD, pad_edge=False)
+    for column in TABLE_COLUMNS:
+        grid.add_column(column, justify="left" if column == "planner" else "right", no_wrap=True)
+    for row in table:
+        grid.add_row(*(cell(row[column]) for column in TABLE_COLUMNS))
+    console = Console(file=io.StringIO(), width=400, record=True, color_system=None)
+    console.print(grid)
+    return "\n".join(line.rstrip() for line in console.export_text().splitlines() if line.strip())
 
 
 MAX_ERRORS_LISTED = 10

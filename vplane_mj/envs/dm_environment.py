@@ -6,7 +6,7 @@ One `step` is one control tick of `vplane_mj.sim.loop.Run`. The first TimeStep o
 FIRST (no reward, no discount), the last is LAST: discount 0 when the run ends in a state of
 its own (reached, stuck, error), 1 when the time limit cuts it short (dm_env's truncation).
 dm_env's `reset` takes no seed: episode k of an environment built with `seed` has the seed
-`seed + k`. The specs, the reward and the endings are those of the README's "dm_env environment".
+`seed + k`. The specs, the reward and the endings are those of docs/environments.md.
 """
 
 from __future__ import annotations
@@ -81,7 +81,7 @@ class VPlaneNavDmEnv(dm_env.Environment):
 
     def observation_spec(self) -> dict[str, specs.BoundedArray]:
         """`ranges` (count,) float32 m, `echo` (count,) int8 0/1, `goal` (2,) float32 m in the
-        robot frame, `velocity` (2,) float32 m/s and rad/s: see the README."""
+        robot frame, `velocity` (2,) float32 m/s and rad/s: see docs/environments.md."""
         return self._observation_spec
 
     def action_spec(self) -> specs.BoundedArray:
@@ -90,7 +90,7 @@ class VPlaneNavDmEnv(dm_env.Environment):
         return self._action_spec
 
     def reward_spec(self) -> specs.Array:
-        """A float64 scalar: the reward of the README (progress in m, collisions, time, success)."""
+        """A float64 scalar: the reward of docs/environments.md (progress in m, collisions, time, success)."""
         return specs.Array((), np.float64, name="reward")
 
     def close(self) -> None:

@@ -5,7 +5,7 @@ One `step` is one control tick of `vplane_mj.sim.loop.Run`: the action takes the
 planner's decision, then the run senses again (`vplane_mj.envs.task`, which the dm_env
 environment shares). Importing this module registers the environment as ENV_ID, so
 `gymnasium.make("vplane_mj/Navigation-v0")` builds it. The spaces, the reward and the ending
-of an episode are those of the README's "Gymnasium environment".
+of an episode are those of docs/environments.md.
 """
 
 from __future__ import annotations

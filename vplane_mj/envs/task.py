@@ -196,7 +196,7 @@ class NavigationTask:
 
     # -- the bounds of observations and actions ----------------------------------------------
     def observation_bounds(self) -> dict[str, Bounds]:
-        """Each entry of the observation (see `_agent_observation`; units in the README)."""
+        """Each entry of the observation (see `_agent_observation`; units in docs/environments.md)."""
         count, speed_turn = self.sonar_count, np.array(VELOCITY_BOUND)
         return {
             "ranges": Bounds.box((count,), np.float32, 0.0, self.reach_m),

@@ -313,8 +313,7 @@ def shortest_path(
     Segments are checked every cell_m / 2; the grid's cells are cell_m, or coarser when the
     arena would need more than MAX_GRID_CELLS of them.
     """
-    from scipy.sparse import coo_matrix  # here: a cached reference path needs no scipy
-    from scipy.sparse.csgraph import dijkstra
+    from scipy.sparse.csgraph import dijkstra  # here: a cached reference path needs no scipy
 
     world, robot = scenario.world, scenario.robot
     width, height = world.size
@@ -345,9 +344,37 @@ def shortest_path(
     centres = np.column_stack([gx.ravel(), gy.ravel()])
     free = (dist(centres) > thr).reshape(ny, nx)
     n = nx * ny
-    idx = np.arange(n).reshape(ny, nx)
 
     # 2. 8-connected graph without corner cutting, plus the start and goal nodes
+    graph = _grid_graph(free, centres, cell_m, (start, goal), clear)
+    cost, pred = dijkstra(graph, directed=False, indices=n, return_predecessors=True)
+    if not np.isfinite(cost[n + 1]):
+        return None
+    chain = [n + 1]
+    while chain[-1] != n:
+        chain.append(int(pred[chain[-1]]))
+    path = np.array([start, *centres[chain[-2:0:-1]], goal])
+
+    # 3. line-of-sight smoothing, then pull the polyline taut
+    path = _relax(_shortcut(path, clear), clear, cell_m)
+    return ReferencePath(_polyline_length(path), path)
+
+
+def _grid_graph(
+    free: np.ndarray,
+    centres: np.ndarray,
+    cell_m: float,
+    ends: tuple[np.ndarray, np.ndarray],
+    clear: _Clearance,
+):
+    """The graph of the free cells (ny, nx) of `cell_m` (m), 8-connected without corner cutting,
+    with node n (the start) and n + 1 (the goal) joined to the free cells they see in a straight
+    line nearby; edge weights in m. A scipy CSR matrix."""
+    from scipy.sparse import coo_matrix
+
+    ny, nx = free.shape
+    n = nx * ny
+    idx = np.arange(n).reshape(ny, nx)
     rows, cols, weights = [], [], []
 
     def link(src: np.ndarray, dst: np.ndarray, mask: np.ndarray, w: float) -> None:
@@ -362,6 +389,7 @@ def shortest_path(
     link(idx[:-1, 1:], idx[1:, :-1], square, cell_m * math.sqrt(2))
 
     free_ids = np.flatnonzero(free.ravel())
+    start, goal = ends
     for node, point, threshold in ((n, start, clear.thr_start), (n + 1, goal, clear.thr_goal)):
         radius = _CONNECT_CELLS * cell_m
         seen = np.zeros(0, dtype=int)
@@ -372,21 +400,9 @@ def shortest_path(
         rows.append(np.full(len(seen), node))
         cols.append(seen)
         weights.append(np.maximum(np.hypot(*(centres[seen] - point).T), _EPS))
-
-    graph = coo_matrix(
+    return coo_matrix(
         (np.concatenate(weights), (np.concatenate(rows), np.concatenate(cols))), shape=(n + 2, n + 2)
     ).tocsr()
-    cost, pred = dijkstra(graph, directed=False, indices=n, return_predecessors=True)
-    if not np.isfinite(cost[n + 1]):
-        return None
-    chain = [n + 1]
-    while chain[-1] != n:
-        chain.append(int(pred[chain[-1]]))
-    path = np.array([start, *centres[chain[-2:0:-1]], goal])
-
-    # 3. line-of-sight smoothing, then pull the polyline taut
-    path = _relax(_shortcut(path, clear), clear, cell_m)
-    return ReferencePath(_polyline_length(path), path)
 
 
 def _source_digest() -> str:

@@ -2,7 +2,7 @@
 
 This is the baseline the paper improves on: it has no escape, so once the
 local-minimum detector has held it trapped for `patience_s` it gives up (outcome
-`stuck`).
+`stuck`). The governor (motion.py) fits the force to the robot's body.
 """
 
 from __future__ import annotations
@@ -11,14 +11,14 @@ from dataclasses import dataclass
 
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.body import RobotBody
-from vplane_mj.planning.groups import FieldParams, MinimumParams
+from vplane_mj.planning.groups import FieldParams, MinimumParams, MotionParams
 from vplane_mj.planning.minima import report_trap
 from vplane_mj.planning.types import Decision, Observation
 
 
 @dataclass(frozen=True)
-class ApfParams(MinimumParams, FieldParams):
-    """The fields' parameters, then the detector's and the patience."""
+class ApfParams(MotionParams, MinimumParams, FieldParams):
+    """The fields' parameters, then the detector's and the patience, then the governor's."""
 
 
 class ApfPlanner(Planner):
@@ -33,10 +33,13 @@ class ApfPlanner(Planner):
     def __init__(self, params: ApfParams, robot: RobotBody | float):
         super().__init__(params, robot)
         self.detector = params.detector()
+        self.governor = params.governor(self.robot)
 
     def step(self, obs: Observation) -> Decision:
         components = self.params.firas_components(obs)
         total = components["attractive"] + components["repulsive"]
+        if not self.governor.idle:
+            total = self.governor.govern(total, obs.position, obs.yaw, obs.echo_points())
         decision = Decision(force=total, mode="normal", components=components)
         report_trap(self.detector, obs, decision, self.params.patience_s)
         return decision

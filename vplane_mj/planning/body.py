@@ -79,6 +79,17 @@ class RobotBody:
         return self.radius_m if self.disc else float(np.max(np.abs(self.footprint[:, 1])))
 
     @property
+    def inner_radius_m(self) -> float:
+        """Radius (m) of the largest disc about base_link's origin inside the footprint: the
+        ground the robot covers whatever its heading; the radius for a round robot."""
+        if self.disc:
+            return self.radius_m
+        a = self.footprint
+        edge = np.roll(a, -1, axis=0) - a
+        # The origin's distance to each edge's line (it lies inside the convex footprint).
+        return float(np.min(np.abs(a[:, 0] * edge[:, 1] - a[:, 1] * edge[:, 0]) / np.hypot(*edge.T)))
+
+    @property
     def front_m(self) -> float:
         """How far the footprint reaches ahead of base_link's origin (m)."""
         return self.radius_m if self.disc else float(np.max(self.footprint[:, 0]))

@@ -1,13 +1,13 @@
 """Bug2 (`bug2`): go along the start-goal line, follow an obstacle's boundary until back on it.
 
-Lumelsky and Stepanov's Bug2 with sonar wall following. The m-line runs from the
-position at the first tick to the goal. In mode "go_to_goal" the robot drives along it;
-when an echo lies within `hit_distance_m` ahead (within +-30 degrees of the goal
-direction) it records the hit point and switches to "following", keeping the wall on one
-side at `wall_distance_m`. It leaves the wall when it is back on the m-line closer to the
-goal than the hit point and the way to the goal is clear. It gives up when it comes back
-to the hit point after a loop around the obstacle (the goal is unreachable) or after
-`max_follow_s` of following.
+Lumelsky and Stepanov's Bug2, following walls on the range scan (sonar or laser). The
+m-line runs from the position at the first tick to the goal. In mode "go_to_goal" the robot
+drives along it; when an echo lies within `hit_distance_m` ahead (within +-30 degrees of
+the goal direction) it records the hit point and switches to "following", keeping the wall
+on one side at `wall_distance_m`. It leaves the wall when it is back on the m-line closer
+to the goal than the hit point and the way to the goal is clear. It gives up when it comes
+back to the hit point after a loop around the obstacle (the goal is unreachable) or after
+`max_follow_s` of following. The governor (motion.py) fits the force to the robot's body.
 """
 
 from __future__ import annotations
@@ -20,7 +20,8 @@ import numpy as np
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
-from vplane_mj.planning.params import PlannerParams, param
+from vplane_mj.planning.groups import MotionParams
+from vplane_mj.planning.params import param
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.planning.vectors import unit, wrap_angle
 
@@ -28,11 +29,13 @@ AHEAD_HALF_ANGLE = math.radians(30.0)
 """Echoes within this angle of the goal direction count as ahead (hit and leave tests)."""
 LEAVE_MARGIN_M = 0.1
 """A leave point must be at least this much closer to the goal than the hit point."""
+SILENT_FREE_M = 3.0
+"""A beam without an echo counts as free this far (m), or as the scan's farthest echo if farther."""
 
 
 @dataclass(frozen=True)
-class Bug2Params(PlannerParams):
-    """Bug2's hit and leave tests, wall following and the m-line."""
+class Bug2Params(MotionParams):
+    """Bug2's hit and leave tests, wall following and the m-line, and the governor's margins."""
 
     hit_distance_m: float = param(0.45, "m", "an echo this close ahead (+-30 deg of the goal) is a hit", gt=0)
     wall_distance_m: float = param(0.4, "m", "distance kept from the followed wall (from the centre)", gt=0)
@@ -81,6 +84,7 @@ class Bug2Planner(Planner):
         self.side = 1  # +1: wall on the right (turned left); -1: wall on the left
         self.left_hit_area = False
         self.gave_up = False
+        self.governor = params.governor(self.robot)
 
     # ------------------------------------------------------------------ geometry
 
@@ -121,11 +125,14 @@ class Bug2Planner(Planner):
         fixed = round(self.params.follow_side)
         if fixed != 0:
             return 1 if fixed > 0 else -1
-        # Turn toward the side with more free space: compare the mean free range left and right.
-        free = np.where(np.isfinite(obs.ranges), obs.ranges, 3.0)
+        # Turn toward the side with more free space: compare the mean free range left and right
+        # (a side the sensor does not see counts as no free space).
+        echoes = np.isfinite(obs.ranges)
+        farthest = max(SILENT_FREE_M, float(obs.ranges[echoes].max())) if echoes.any() else SILENT_FREE_M
+        free = np.where(echoes, obs.ranges, farthest)
         rel = wrap_angle(obs.bearings)
-        left = free[(rel > 0.1) & (rel < math.pi / 2 + 0.1)].mean()
-        right = free[(rel < -0.1) & (rel > -math.pi / 2 - 0.1)].mean()
+        sides = ((rel > 0.1) & (rel < math.pi / 2 + 0.1), (rel < -0.1) & (rel > -math.pi / 2 - 0.1))
+        left, right = (float(free[side].mean()) if side.any() else 0.0 for side in sides)
         return 1 if left >= right else -1
 
     def _follow(self, obs: Observation) -> dict[str, np.ndarray]:
@@ -219,4 +226,6 @@ class Bug2Planner(Planner):
             return Decision(force=np.zeros(2), mode="gave_up", events=events, gave_up=True)
         components = self._go_to_goal(obs) if self.mode == "go_to_goal" else self._follow(obs)
         force = np.sum(list(components.values()), axis=0)
+        if not self.governor.idle:
+            force = self.governor.govern(force, position, obs.yaw, obs.echo_points())
         return Decision(force=force, mode=self.mode, components=components, events=events)

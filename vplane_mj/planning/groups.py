@@ -3,8 +3,9 @@
 A planner's parameters combine them by inheritance (bases listed last group first, see
 `PlannerParams`): `FieldParams` (Khatib's fields, eqs. 2-6), `DetectorParams` (the
 local-minimum detector), `MinimumParams` (the detector and the patience of a planner without
-an escape), `LocalMapParams` (the sonar certainty grid) and `SonarMapParams` (the grid and its
-polar histogram).
+an escape), `LocalMapParams` (the sonar certainty grid), `SonarMapParams` (the grid and its
+polar histogram) and `MotionParams` (the margins of the governor that fits a force to the
+robot's body).
 """
 
 from __future__ import annotations
@@ -13,9 +14,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning import fields
+from vplane_mj.planning import fields, scan
+from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.localmap import LocalMap
 from vplane_mj.planning.minima import LocalMinimumDetector
+from vplane_mj.planning.motion import Governor
 from vplane_mj.planning.params import PlannerParams, param
 from vplane_mj.planning.types import Observation
 
@@ -30,15 +33,32 @@ class FieldParams(PlannerParams):
     influence: float = param(0.8, "m", "f0 of eqs. 4-5, distance of influence of an echo", gt=0)
 
     def firas_components(self, obs: Observation) -> dict[str, np.ndarray]:
-        """Eq. 6's two terms at the robot: attraction to the goal and repulsion from the echoes."""
+        """Eq. 6's two terms at the robot: attraction to the goal and repulsion from the echoes
+        (of a dense scan, the nearest in each sonar ring sector: scan.py)."""
         return {
             "attractive": fields.attractive_force(
                 obs.position, obs.goal, self.attract_gain, self.attract_radius
             ),
             "repulsive": fields.repulsive_force(
-                obs.position, obs.echo_points(), self.repulse_gain, self.influence
+                obs.position, scan.repulsion_points(obs), self.repulse_gain, self.influence
             ),
         }
+
+
+@dataclass(frozen=True)
+class MotionParams(PlannerParams):
+    """The margins of the governor that fits a force to the robot's body (motion.py)."""
+
+    stop_margin_m: float = param(
+        0.1, "m", "the speed allows braking to a stop this far short of an obstacle ahead", ge=0, le=1.0
+    )
+    turn_margin_m: float = param(
+        0.03, "m", "a turn in place keeps the footprint this far from obstacles", ge=0, le=1.0
+    )
+
+    def governor(self, body: RobotBody) -> Governor:
+        """The governor of forces for `body` with these margins."""
+        return Governor(body, self.stop_margin_m, self.turn_margin_m)
 
 
 @dataclass(frozen=True)

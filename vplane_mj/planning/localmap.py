@@ -1,27 +1,45 @@
-"""A small local map accumulated from sonar echoes (a VFH-style certainty grid).
+"""A small local map accumulated from range scans (a VFH-style certainty grid).
 
 The grid is a square of `size_m` around the robot with cells of `cell_m`, anchored to
 the world (it shifts by whole cells when the robot nears its edge; cells that fall off
-are forgotten). Each sonar reading is treated as a real sonar's: the echo lies somewhere
-on the arc of the beam at the measured range, and the cone in front of the arc is free.
-Arc cells gain `hit` certainty (up to `max_certainty`), cone cells lose `miss`; so
-phantom echoes (a wide beam grazing a corridor wall) are erased by later readings while
-real surfaces accumulate (Borenstein and Koren's histogramic in-motion mapping, HIMM).
+are forgotten). A scan is any set of beams: bearings (robot frame, in any order, unevenly
+spaced, over any field of view; several beams may share a bearing), one range per beam
+(from the robot's centre) and one beam width: a sonar ring, a front and a rear sonar array,
+or a laser (its beam width is its angle step). Each reading is treated as a real sonar's:
+the echo lies somewhere on the arc of the beam at the measured range, and the cone in front
+of the arc is free. Arc cells gain `hit` certainty (up to `max_certainty`), cone cells lose
+`miss`; so phantom echoes (a wide beam grazing a corridor wall) are erased by later readings
+while real surfaces accumulate (Borenstein and Koren's histogramic in-motion mapping, HIMM).
 A reading with no echo carries no information here: it may be a lost reading. The map
-is the planner's only memory of obstacles, built from the sonar ring and the pose alone.
+is the planner's only memory of obstacles, built from the scans and the pose alone.
+
+Which beam speaks for a cell: the one whose bearing is nearest to the cell centre's, and
+only when the centre lies within half a beam width of that bearing (`beams.BeamFan`). So
+beams wider than their spacing are clipped to their share of the circle, a cell between two
+narrow beams or outside the field of view is left as it is, and a laser's cell is judged by
+the ray through it. Beams that share a bearing act as one, with the shortest of their
+echoes. A cell within ARC_HALF_WIDTH (0.75) cell of the range, along its beam, is on the
+arc; a cell nearer than the range less one cell is in the free cone.
 
 Options for planners that plan ways on the map: `hit_range_m` (an echo farther than this
-only clears its cone: its arc is too wide to place it), `seen` (the cells some reading has
-shown free, as opposed to merely unknown; with `silent_free_m`, a reading without an echo
+only clears its cone: its arc is too wide to place it; an arc at most one cell wide,
+range x beam <= cell_m, as a laser's, marks at any range), `seen` (the cells some reading
+has shown free, as opposed to merely unknown; with `silent_free_m`, a reading without an echo
 shows its cone free that far) and `sweep` (the cells the robot's own disc has covered, never
 obstacles in a static world).
 
+An echo beyond the grid clears its cone up to the grid's edge and marks nothing there: the
+grid holds no cells beyond its edge, and its storage does not grow with an echo's range.
+
 A scan changes only the cells near its echo arcs (hits), the marked cells inside its cones
 (misses: an empty cell stays empty) and, with `seen`, the cells of its cones not yet seen. So
-an update visits just those, from a table
-of grid offsets by sonar direction and range (`_ConeTable`), and classifies each by the
-rule above (nearest sonar, beam cone, distance to the echo), computed exactly as a pass
+an update visits just those and classifies each by the rule above, computed exactly as a pass
 over every cell within reach of the longest echo would: the grid is the same, bit for bit.
+They are found from a table of grid offsets by beam direction and range (`_ConeTable`) for a
+scan of few beams reaching a few metres (a sonar's), and otherwise, for a laser's hundreds of
+beams or an echo far beyond the grid, by a compiled walk through each cone
+(`cone_walk.cone_cells`, numba, imported only then: its start-up, about 0.3 s a process, is
+more than a sonar run's map ever costs).
 """
 
 from __future__ import annotations
@@ -31,6 +49,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from vplane_mj.planning.beams import BeamFan
 
 
 class LocalMap:
@@ -55,6 +75,9 @@ class LocalMap:
         self.silent_free_m = silent_free_m if track_seen else 0.0
         self.origin: np.ndarray | None = None  # world cell index of grid[0, 0]
         self._cones: _ConeTable | None = None
+        self._fan: BeamFan | None = None
+        self._stamps: np.ndarray | None = None  # per padded cell: the last walk that listed it
+        self._stamp = 0
         empty = np.zeros((self.n, self.n), dtype=bool)
         self._allocate(np.zeros((self.n, self.n), dtype=np.int16), empty, empty, 0)
 
@@ -77,53 +100,37 @@ class LocalMap:
     def update(
         self, position: np.ndarray, yaw: float, bearings: np.ndarray, ranges: np.ndarray, beam: float
     ) -> None:
-        """Fold one scan of the sonar ring (ranges in m from the robot's centre) into the grid."""
+        """Fold one scan into the grid: `ranges` (m from the robot's centre, NaN: no echo) along
+        `bearings` (rad, robot frame; any order, duplicates allowed), each beam `beam` wide (rad)."""
         origin = self._follow(position)
+        fan = self._fan_of(bearings, beam)
+        ranges = fan.readings(ranges)  # one per direction
         echoes = ranges == ranges  # not NaN
         silent = self.silent_free_m if not echoes.all() else 0.0
-        looked = np.flatnonzero(echoes) if silent <= 0 else np.arange(len(ranges))
+        looked = np.flatnonzero(echoes) if silent <= 0 else np.arange(fan.count)
         if not len(looked):
             return
         px, py = float(position[0]), float(position[1])
         cell = self.cell_m
-        reach = np.where(echoes, ranges, silent)[looked]  # a silent sonar: its cone to `silent`
-        cones = self._cones
-        bands = float(reach.max()) / cell + 3.0  # the arc's last band, and a margin
-        if cones is None or cones.half_beam != beam / 2 or bands > cones.radius:
-            radius = TABLE_RADIUS_STEP * math.ceil(bands / TABLE_RADIUS_STEP)  # few distinct tables
-            if radius > self._pad + self.n // 4:
-                self._allocate(
-                    self._grid.copy(), self._seen.copy(), self._swept.copy(), radius - self.n // 4 + 1
-                )
-            cones = self._cones = _cone_table(cell, beam / 2, radius, self._stride)
-        robot = (math.floor(px / cell) - origin[0] + self._pad) * self._stride
-        robot += math.floor(py / cell) - origin[1] + self._pad
-        offsets, cone_only = cones.near(yaw + bearings[looked], reach)
-        cand = offsets + robot
-        # Before its arc, a cone only empties marked cells, and shows unseen ones free: an
-        # unmarked cell already seen stays as it is.
-        changes = self._marked[cand] if not self.track_seen else self._marked[cand] | ~self._seen_flat[cand]
-        cand = cand[~cone_only | changes]
+        reach = np.where(echoes, ranges, silent)[looked]  # a silent beam: its cone to `silent`
+        farthest = float(reach.max())
+        # An arc at most a cell wide (range x beam <= cell) places its echo as precisely as the
+        # grid can hold it, at any range.
+        marks = ranges <= max(self.hit_range_m, cell / beam if beam > 0 else math.inf)
+        if fan.count <= TABLE_MAX_BEAMS and farthest / cell + 3.0 <= TABLE_MAX_RADIUS:
+            cand = self._table_cells(fan, yaw, px, py, origin, looked, reach, farthest)
+        else:
+            cand = self._walked_cells(fan, yaw, px, py, origin, looked, ranges, marks, silent)
         rel_x = self._centre_x[cand] - px
         rel_y = self._centre_y[cand] - py
         distance = np.hypot(rel_x, rel_y)
-        axis = yaw + bearings[0]
-        bearing = np.arctan2(rel_y, rel_x) - axis
-        spacing = 2 * math.pi / len(bearings)
-        sonar = np.rint(bearing / spacing).astype(int)  # the nearest sonar (halves to even, as np.round)
-        sonar %= len(bearings)
-        offset = bearing - sonar * spacing + math.pi  # wrapped below: the angle from its axis
-        if abs(axis) <= math.pi:  # offset in (-2 pi, 4 pi): the modulo is one conditional turn
-            turn = 2 * math.pi
-            offset = np.where(offset < 0.0, offset + turn, np.where(offset >= turn, offset - turn, offset))
-            offset -= math.pi
-        else:
-            offset = offset % (2 * math.pi) - math.pi
+        axis = yaw + fan.directions[0]
+        nearest, offset = fan.nearest(np.arctan2(rel_y, rel_x) - axis, axis)
         in_beam = np.abs(offset) <= beam / 2
-        reading = np.where(echoes, ranges, -1.0)[sonar]  # -1: no echo
+        reading = np.where(echoes, ranges, -1.0)[nearest]  # -1: no echo
         reading = np.where(in_beam, reading, -1.0)  # -1: not in a cone with an echo
         shown_free = distance < reading - cell
-        delta = self.hit * ((np.abs(distance - reading) <= 0.75 * cell) & (reading <= self.hit_range_m))
+        delta = self.hit * ((np.abs(distance - reading) <= ARC_HALF_WIDTH * cell) & marks[nearest])
         delta -= self.miss * shown_free
         flat = self._padded.reshape(-1)
         value = np.minimum(np.maximum(flat[cand] + delta, 0), self.max_certainty)  # a cheaper np.clip
@@ -131,8 +138,93 @@ class LocalMap:
         self._marked[cand] = value > 0
         if self.track_seen:
             if silent > 0:
-                shown_free |= in_beam & ~echoes[sonar] & (distance < silent)
+                shown_free |= in_beam & ~echoes[nearest] & (distance < silent)
             self._seen_flat[cand[shown_free]] = True
+
+    def _fan_of(self, bearings: np.ndarray, beam: float) -> BeamFan:
+        """The scan's directions (kept while the bearings and the beam stay the same)."""
+        fan = self._fan
+        if (
+            fan is None
+            or fan.beam != beam
+            or fan.bearings.shape != np.shape(bearings)
+            or not (fan.bearings == bearings).all()
+        ):
+            fan = self._fan = BeamFan(bearings, beam)
+        return fan
+
+    def _table_cells(
+        self,
+        fan: BeamFan,
+        yaw: float,
+        px: float,
+        py: float,
+        origin: np.ndarray,
+        looked: np.ndarray,
+        reach: np.ndarray,
+        farthest: float,
+    ) -> np.ndarray:
+        """Flat indices of the cells the scan may change, from the cone table (some repeated)."""
+        cell = self.cell_m
+        cones = self._cones
+        half_beam = fan.beam / 2
+        bands = farthest / cell + 3.0  # the arc's last band, and a margin
+        if cones is None or cones.half_beam != half_beam or bands > cones.radius:
+            radius = TABLE_RADIUS_STEP * math.ceil(bands / TABLE_RADIUS_STEP)  # few distinct tables
+            if radius > self._pad + self.n // 4:
+                self._allocate(
+                    self._grid.copy(), self._seen.copy(), self._swept.copy(), radius - self.n // 4 + 1
+                )
+            cones = self._cones = _cone_table(cell, half_beam, radius, self._stride)
+        robot = (math.floor(px / cell) - origin[0] + self._pad) * self._stride
+        robot += math.floor(py / cell) - origin[1] + self._pad
+        offsets, cone_only = cones.near(yaw + fan.directions[looked], reach)
+        cand = offsets + robot
+        # Before its arc, a cone only empties marked cells, and shows unseen ones free: an
+        # unmarked cell already seen stays as it is.
+        changes = self._marked[cand] if not self.track_seen else self._marked[cand] | ~self._seen_flat[cand]
+        return cand[~cone_only | changes]
+
+    def _walked_cells(
+        self,
+        fan: BeamFan,
+        yaw: float,
+        px: float,
+        py: float,
+        origin: np.ndarray,
+        looked: np.ndarray,
+        ranges: np.ndarray,
+        marks: np.ndarray,
+        silent: float,
+    ) -> np.ndarray:
+        """Flat indices of the cells the scan may change, from a walk through each cone."""
+        from vplane_mj.planning.cone_walk import cone_cells  # numba: only scans that need it pay
+
+        axes = yaw + fan.directions[looked]
+        if self._stamps is None or self._stamp >= np.iinfo(np.int32).max:
+            self._stamps = np.zeros(self._stride * self._stride, dtype=np.int32)
+            self._stamp = 0
+        self._stamp += 1
+        out = np.empty(self.n * self.n, dtype=np.int64)
+        count = cone_cells(
+            np.array((px, py)),
+            np.asarray(origin, dtype=np.int64),
+            np.array((self.n, self._pad, self._stride), dtype=np.int64),
+            self.cell_m,
+            ARC_HALF_WIDTH * self.cell_m,
+            axes - fan.half_before[looked],
+            axes + fan.half_after[looked],
+            ranges[looked],
+            marks[looked],
+            silent,
+            self._padded.reshape(-1),
+            self._seen_flat,
+            self.track_seen,
+            self._stamps,
+            self._stamp,
+            out,
+        )
+        return out[:count]
 
     def sweep(self, position: np.ndarray, radius_m: float) -> None:
         """Mark swept (and seen) the cells whose centre lies within `radius_m` of a point (m):
@@ -249,6 +341,7 @@ class LocalMap:
         self._seen = padded_seen[middle]
         self._seen[...] = seen
         self._swept = swept.copy()
+        self._stamps = None
         self._anchor()
 
     def _anchor(self) -> None:
@@ -310,9 +403,16 @@ class ClearanceField:
 
 
 DIRECTIONS = 256
-"""Bins of sonar axis direction in the cone table."""
+"""Bins of beam axis direction in the cone table."""
 TABLE_RADIUS_STEP = 16
 """The cone table reaches a multiple of this many cells, so that few tables are ever built."""
+TABLE_MAX_BEAMS = 64
+"""A scan of more beam directions than this walks its cones instead of using the cone table."""
+TABLE_MAX_RADIUS = 128
+"""A scan that reaches farther than this many cells (its longest reach plus a 3-cell margin)
+walks its cones: the cone table, and the margin around the grid that it needs, stay this size."""
+ARC_HALF_WIDTH = 0.75
+"""An echo's arc holds the cells within this many cells of its range (along the beam)."""
 
 
 @functools.lru_cache(maxsize=16)
@@ -321,7 +421,7 @@ def _cone_table(cell_m: float, half_beam: float, radius: int, stride: int) -> _C
 
 
 class _ConeTable:
-    """The grid cells an echo can change, by direction of the sonar's axis and range band.
+    """The grid cells an echo can change, by direction of the beam's axis and range band.
 
     For each of DIRECTIONS bins of axis direction: the grid offsets (in cells, from the
     robot's cell) within `radius` whose bearing lies within the beam of an axis in the bin,
@@ -359,8 +459,8 @@ class _ConeTable:
         keys = direction * (2.0 * radius + 8.0) + length[member]  # ascending
         base = np.arange(DIRECTIONS)[:, None] * (2.0 * radius + 8.0)
         bands = np.arange(radius + 1.0)[None, :]
-        self.arc_first = np.searchsorted(keys, base + bands - 0.75 - slack, "left")
-        self.arc_stop = np.searchsorted(keys, base + bands + 1.75 + slack, "right")
+        self.arc_first = np.searchsorted(keys, base + bands - ARC_HALF_WIDTH - slack, "left")
+        self.arc_stop = np.searchsorted(keys, base + bands + 1.0 + ARC_HALF_WIDTH + slack, "right")
         self._bin = DIRECTIONS / (2 * math.pi)
         self._runs: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
 

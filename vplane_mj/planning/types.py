@@ -11,11 +11,15 @@ from vplane_mj.planning.events import Event
 
 @dataclass(frozen=True)
 class Observation:
-    """The planner's whole view of the world: its pose, its goal and its sonar ring.
+    """The planner's whole view of the world: its pose, its goal and its range scan.
 
     `ranges` (m) are measured from the robot's centre along `bearings` (rad, robot
-    frame, counter-clockwise from the heading, evenly spaced); NaN means no echo.
-    `beam_width` (rad) is each sonar's beam: an echo lies somewhere within it.
+    frame, counter-clockwise from the heading); NaN means no echo. The bearings are any
+    sensor's: an evenly spaced sonar ring, uneven sonar arrays (several beams may share a
+    bearing), or a laser's scan over its field of view, in any order. `beam_width` (rad) is
+    each beam's width, the same for all: an echo lies somewhere within it (a laser's is its
+    angle step). `velocity` is the robot's speed along its heading (m/s, negative when
+    reversing) and turn rate (rad/s), as its wheel encoders measure them.
     """
 
     time_s: float
@@ -26,9 +30,10 @@ class Observation:
     bearings: np.ndarray
     ranges: np.ndarray
     beam_width: float
+    velocity: tuple[float, float] = (0.0, 0.0)
 
     def echo_points(self) -> np.ndarray:
-        """World-frame points (N, 2) of the sonar echoes; no-echo readings are dropped.
+        """World-frame points (N, 2) of the echoes, each on its beam's axis; no-echo readings are dropped.
 
         Computed once per observation and shared by every caller, so it is read-only.
         """
@@ -60,6 +65,9 @@ class Decision:
     `local_minimum` and `escape_completed` mark a detection and a finished escape;
     `objective` is the virtual new objective while one exists (world frame, m) and
     `planes` the virtual planes in force, each as its two end points.
+    `command`, when given, is the body speed (m/s, negative to reverse) and turn rate (rad/s)
+    to drive, within the robot's limits, instead of what the heading controller makes of the
+    force (which is then only shown): for a planner that plans in velocities, or must back off.
     """
 
     force: np.ndarray
@@ -71,3 +79,4 @@ class Decision:
     gave_up: bool = False
     objective: np.ndarray | None = None
     planes: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
+    command: tuple[float, float] | None = None

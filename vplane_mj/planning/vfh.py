@@ -1,13 +1,16 @@
 """VFH+ steering toward the goal (`vfh`), after Borenstein and Koren, and Ulrich and Borenstein.
 
 The sonar certainty grid (localmap.py) gives a polar histogram with obstacle cells
-enlarged by the robot radius plus a clearance (histogram.py); the free valleys are the
-directions the robot fits through; cells beyond the goal do not count. Candidates are the
+enlarged by the robot's half width (its radius when round) plus a clearance (histogram.py):
+the free valleys are the directions the robot fits through, driving along them aligned;
+cells beyond the goal do not count. Candidates are the
 goal direction when it lies in a valley, the middle of narrow valleys and, in wide
 valleys, the directions half a wide valley in from each border. The cost
 5 |c - goal| + 2 |c - heading| + 2 |c - previous| picks one (VFH+'s weights). The force
 is a unit vector that way, shortened within 1 m of the goal. With no valley the robot
 stops; the local-minimum detector then makes it give up after `patience_s` (`stuck`).
+The governor (motion.py) then fits the force to the robot's body: no turn in place into an
+obstacle, and no faster than the robot can brake within the room ahead.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ import numpy as np
 from vplane_mj.planning import histogram
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.body import RobotBody
-from vplane_mj.planning.groups import MinimumParams, SonarMapParams
+from vplane_mj.planning.groups import MinimumParams, MotionParams, SonarMapParams
 from vplane_mj.planning.minima import report_trap
 from vplane_mj.planning.params import param
 from vplane_mj.planning.types import Decision, Observation
@@ -31,10 +34,11 @@ GOAL_WEIGHT, HEADING_WEIGHT, PREVIOUS_WEIGHT = 5.0, 2.0, 2.0
 
 
 @dataclass(frozen=True)
-class VfhParams(SonarMapParams, MinimumParams):
-    """The detector's and the patience's parameters, the sonar map's and VFH+'s own."""
+class VfhParams(MotionParams, SonarMapParams, MinimumParams):
+    """The detector's and the patience's parameters, the sonar map's, the governor's and VFH+'s
+    own."""
 
-    clearance_m: float = param(0.1, "m", "clearance added to the robot radius (enlargement)", ge=0)
+    clearance_m: float = param(0.1, "m", "clearance added to the robot's half width (enlargement)", ge=0)
     wide_valley_deg: float = param(80.0, "deg", "valleys at least this wide are wide (s_max)", gt=0)
 
 
@@ -60,11 +64,12 @@ class VfhPlanner(Planner):
         self.map = params.local_map()
         self.n_sectors = params.sector_count()
         self.previous: float | None = None
+        self.governor = params.governor(self.robot)
 
     def step(self, obs: Observation) -> Decision:
         p = self.params
         self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
-        enlarge = self.radius + p.clearance_m
+        enlarge = self.robot.half_width_m + p.clearance_m
         window = min(p.window_m, obs.distance_to_goal() + enlarge)  # nothing beyond the goal blocks it
         cells, certainty = self.map.cells(p.map_threshold, obs.position, window)
         h = histogram.polar_histogram(obs.position, cells, certainty, self.n_sectors, window, enlarge)
@@ -77,10 +82,18 @@ class VfhPlanner(Planner):
         else:
             self.previous = direction
             scale = min(1.0, obs.distance_to_goal())
-            decision.force = scale * np.array([math.cos(direction), math.sin(direction)])
+            force = scale * np.array([math.cos(direction), math.sin(direction)])
+            decision.force = self._governed(force, obs)
         decision.components = {"steering": decision.force}
         report_trap(self.detector, obs, decision, p.patience_s)
         return decision
+
+    def _governed(self, force: np.ndarray, obs: Observation) -> np.ndarray:
+        """The force fitted to the robot's body among the echoes and the mapped cells near it."""
+        if self.governor.idle:
+            return force
+        cells, _ = self.map.cells(self.params.map_threshold, obs.position, self.governor.reach_m)
+        return self.governor.govern(force, obs.position, obs.yaw, np.vstack((obs.echo_points(), cells)))
 
     def _choose(self, valleys: list[histogram.Valley], goal: float, heading: float) -> float | None:
         """The VFH+ candidate direction of least cost, or None when every sector is blocked."""

@@ -4,7 +4,7 @@ On each local-minimum detection a virtual obstacle (a FIRAS repulsive point, eqs
 placed at the robot's position and pushes it out of the minimum. A virtual obstacle is
 cleared after `vobs_lifetime_s`; the robot may then fall back into the same minimum, the
 weakness the virtual-plane method addresses. After `max_virtual` obstacles the planner
-gives up (outcome `stuck`).
+gives up (outcome `stuck`). The governor (motion.py) fits the force to the robot's body.
 """
 
 from __future__ import annotations
@@ -17,14 +17,14 @@ from vplane_mj.planning import fields
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
-from vplane_mj.planning.groups import DetectorParams, FieldParams
+from vplane_mj.planning.groups import DetectorParams, FieldParams, MotionParams
 from vplane_mj.planning.params import param
 from vplane_mj.planning.types import Decision, Observation
 
 
 @dataclass(frozen=True)
-class VobsParams(DetectorParams, FieldParams):
-    """The fields' and the detector's parameters, and the virtual obstacles'."""
+class VobsParams(MotionParams, DetectorParams, FieldParams):
+    """The fields', the detector's and the governor's parameters, and the virtual obstacles'."""
 
     vobs_gain: float = param(0.3, "m", "eta of eq. 5 for a virtual obstacle", gt=0)
     vobs_influence_m: float = param(1.5, "m", "f0 of eq. 5 for a virtual obstacle", gt=0)
@@ -47,6 +47,7 @@ class VobsPlanner(Planner):
     def __init__(self, params: VobsParams, robot: RobotBody | float):
         super().__init__(params, robot)
         self.detector = params.detector()
+        self.governor = params.governor(self.robot)
         self.virtual: list[tuple[float, np.ndarray]] = []  # (time placed, position)
         self.placed = 0
 
@@ -84,6 +85,8 @@ class VobsPlanner(Planner):
         points = np.array([position for _, position in self.virtual]).reshape(-1, 2)
         components["virtual"] = fields.repulsive_force(obs.position, points, p.vobs_gain, p.vobs_influence_m)
         decision.force = sum(components.values(), np.zeros(2))
+        if not self.governor.idle:
+            decision.force = self.governor.govern(decision.force, obs.position, obs.yaw, obs.echo_points())
         decision.mode = "escaping" if len(self.virtual) else "normal"
         decision.planes = []
         return decision

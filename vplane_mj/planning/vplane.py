@@ -33,7 +33,7 @@ from vplane_mj.planning import fields, histogram
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
-from vplane_mj.planning.groups import DetectorParams, FieldParams, SonarMapParams
+from vplane_mj.planning.groups import DetectorParams, FieldParams, MotionParams, SonarMapParams
 from vplane_mj.planning.localmap import angular_extremes
 from vplane_mj.planning.params import param
 from vplane_mj.planning.types import Decision, Observation
@@ -48,8 +48,9 @@ EDGE_OFFSETS_M = (0.05, 0.3, 0.6)
 
 
 @dataclass(frozen=True)
-class VPlaneParams(SonarMapParams, DetectorParams, FieldParams):
-    """The fields', the detector's and the sonar map's parameters, and the escape's."""
+class VPlaneParams(MotionParams, SonarMapParams, DetectorParams, FieldParams):
+    """The fields', the detector's, the sonar map's and the governor's parameters, and the
+    escape's."""
 
     echo_memory: int = param(100, "", "sonar scans kept for the extreme points e1, e2", ge=1, integer=True)
     clearance_m: float = param(
@@ -123,6 +124,7 @@ class VPlanePlanner(Planner):
         self.avoid_waypoint: np.ndarray | None = None
         self.next_concavity_check_s = 0.0
         self.echoes: deque[np.ndarray] = deque(maxlen=max(1, round(p.echo_memory)))
+        self.governor = p.governor(self.robot)
 
     # -- the loop -------------------------------------------------------------------------
     def step(self, obs: Observation) -> Decision:
@@ -163,10 +165,18 @@ class VPlanePlanner(Planner):
                 )
         components["virtual"] = self._planes_force(obs.position)
         decision.components = components
-        decision.force = sum(components.values(), np.zeros(2))
+        decision.force = self._governed(sum(components.values(), np.zeros(2)), obs)
         decision.objective = self.temp_goal
         decision.planes = [(plane.e1, plane.e2) for plane in self.planes]
         return decision
+
+    def _governed(self, force: np.ndarray, obs: Observation) -> np.ndarray:
+        """The force fitted to the robot's body (motion.py) among the echoes and the mapped
+        cells around it, which remember what the sensor sees between its beams or behind."""
+        if self.governor.idle:
+            return force
+        cells, _ = self.map.cells(self.params.map_threshold, obs.position, self.governor.reach_m)
+        return self.governor.govern(force, obs.position, obs.yaw, np.vstack((obs.echo_points(), cells)))
 
     # -- Algorithm 2: escaping ---------------------------------------------------------------
     def _start_escape(self, obs: Observation, decision: Decision) -> bool:
@@ -186,6 +196,7 @@ class VPlanePlanner(Planner):
         i1, i2, _ = angular_extremes(obs.position, trap)
         e1, e2 = trap[i1], trap[i2]
         plane = make_plane(e1, e2, trap, obs.position, obs.goal, extend=self._link_m())
+        # The robot stands and turns at the objective: its circumscribed radius.
         clearance = self.radius + self.params.escape_margin_m
         self.temp_goal = virtual_objective(obs.position, e1, e2, obs.goal, plane, clearance)
         self.pending_plane = plane
@@ -229,8 +240,9 @@ class VPlanePlanner(Planner):
         return trap if len(trap) >= 2 else cells[labels == trap_label]
 
     def _link_m(self) -> float:
-        """Obstacle cells closer than this leave no gap for the robot: one cluster."""
-        return 2 * self.radius + self.params.clearance_m
+        """Obstacle cells closer than this leave no gap for the robot: one cluster. The robot
+        passes a gap aligned with it, so its width counts (the diameter of a round robot)."""
+        return 2 * self.robot.half_width_m + self.params.clearance_m
 
     # -- the virtual planes -------------------------------------------------------------------
     def _planes_force(self, position: np.ndarray) -> np.ndarray:
@@ -272,8 +284,15 @@ class VPlanePlanner(Planner):
         if len(cells) == 0 and not self.map.any_cells(p.map_threshold):
             self.avoid_waypoint = None
             return
+        # A valley is a direction the robot drives along, aligned with it: cells enlarged by
+        # its half width (VFH+'s robot radius for a round robot).
         h = histogram.polar_histogram(
-            obs.position, cells, certainty, self.n_sectors, p.window_m, self.radius + p.clearance_m
+            obs.position,
+            cells,
+            certainty,
+            self.n_sectors,
+            p.window_m,
+            self.robot.half_width_m + p.clearance_m,
         )
         blocked = h > p.histogram_threshold
         goal_free = not blocked[histogram.sector_of(goal_bearing, self.n_sectors)]
@@ -328,7 +347,7 @@ class VPlanePlanner(Planner):
         forward = rel @ heading
         lateral = np.abs(rel @ np.array([-heading[1], heading[0]]))
         reach = min(p.lookahead_m, obs.distance_to_goal())
-        ahead = (forward > 0) & (forward < reach) & (lateral < self.radius + p.clearance_m)
+        ahead = (forward > 0) & (forward < reach) & (lateral < self.robot.half_width_m + p.clearance_m)
         if not ahead.any():
             return None
         nearest = np.flatnonzero(ahead)[np.argmin(forward[ahead])]
@@ -361,8 +380,11 @@ class VPlanePlanner(Planner):
         return None
 
     def _reachable(self, start: np.ndarray, end: np.ndarray, cells: np.ndarray) -> bool:
-        """No known obstacle cell within the robot's radius plus clearance of the segment."""
+        """No known obstacle cell within the robot's half width plus clearance of the segment
+        (the robot drives along it, aligned with it)."""
         span = end - start
         t = np.clip((cells - start) @ span / max(float(span @ span), 1e-12), 0.0, 1.0)
         nearest = start + t[:, None] * span
-        return bool(np.min(np.hypot(*(cells - nearest).T)) > self.radius + self.params.clearance_m)
+        return bool(
+            np.min(np.hypot(*(cells - nearest).T)) > self.robot.half_width_m + self.params.clearance_m
+        )

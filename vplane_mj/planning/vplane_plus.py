@@ -5,7 +5,8 @@ histogram avoidance of concave obstacles (Algorithm 1, `avoiding`), and on a loc
 virtual new objective on the bisector of the trap's extreme points (Algorithm 2, `escaping`)
 followed by a virtual plane e1-e2 that keeps the robot out of the trap. What the paper leaves
 open is decided with what the sonar map remembers (`gridsearch`: the map's obstacle cells
-inflated by the robot's disc, the unknown counted as free):
+inflated by the robot's half width, as a robot drives along a way aligned with it, the
+unknown counted as free):
 
 - the trap is one obstacle: the connected obstacle cells nearest toward the goal, where cells
   separated by a gap the robot fits through belong to different obstacles; e1 and e2 are its
@@ -18,7 +19,11 @@ inflated by the robot's disc, the unknown counted as free):
 - after `fallback_after` escapes, the robot follows the map's shortest way to the goal
   (`following`), replanned as the map grows: with a map that remembers, this finds the goal
   whenever the sonar can show a way (a complete fallback); the planner gives up only when the
-  map holds no way to the goal at all for `no_way_patience_s`.
+  map holds no way to the goal at all for `no_way_patience_s`. A dense scan (a laser: scan.py)
+  maps the obstacles it sees as they are from the first scan, so with one the robot follows
+  the map's way from the start;
+- the governor (motion.py) fits the force to the robot's body: no turn in place into an
+  obstacle, and no faster than the robot can brake within the room ahead.
 
 Every decision is an event (`/events`), and objectives and planes appear in `/virtual`.
 """
@@ -31,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from vplane_mj.planning import fields, gridsearch
+from vplane_mj.planning import fields, gridsearch, scan
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.localmap import LocalMap, angular_extremes
@@ -55,6 +60,8 @@ SILENT_FREE_M = 1.0
 """A sonar that hears no echo shows its first metre free, for the choice of objectives only."""
 OBJECTIVE_ROOM_M = 0.05
 """A virtual objective lies at least this much beyond the robot's disc from every mapped obstacle."""
+BEND_HORIZON_M = 3.0
+"""The way this far ahead (m) bounds the speed by the turns it asks for (motion.py)."""
 TRAP_REACH_M = 2.5
 """Obstacle cells farther than this from the robot are not part of the trap it is in."""
 
@@ -79,14 +86,14 @@ class VPlanePlusParams(VPlaneParams):
         2, "", "certainty a reading removes from the cells it shows free", ge=0, le=15, integer=True
     )
     path_clearance_m: float = param(
-        0.01, "m", "the map's ways never pass closer than the robot radius plus this", ge=0, le=1.0
+        0.01, "m", "the map's ways never pass closer than the robot's half width plus this", ge=0, le=1.0
     )
     inflation_m: float = param(0.3, "m", "beyond that, the map's ways pay for passing closer than this", gt=0)
     inflation_weight: float = param(
         4.0, "", "extra step cost right at the clearance (costmap inflation)", ge=0
     )
     map_hit_range_m: float = param(
-        1.5, "m", "echoes farther than this only clear the map (arcs too wide)", gt=0
+        1.5, "m", "echoes farther than this only clear the map, unless their arc is a cell wide at most", gt=0
     )
     map_sure: int = param(
         10, "", "certainty at which an obstacle cell is sure (lower: doubtful)", ge=1, integer=True
@@ -132,7 +139,8 @@ class VPlanePlusPlanner(VPlanePlanner):
             p.map_size_m,
             hit=round(p.map_hit),
             miss=round(p.map_miss),
-            hit_range_m=p.map_hit_range_m,
+            # A laser's beams are narrow: its echoes place obstacles as far as it reaches.
+            hit_range_m=p.map_hit_range_m if self.robot.sensor_kind != "laser" else math.inf,
             track_seen=True,
             silent_free_m=SILENT_FREE_M,
         )
@@ -150,8 +158,10 @@ class VPlanePlusPlanner(VPlanePlanner):
         p = self.params
         if self._moved_since_last_scan(obs):
             self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
-            self.map.sweep(obs.position, self.radius)
+            self.map.sweep(obs.position, self.robot.inner_radius_m)  # under the robot at any heading
         decision = Decision(force=np.zeros(2), mode="normal")
+        if not self.following and self.last_scan_pose is not None and scan.is_dense(obs):
+            self._start_following(obs, decision, "a dense scan maps the way from the start")
         self._retire_planes(obs, decision)
 
         near_goal = obs.distance_to_goal() <= obs.goal_tolerance
@@ -212,7 +222,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         components["virtual"] = np.zeros(2) if self.following else self._planes_force(obs.position)
         components["map"] = self._nearest_cell_force(obs.position)
         decision.components = components
-        decision.force = sum(components.values(), np.zeros(2))
+        decision.force = self._governed(sum(components.values(), np.zeros(2)), obs)
         decision.objective = self.temp_goal
         decision.planes = [(plane.e1, plane.e2) for plane in self.planes]
         return decision
@@ -260,6 +270,23 @@ class VPlanePlusPlanner(VPlanePlanner):
         near = fade * fields.repulsive_force(obs.position, echoes[close], gain, influence)
         components["repulsive"] = near + farther - min(float(farther @ heading), 0.0) * heading
 
+    def _governed(self, force: np.ndarray, obs: Observation) -> np.ndarray:
+        """The force fitted to the robot's body (motion.py) among the echoes and the mapped
+        cells around it (not swept), which remember what the sensor sees between its beams or
+        behind; on a way, no faster than lets the robot turn along the way's next
+        `BEND_HORIZON_M`."""
+        if self.governor.idle:
+            return force
+        cells = self._mapped_cells_near(obs.position, self.governor.reach_m)
+        way = self.escape_way if self.temp_goal is not None else self.follow_way if self.following else []
+        speed = math.inf
+        if way:
+            ahead = np.array(way)
+            travelled = np.cumsum(np.hypot(*np.diff(np.vstack((obs.position, ahead)), axis=0).T))
+            speed = self.governor.policy.bend_speed(obs.position, obs.yaw, ahead[travelled <= BEND_HORIZON_M])
+        points = np.vstack((obs.echo_points(), cells))
+        return self.governor.govern(force, obs.position, obs.yaw, points, speed)
+
     def _mapped_cells_near(self, position: np.ndarray, reach_m: float) -> np.ndarray:
         """Centres (N, 2) of the mapped obstacle cells (not swept) within a square of half side
         `reach_m` around a point (m)."""
@@ -274,8 +301,9 @@ class VPlanePlusPlanner(VPlanePlanner):
         return (np.column_stack((i, j)) + lo + self.map.origin + 0.5) * cell
 
     def _way_is_blocked(self, position: np.ndarray, way: list[np.ndarray]) -> bool:
-        """Whether a mapped obstacle cell now lies within the robot's radius of the way's next
-        `BLOCK_LOOKAHEAD_M` (the sonar has seen something new on it)."""
+        """Whether a mapped obstacle cell now lies within the robot's half width of the way's next
+        `BLOCK_LOOKAHEAD_M` (the sonar has seen something new on it): the robot drives along the
+        way aligned with it."""
         ahead = [point for point in way if np.hypot(*(point - position)) <= BLOCK_LOOKAHEAD_M]
         if not ahead:
             return False
@@ -284,7 +312,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             return False
         points = np.array(ahead)
         gaps = np.hypot(*(cells[:, None, :] - points[None, :, :]).transpose(2, 0, 1))
-        return bool(gaps.min() < self.radius)
+        return bool(gaps.min() < self.robot.half_width_m)
 
     def _nearest_cell_force(self, position: np.ndarray) -> np.ndarray:
         """FIRAS repulsion (eq. 5) of the nearest mapped obstacle cell within `guard_m`: the map
@@ -317,7 +345,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         mouth = make_plane(
             e1, e2, cells, obs.position, obs.goal, extend=self._link_m() / 2, to_outermost=False
         )
-        clearance = self.radius + self.params.escape_margin_m
+        clearance = self.radius + self.params.escape_margin_m  # it stands and turns there
         window = self._window(obs.position, obs.goal, self.planes, margin=self.params.search_margin_m)
         plane: VirtualPlane | None = None
         if self._spans_a_gap(mouth, others):
@@ -431,7 +459,8 @@ class VPlanePlusPlanner(VPlanePlanner):
         origin = np.array([np.ravel_multi_index(start, window.cost.shape)])
         costs = gridsearch.cost_to_go(window.cost, origin, np.zeros(1), window.cell_m)
         # Known free with room around it: far enough from mapped obstacles and from every cell
-        # the sonar has not seen free (an obstacle the map has not placed may stand there).
+        # the sonar has not seen free (an obstacle the map has not placed may stand there). The
+        # robot turns there: room for its circumscribed radius.
         room = self.radius + OBJECTIVE_ROOM_M
         roomy = gridsearch.clear_step_cost(
             OBJECTIVE_ROOM_M, self.params.inflation_m, self.params.inflation_weight
@@ -561,7 +590,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             certainty >= p.map_sure,
             (certainty >= p.map_threshold) & (certainty < p.map_sure),
             cell,
-            self.radius + p.path_clearance_m,
+            self._lethal_m(),
             p.inflation_m,
             p.inflation_weight,
             p.doubt_cost,
@@ -575,6 +604,13 @@ class VPlanePlusPlanner(VPlanePlanner):
         for plane in planes:  # but no way crosses a virtual plane, even under the robot
             window.block_segment(plane.e1, plane.e2)
         return window
+
+    def _lethal_m(self) -> float:
+        """How close (m) the map's ways come to an obstacle cell's centre: ways are driven along,
+        aligned, so the robot's half width plus `path_clearance_m`; for a robot that is not round,
+        plus the governor's turn margin, which it keeps when it turns toward the way."""
+        lethal = self.robot.half_width_m + self.params.path_clearance_m
+        return lethal if self.robot.disc else lethal + self.params.turn_margin_m
 
     def _way(self, window: gridsearch.Window, start: np.ndarray, end: np.ndarray) -> list[np.ndarray] | None:
         """Waypoints (m) of the map's shortest way from `start` to `end` (beyond the window:

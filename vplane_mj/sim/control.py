@@ -32,6 +32,18 @@ def heading_command(fx: float, fy: float, yaw: float, gains: ControllerGains) ->
     return speed, turn
 
 
+def within_limits(command: tuple[float, float], gains: ControllerGains) -> tuple[float, float]:
+    """A body speed (m/s, either way) and turn rate (rad/s) clamped to the robot's top ones; a
+    non-finite value stops the robot."""
+    speed, turn = command
+    if not (math.isfinite(speed) and math.isfinite(turn)):
+        return 0.0, 0.0
+    return (
+        max(-gains.max_speed, min(gains.max_speed, float(speed))),
+        max(-gains.max_turn_rate, min(gains.max_turn_rate, float(turn))),
+    )
+
+
 def wheel_targets(
     speed: float, turn: float, track: float, wheel_radius: float, max_wheel_speed: float
 ) -> tuple[float, float]:

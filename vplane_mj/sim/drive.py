@@ -84,6 +84,13 @@ class Drive:
         forward = qvel[self.root_dof] * math.cos(yaw) + qvel[self.root_dof + 1] * math.sin(yaw)
         return float(forward), float(qvel[self.root_dof + 5])
 
+    def wheel_velocity(self) -> tuple[float, float]:
+        """The speed along the heading (m/s) and the turn rate (rad/s) that the wheels' speeds
+        give, as encoders measure them (the track is the effective one of a skid-steer robot)."""
+        radius = self.geometry["wheel_radius_m"]
+        left, right = (float(self.data.qvel[dof]) for dof in self.wheel_dofs)
+        return radius * (left + right) / 2, radius * (right - left) / self.track_m
+
     def wheel_angles(self) -> tuple[float, float]:
         """The wheels' encoder angles (rad), left and right."""
         return float(self.data.qpos[self.wheel_qpos[0]]), float(self.data.qpos[self.wheel_qpos[1]])

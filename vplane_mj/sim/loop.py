@@ -26,19 +26,19 @@ import numpy as np
 from vplane_mj import __version__
 from vplane_mj.errors import VPlaneError
 from vplane_mj.geometry import shapes
-from vplane_mj.interrupts import Interrupted
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario import Scenario
-from vplane_mj.sim.control import heading_command
+from vplane_mj.sim.control import heading_command, within_limits
 from vplane_mj.sim.drive import BELIEF_PATIENCE_S, CollisionCounter, Drive, Localiser
 from vplane_mj.sim.failure import RunFailure, failure_of
 from vplane_mj.sim.metrics import Clearance, motion_quality, path_quality, trajectory_digest, travelled
 from vplane_mj.sim.sensors import range_sensor
 from vplane_mj.sim.summary import Outcome, RunSummary
 from vplane_mj.sim.world import build_model
+from vplane_mj.terminal import Interrupted
 
 EXTERNAL_PLANNER = "external"
 """The summary's planner name of a run whose decisions come from outside the package."""
@@ -127,14 +127,24 @@ class RunResult:
 class Run:
     """One run of a scenario, a control tick at a time (see the module docstring)."""
 
-    def __init__(self, scenario: Scenario, observers: tuple[Observer, ...] = (), external: bool = False):
+    def __init__(
+        self,
+        scenario: Scenario,
+        observers: tuple[Observer, ...] = (),
+        external: bool = False,
+        physics: tuple[mujoco.MjModel, mujoco.MjData] | None = None,
+    ):
         """`external`: the decisions come from outside through `observe` and `apply` (a learned
         policy, say), not from the scenario's planner, which is then not made; the summary
-        names the planner EXTERNAL_PLANNER."""
+        names the planner EXTERNAL_PLANNER. `physics`: the model and data to step, when another
+        owner holds them (dm_control's Physics, say); built from the scenario, without
+        rangefinders (`world.build_model`), and fresh; by default the run builds its own."""
         self.scenario = scenario
         self.observers = observers
-        self.model = build_model(scenario, rangefinders=False)
-        self.data = mujoco.MjData(self.model)
+        if physics is None:
+            physics = build_model(scenario, rangefinders=False), None
+        self.model = physics[0]
+        self.data = physics[1] if physics[1] is not None else mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
         profile = scenario.robot.profile
         self.drive = Drive(self.model, self.data, scenario.run.control_hz, profile)
@@ -250,6 +260,7 @@ class Run:
             self.sensor.bearings,
             self.ranges,
             self.sensor.beam_width,
+            self.drive.wheel_velocity(),
         )
         return self._observation
 
@@ -347,6 +358,8 @@ class Run:
         decision = self._decision
         assert self._belief is not None and decision is not None, "reporting a tick not planned"
         believed_xy, believed_yaw = self._belief
+        if command is None and decision.command is not None:
+            command = within_limits(decision.command, self.drive.gains)
         if command is None:
             command = heading_command(
                 float(decision.force[0]), float(decision.force[1]), believed_yaw, self.drive.gains

@@ -38,6 +38,11 @@ PART_NAMES: dict[type, tuple[str, ...]] = {
 BORDER_SIDES = ("west", "east", "south", "north")
 RENDER_PIXELS = 800
 """Longest side (px) of the offscreen buffer that the top camera renders into."""
+TOP_CAMERA = "top"
+"""The orthographic camera above the arena that frames it whole (the renders' camera)."""
+CHASE_CAMERA = "chase"
+"""The camera that follows the robot (named `robot/chase` in the world)."""
+CHASE_BACK_M, CHASE_UP_M, CHASE_PITCH_DEG = 1.2, 0.9, 35.0
 SONAR_SITE_SIZE_M = 0.004
 SONAR_SITE_RGBA = (0.1, 0.7, 0.2, 0.6)
 
@@ -121,6 +126,7 @@ def build_spec(scenario: Scenario, rangefinders: bool = True) -> mujoco.MjSpec:
         name=ROBOT_PREFIX, pos=[x, y, 0.0], quat=[math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]
     )
     mount.add_freejoint(name=ROBOT_PREFIX)
+    _add_chase_camera(robot)
     arena.attach(robot, prefix=ROBOT_PREFIX, frame=mount.add_frame())
     return arena
 
@@ -134,6 +140,21 @@ def standalone_xml(scenario: Scenario) -> str:
     """One self-contained MJCF document of the world, rangefinders included (assets are
     built-in textures only; numbers at MuJoCo's XML precision of 6 significant digits)."""
     return build_spec(scenario).to_xml()
+
+
+def _add_chase_camera(robot: mujoco.MjSpec) -> None:
+    """A camera that follows the robot from behind and above, looking ahead and down
+    (`robot/chase`): CHASE_BACK_M behind base_link, CHASE_UP_M above it, pitched CHASE_PITCH_DEG
+    below the horizon. A camera looks along its -z, its image's x and y being its own."""
+    pitch = math.radians(CHASE_PITCH_DEG)
+    right = [0.0, -1.0, 0.0]  # the image's x: the robot's right
+    up = [math.sin(pitch), 0.0, math.cos(pitch)]  # the image's y: up, leaning ahead
+    camera = robot.body(BASE_BODY).add_camera(
+        name=CHASE_CAMERA, mode=mujoco.mjtCamLight.mjCAMLIGHT_FIXED, pos=[-CHASE_BACK_M, 0.0, CHASE_UP_M]
+    )
+    camera.fovy = 60.0
+    camera.alt.type = mujoco.mjtOrientation.mjORIENTATION_XYAXES
+    camera.alt.xyaxes = right + up
 
 
 def _size_camera(arena: mujoco.MjSpec, size: tuple[float, float]) -> None:

@@ -13,8 +13,8 @@ own ffmpeg encodes them, so no system package is needed.
 
 from __future__ import annotations
 
+import contextlib
 import math
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,6 +37,7 @@ from vplane_mj.logs.replay import load_log
 from vplane_mj.logs.timeline import FORCE_NAMES, Timeline, timeline_from_log
 from vplane_mj.logs.writer import METADATA_NAME
 from vplane_mj.scenario import Scenario
+from vplane_mj.terminal import Progress
 from vplane_mj.viz.render import MODE_RGBA, OTHER_MODE_RGBA
 
 
@@ -128,7 +129,7 @@ def write_video(log: Path, target: Path, speed: float = 1.0, show_progress: bool
         )
     radius = float(contents.metadata[METADATA_NAME]["robot_radius_m"])
     canvas = FrameCanvas(scenario, timeline, radius, fmt.width_px, speed)
-    progress = Progress(frames + hold, target.name) if show_progress else None
+    progress = Progress(target.name, frames + hold, "frames") if show_progress else None
 
     def encode(temporary: Path) -> None:
         writer = imageio_ffmpeg.write_frames(
@@ -144,13 +145,14 @@ def write_video(log: Path, target: Path, speed: float = 1.0, show_progress: bool
         )
         writer.send(None)
         try:
-            frame = b""
-            for k in range(frames + hold):
-                if k < frames:
-                    frame = canvas.frame(k * speed / fmt.fps)
-                writer.send(frame)
-                if progress:
-                    progress.advance()
+            with progress or contextlib.nullcontext():
+                frame = b""
+                for k in range(frames + hold):
+                    if k < frames:
+                        frame = canvas.frame(k * speed / fmt.fps)
+                    writer.send(frame)
+                    if progress:
+                        progress.advance()
         finally:
             writer.close()  # ffmpeg finishes the file (or is stopped, on an interruption)
 
@@ -158,25 +160,6 @@ def write_video(log: Path, target: Path, speed: float = 1.0, show_progress: bool
         return write_atomically(target, encode)
     finally:
         plt.close(canvas.figure)
-
-
-class Progress:
-    """A progress bar of frames on stderr (a line every 10% when it is not a terminal)."""
-
-    def __init__(self, total: int, name: str):
-        self.total, self.done, self.name = total, 0, name
-        self.tty = sys.stderr.isatty()
-        self._last_decile = -1
-
-    def advance(self) -> None:
-        self.done += 1
-        filled = round(30 * self.done / self.total)
-        line = f"{self.name}: [{'#' * filled}{'.' * (30 - filled)}] {self.done}/{self.total} frames"
-        if self.tty:
-            print(f"\r{line}", end="" if self.done < self.total else "\n", file=sys.stderr, flush=True)
-        elif (decile := 10 * self.done // self.total) != self._last_decile:
-            self._last_decile = decile
-            print(line, file=sys.stderr, flush=True)
 
 
 class FrameCanvas:

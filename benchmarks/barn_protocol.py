@@ -1,0 +1,175 @@
+"""The planners on the BARN challenge's protocol worlds with the Jackal and its laser.
+
+Generates `--count` worlds as `vplane-mj generate barn --protocol` does (seed `--world-seed`;
+4.2 x 14 m, 0.15 m posts, the Jackal, its 270-degree 720-beam laser), writes them to
+`OUT/cases/`, and runs each planner of `--planners` on each world for each seed of `--seeds`,
+with laser noise `--noise` (m, `sensors.noise_std`). The runs go through
+`vplane_mj.bench.sweep.run_sweep`, so `OUT/bench.jsonl` journals them and the same command
+run again only does what is missing.
+
+Prints, per planner, the runs, success rate (reached without a collision), the share of runs
+with a collision, timeouts, stuck runs, the mean BARN score (success x OT / clip(T, 2 OT,
+8 OT), at most 0.5) and the planner's mean CPU time per tick, beside BARN's published figures:
+the DWA baseline of the benchmark paper (Perille et al., 2020: score 0.159, 85% success, 5.6%
+collisions) and the best entries of the BARN challenges (mean scores 0.40 to 0.48). Writes the
+table to `OUT/barn_protocol.csv` and a figure of success and mean score per planner, with the
+published figures as lines, to `OUT/barn_protocol.png`.
+
+    python benchmarks/barn_protocol.py [--count 50] [--seeds 0-2] [--noise 0.01] [--jobs 2]
+    python benchmarks/barn_protocol.py --count 2 --seeds 0 --planners vplane_plus,dwa --out /tmp/barn
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import statistics
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from vplane_mj.bench.sweep import parse_seeds, plan_jobs, run_sweep
+from vplane_mj.errors import VPlaneError
+from vplane_mj.files import prepare_out_dir, write_atomically
+from vplane_mj.planning.registry import PLANNERS
+from vplane_mj.worlds.barn_protocol import generate_protocol
+
+PLANNER_ORDER = ("vplane_plus", "dwa", "vplane", "vfh", "apf", "vobs", "bug2")
+COLUMNS = (
+    "planner",
+    "runs",
+    "success_rate",
+    "collision_rate",
+    "timeouts",
+    "stuck",
+    "mean_score",
+    "planner_cpu_ms_mean",
+)
+PUBLISHED = (
+    {"planner": "BARN: DWA baseline", "success_rate": 0.85, "collision_rate": 0.056, "mean_score": 0.159},
+    {"planner": "BARN: best entries", "mean_score": "0.40-0.48"},
+)
+"""BARN's published figures: the benchmark paper's DWA and the challenges' best mean scores."""
+
+
+def write_cases(out: Path, count: int, seed: int) -> list[str]:
+    """The protocol worlds' scenario files under `out/cases/`, their paths."""
+    cases_dir = out / "cases"
+    cases_dir.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for case in generate_protocol(count, seed):
+        path = cases_dir / f"{case.name}.toml"
+        path.write_text(case.toml(), encoding="utf-8")
+        paths.append(str(path))
+    return paths
+
+
+def planner_table(rows: list[dict]) -> list[dict]:
+    """One row per planner, in the order they first appear."""
+    table = []
+    for planner in dict.fromkeys(row["planner"] for row in rows):
+        mine = [r for r in rows if r["planner"] == planner]
+        cpu = [r["planner_cpu_ms_mean"] for r in mine if r.get("planner_cpu_ms_mean") is not None]
+        table.append(
+            {
+                "planner": planner,
+                "runs": len(mine),
+                "success_rate": sum(bool(r["success"]) for r in mine) / len(mine),
+                "collision_rate": sum((r.get("collisions") or 0) > 0 for r in mine) / len(mine),
+                "timeouts": sum(r["outcome"] == "timeout" for r in mine),
+                "stuck": sum(r["outcome"] == "stuck" for r in mine),
+                "mean_score": statistics.fmean(r.get("score") or 0.0 for r in mine),
+                "planner_cpu_ms_mean": statistics.fmean(cpu) if cpu else None,
+            }
+        )
+    return table
+
+
+def markdown(rows: list[dict]) -> str:
+    """The table and BARN's published figures as Markdown."""
+
+    def cell(key: str, value) -> str:
+        if value is None:
+            return "-"
+        if key.endswith("_rate") and isinstance(value, float):
+            return f"{100 * value:.1f}%"
+        if key == "mean_score" and isinstance(value, float):
+            return f"{value:.3f}"
+        return f"{value:.2f}" if isinstance(value, float) else str(value)
+
+    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+    lines += ["| " + " | ".join(cell(k, row.get(k)) for k in COLUMNS) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def plot(table: list[dict], path: Path) -> None:
+    """Success rate and mean BARN score per planner, with BARN's published figures as lines."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    names = [row["planner"] for row in table]
+    x = np.arange(len(names))
+    figure, (left, right) = plt.subplots(1, 2, figsize=(4 + 1.1 * len(names), 4))
+    left.bar(x, [100 * row["success_rate"] for row in table], color="tab:green")
+    left.axhline(85, color="tab:red", linestyle="--", label="BARN DWA baseline (85%)")
+    left.set_ylabel("success, % of runs")
+    left.set_ylim(0, 100)
+    right.bar(x, [row["mean_score"] for row in table], color="tab:blue")
+    right.axhline(0.159, color="tab:red", linestyle="--", label="BARN DWA baseline (0.159)")
+    right.axhspan(0.40, 0.48, color="tab:orange", alpha=0.3, label="BARN best entries (0.40-0.48)")
+    right.set_ylabel("mean BARN score")
+    right.set_ylim(0, 0.5)
+    for ax in (left, right):
+        ax.set_xticks(x, names, rotation=30, ha="right")
+        ax.legend(fontsize=8, loc="upper right")
+    figure.suptitle(f"BARN protocol worlds, Jackal with laser ({table[0]['runs']} runs per planner)")
+    figure.tight_layout()
+    write_atomically(path, lambda tmp: figure.savefig(tmp, format="png", dpi=100))
+    plt.close(figure)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    default = [name for name in PLANNER_ORDER if name in PLANNERS]
+    parser.add_argument("--planners", default=",".join(default))
+    parser.add_argument("--count", type=int, default=50, help="protocol worlds")
+    parser.add_argument("--world-seed", type=int, default=0, help="seed of the worlds")
+    parser.add_argument("--seeds", default="0-2", help="run seeds, as vplane-mj bench takes them")
+    parser.add_argument("--noise", type=float, default=0.01, help="laser range noise (m)")
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--out", type=Path, default=Path("logs/barn_protocol"))
+    args = parser.parse_args(argv)
+    planners = [p.strip() for p in args.planners.split(",")]
+    unknown = sorted(set(planners) - set(PLANNERS))
+    if unknown or args.count < 1 or args.jobs < 1 or args.noise < 0:
+        print(f"error: bad arguments (unknown planners: {unknown})", file=sys.stderr)
+        return 2
+    try:
+        seeds = parse_seeds(args.seeds)
+        out = prepare_out_dir(args.out)
+    except VPlaneError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    scenarios = write_cases(out, args.count, args.world_seed)
+    overrides = [f"sensors.noise_std={args.noise}"] if args.noise > 0 else []
+    rows = run_sweep(plan_jobs(scenarios, planners, seeds, overrides), out, args.jobs)
+    table = planner_table(rows)
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=COLUMNS)
+    writer.writeheader()
+    writer.writerows(table)
+    write_atomically(
+        out / "barn_protocol.csv", lambda tmp: tmp.write_text(buffer.getvalue(), encoding="utf-8")
+    )
+    plot(table, out / "barn_protocol.png")
+    print(markdown([*table, *PUBLISHED]))
+    print(f"wrote {out / 'barn_protocol.csv'}\nwrote {out / 'barn_protocol.png'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,92 @@
+"""The directions of a scan's beams, and which beam speaks for a point (the local map's rule).
+
+A scan's bearings come in any order, unevenly spaced, over any field of view, and several
+beams may share a bearing (they then act as one, with the shortest of their echoes). A
+point's beam is the one whose bearing is nearest to the point's; the map then asks whether
+the point lies within half a beam width of it. For an evenly spaced ring the nearest beam
+follows by arithmetic (`nearest_in_ring`), for any directions by a search among the bounds
+half-way between neighbouring directions (`nearest_by_search`): one rule, two ways, and they
+agree wherever rounding does not decide (a tie exactly half-way between two beams).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+SAME_DIRECTION_RAD = 1e-9
+"""Bearings closer than this (rad) are one direction: their beams act as one."""
+RING_TOLERANCE_RAD = 1e-12
+"""Directions this close (rad) to an even ring's are that ring (the nearest beam by arithmetic)."""
+
+
+class BeamFan:
+    """The directions of a scan's beams: sorted, those that share a bearing merged, and the rule
+    that gives a cell its beam (the nearest direction) and its angle from that beam's axis.
+
+    Directions are angles in [0, 2 pi) (one slightly below 0 when a bearing lies within
+    SAME_DIRECTION_RAD below a full turn); `relative` are them less the first. Each beam's
+    cone is clipped to its share of the circle: `half_before` and `half_after` (rad) are the
+    half beam or, if less, half the gap to the neighbouring direction.
+    """
+
+    def __init__(self, bearings: np.ndarray, beam: float):
+        turn = 2 * math.pi
+        self.bearings = np.array(bearings, dtype=float)
+        self.beam = beam
+        wrapped = np.mod(self.bearings, turn)
+        wrapped[wrapped > turn - SAME_DIRECTION_RAD] -= turn
+        self._order = np.argsort(wrapped, kind="stable")
+        ordered = wrapped[self._order]
+        self._first = np.flatnonzero(np.diff(ordered, prepend=-math.inf) > SAME_DIRECTION_RAD)
+        self._sorted = len(self._first) == len(ordered) and bool(np.all(np.diff(self._order) == 1))
+        self.directions = ordered[self._first]
+        self.count = len(self.directions)
+        self.relative = self.directions - self.directions[0]
+        gaps = np.diff(self.relative, append=turn)  # to the next direction, counter-clockwise
+        self.bounds = self.relative + gaps / 2  # where the next direction becomes the nearest
+        self.half_before = np.minimum(beam / 2, np.roll(gaps, 1) / 2)
+        self.half_after = np.minimum(beam / 2, gaps / 2)
+        ring = np.arange(self.count) * (turn / self.count)
+        even = self.count == len(self.bearings) and np.max(np.abs(self.relative - ring)) <= RING_TOLERANCE_RAD
+        self.spacing = turn / self.count if even else None
+        """The ring's spacing (rad) when the directions are an evenly spaced ring, else None."""
+
+    def readings(self, ranges: np.ndarray) -> np.ndarray:
+        """One range per direction (m): the shortest echo of its beams, NaN when none echoed."""
+        ranges = np.asarray(ranges, dtype=float)
+        if self._sorted:
+            return ranges
+        ordered = ranges[self._order]
+        return ordered if self.count == len(ordered) else np.fmin.reduceat(ordered, self._first)
+
+    def nearest(self, angle: np.ndarray, axis: float) -> tuple[np.ndarray, np.ndarray]:
+        """The nearest direction (index) of each angle (rad from the first direction's world
+        axis, `axis`), and the angle from its axis, in [-pi, pi)."""
+        if self.spacing is not None:
+            return self.nearest_in_ring(angle, axis)
+        return self.nearest_by_search(angle)
+
+    def nearest_in_ring(self, angle: np.ndarray, axis: float) -> tuple[np.ndarray, np.ndarray]:
+        """`nearest` by arithmetic, for an evenly spaced ring."""
+        spacing = self.spacing
+        assert spacing is not None, "the arithmetic holds for an evenly spaced ring only"
+        beam = np.rint(angle / spacing).astype(int)  # halves to even, as np.round
+        beam %= self.count
+        offset = angle - beam * spacing + math.pi  # wrapped below: the angle from its axis
+        if abs(axis) <= math.pi:  # offset in (-2 pi, 4 pi): the modulo is one conditional turn
+            turn = 2 * math.pi
+            offset = np.where(offset < 0.0, offset + turn, np.where(offset >= turn, offset - turn, offset))
+            offset -= math.pi
+        else:
+            offset = offset % (2 * math.pi) - math.pi
+        return beam, offset
+
+    def nearest_by_search(self, angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """`nearest` by a search among the directions' bounds, for any directions."""
+        turn = 2 * math.pi
+        angle = angle % turn
+        beam = np.searchsorted(self.bounds, angle, side="right")
+        beam %= self.count
+        return beam, (angle - self.relative[beam] + math.pi) % turn - math.pi
