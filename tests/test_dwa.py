@@ -388,3 +388,26 @@ def test_with_follow_way_it_aims_at_the_goal_when_the_map_holds_no_way():
     box += [(x, y) for x in (-1.25, 1.25) for y in np.arange(-1.15, 1.2, 0.1)]
     way, obs = at_rest_on(box, goal=(4.0, 0.0), follow_way=1)
     assert np.all(way.aim(obs) == obs.goal)
+
+
+def laser_scan_with_echo(echo_bearing, echo_range, beams=720):
+    """A 270-degree laser's bearings and beam width, one echo at the beam nearest a bearing."""
+    bearings = np.linspace(-0.75 * math.pi, 0.75 * math.pi, beams)
+    ranges = np.full(beams, np.nan)
+    ranges[np.argmin(np.abs(bearings - echo_bearing))] = echo_range
+    return bearings, ranges, float(bearings[1] - bearings[0])
+
+
+def test_a_laser_echo_blocks_the_arcs_before_the_map_is_sure_of_it():
+    """One scan leaves the echo's cell below the map's threshold; the polygon check counts the
+    cells of the scan's own echoes (a laser's), a sparse sonar's echo waits for the map."""
+    for bearings, ranges, beam, blocked in (
+        (*laser_scan_with_echo(0.0, 1.05), True),
+        (BEARINGS, np.where(np.arange(16) == 0, 1.05, np.nan), BEAM, False),
+    ):
+        jackal = dwa.DwaPlanner.build({}, JACKAL)
+        obs = Observation(0.0, np.zeros(2), 0.0, GOAL_FAR, 0.15, bearings, ranges, beam)
+        jackal.step(obs)
+        assert not jackal.map.any_cells(jackal.params.map_threshold)  # one scan: not yet sure
+        dist = jackal.free_distance(obs, np.array([0.1]), np.array([0.0]))[0, 0]
+        assert (dist < 1.05 - JACKAL_HALF_LENGTH) == blocked

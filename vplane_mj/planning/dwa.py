@@ -30,11 +30,14 @@ control tick:
      the disc does not already cover: its dist is L.
    - A polygon robot: its footprint at poses along the arc, no point of it moving more than
      half a cell between two, and the signed distance from the footprint to the obstacle
-     cells' centres there (footprint_clearance.py). dist is the length the centre travels
-     before that distance falls below the margin, `margin_m` plus DRIFT_PERIODS T v: the
-     robot drifts from the arc it was asked for while its drive catches up with the command
-     (a skid-steer also turns faster than asked), the more the faster it goes. An arc is followed at most one
-     full circle, after which it repeats. A turn on the spot sweeps the sector that the
+     cells' centres there (footprint_clearance.py); with a dense scan (a laser's), the cells
+     that hold this scan's echoes count as obstacle cells too, whatever the map holds (it
+     judges a cell by the beam nearest its centre, which along a wall seen at a grazing angle
+     passes the wall and clears it). dist is the length the centre travels before that
+     distance falls below the margin, `margin_m` plus DRIFT_PERIODS T v: the robot drifts
+     from the arc it was asked for while its drive catches up with the command (a skid-steer
+     also turns faster than asked), the more the faster it goes. An arc is followed at most
+     one full circle, after which it repeats. A turn on the spot sweeps the sector that the
      footprint turns through, up to the whole circumscribed disc: its dist is the length the
      outermost point (at the circumscribed radius R) travels, turning that way, before the
      footprint comes within `margin_m` of a cell.
@@ -56,8 +59,11 @@ control tick:
    inflation), and the aim lies `look_ahead_m` of the last command's speed along it. sigma
    is a Gaussian over neighbouring samples (`smoothing`, in samples) in which inadmissible
    samples count 0, so the choice keeps off blocked arcs. The admissible sample of greatest
-   G is the command.
-6. Force: the one the heading controller (vplane_mj/control.py) turns into that command with
+   G is the command. A robot that turns slowly (the Jackal: 4 rad/s^2) reaches headings
+   little apart within one window, so the heading term varies little across it and the
+   clearance term leads; following a way, which already keeps off obstacles, it does
+   better with less of it (`clearance_weight` 0.05).
+6. Force: the one the heading controller (vplane_mj/sim/control.py) turns into that command with
    the robot's gains k_v and k_w (`RobotBody.gains`): direction yaw + omega / k_w and
    magnitude v / (k_v cos(omega / k_w)).
 
@@ -75,7 +81,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning import gridsearch
+from vplane_mj.planning import gridsearch, scan
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.body import DriveLimits, HeadingGains, RobotBody
 from vplane_mj.planning.events import Event, EventKind
@@ -367,9 +373,7 @@ class DwaPlanner(Planner):
         footprint comes within the margin of an obstacle cell, L when it never does; for a turn
         on the spot, the length its outermost point travels (step 3 of the module docstring)."""
         p, reach = self.params, self.lookahead
-        occupied = self.map.grid >= p.map_threshold
-        origin = self.map.origin
-        assert origin is not None, "the map's update places its origin"
+        occupied, origin = self._obstacle_cells(obs)
         first_cell = (int(origin[0]), int(origin[1]))
 
         margins = p.margin_m + DRIFT_PERIODS * self.period * speeds  # wider the faster (step 3)
@@ -390,6 +394,20 @@ class DwaPlanner(Planner):
         if not moving[0]:
             dist[0] = self._turns_free_distance(obs, turns, clearance, float(limits[0]))
         return dist
+
+    def _obstacle_cells(self, obs: Observation) -> tuple[np.ndarray, np.ndarray]:
+        """The map's obstacle cells (n, n) and its origin (world cell index of [0, 0]). With a
+        dense scan (a laser's narrow beams, each echo where its beam says), also the cells that
+        hold this scan's echoes: the map judges a cell by the beam nearest its centre, which
+        along a wall seen at a grazing angle passes the wall and clears it."""
+        origin = self.map.origin
+        assert origin is not None, "the map's update places its origin"
+        occupied = self.map.grid >= self.params.map_threshold
+        if scan.is_dense(obs):
+            cells = np.floor(obs.echo_points() / self.map.cell_m).astype(int) - origin
+            inside = np.all((cells >= 0) & (cells < self.map.n), axis=1)
+            occupied[cells[inside, 0], cells[inside, 1]] = True
+        return occupied, origin
 
     def _arcs_free_distance(
         self,
@@ -462,10 +480,8 @@ class DwaPlanner(Planner):
         p, cell = self.params, self.map.cell_m
         if not p.follow_way:
             return obs.goal
-        origin = self.map.origin
-        assert origin is not None, "the map's update places its origin"
+        occupied, origin = self._obstacle_cells(obs)
         passage = self.robot.half_width_m + p.margin_m
-        occupied = self.map.grid >= p.map_threshold
         cost = gridsearch.step_costs(
             occupied, np.zeros_like(occupied), cell, passage, WAY_INFLATION_M, WAY_INFLATION_WEIGHT, 0.0
         )
