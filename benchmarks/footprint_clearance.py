@@ -34,11 +34,16 @@ CHUNK = 2048
 """Poses per distance matrix in the numpy version (a chunk's matrix: CHUNK x occupied cells)."""
 
 
-def numpy_clearance(occupied, first_cell, cell_m, footprint, poses, cap_m):
-    """`footprint_clearance` in plain numpy: the pairs of poses and occupied cells within reach."""
+def numpy_clearance(occupied, first_cell, cell_m, footprint, poses, cap_m, points=None):
+    """`footprint_clearance` in plain numpy: the pairs of poses and obstacles (occupied cells'
+    centres, points on the grid) within reach."""
     radius = float(np.max(np.hypot(footprint[:, 0], footprint[:, 1])))
     i, j = np.nonzero(occupied)
     centres = (np.column_stack((i, j)) + first_cell + 0.5) * cell_m
+    if points is not None:
+        cells = np.floor(points / cell_m) - first_cell
+        on_grid = np.all((cells >= 0) & (cells < occupied.shape), axis=1)
+        centres = np.vstack((centres, points[on_grid]))
     result = np.full(len(poses), cap_m)
     start, edge = footprint[None], (np.roll(footprint, -1, axis=0) - footprint)[None]
     for first in range(0, len(poses), CHUNK):

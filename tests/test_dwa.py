@@ -400,7 +400,8 @@ def laser_scan_with_echo(echo_bearing, echo_range, beams=720):
 
 def test_a_laser_echo_blocks_the_arcs_before_the_map_is_sure_of_it():
     """One scan leaves the echo's cell below the map's threshold; the polygon check counts the
-    cells of the scan's own echoes (a laser's), a sparse sonar's echo waits for the map."""
+    scan's own echoes where the map holds no cell (a laser's), a sparse sonar's echo waits for
+    the map."""
     for bearings, ranges, beam, blocked in (
         (*laser_scan_with_echo(0.0, 1.05), True),
         (BEARINGS, np.where(np.arange(16) == 0, 1.05, np.nan), BEAM, False),

@@ -52,3 +52,40 @@ def test_a_cell_off_the_grid_or_beyond_the_cap_is_not_seen():
     poses = np.array([[0.55, 0.0, 0.0], [0.55, 0.0, math.pi / 2], [5.0, 5.0, 0.0], [-3.0, 0.55, 0.0]])
     got = footprint_clearance(occupied, (0, 0), 0.1, footprint, poses, 0.5)
     assert got == pytest.approx([0.55 - 0.215, 0.55 - 0.254, 0.5, 0.5])
+
+
+def test_points_count_where_they_are_and_off_the_grid_not_at_all():
+    footprint = robot_body("jackal").footprint
+    occupied = np.zeros((10, 10), dtype=bool)
+    points = np.array([[0.6, 0.5], [0.62, -0.3], [1.5, 0.0]])  # the last is off the grid
+    poses = np.array([[0.0, 0.5, 0.0], [0.0, 0.5, math.pi / 2], [1.5, 0.3, 0.0]])
+    got = footprint_clearance(occupied, (0, 0), 0.1, footprint, poses, 0.5, points)
+    want = brute_force_points(points[:2], footprint, poses, 0.5)
+    assert got == pytest.approx(want) and got[0] == pytest.approx(0.6 - 0.254)
+    assert got[2] == 0.5  # (1.5, 0.0) lies beyond the grid's 1 m
+
+
+def brute_force_points(points, footprint, poses, cap_m):
+    result = []
+    for x, y, yaw in poses:
+        c, s = math.cos(yaw), math.sin(yaw)
+        rel = points - (x, y)
+        body = np.column_stack((c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]))
+        result.append(min(cap_m, signed_distance(footprint, body).min()))
+    return np.array(result)
+
+
+def test_cells_and_points_together_agree_with_brute_force():
+    rng = np.random.default_rng(5)
+    footprint = robot_body("pioneer3dx").footprint
+    occupied = rng.random((30, 30)) < 0.03
+    points = rng.uniform(-1.0, 4.0, (300, 2))
+    poses = np.column_stack((rng.uniform(0, 3, 300), rng.uniform(0, 3, 300), rng.uniform(-4, 4, 300)))
+    got = footprint_clearance(occupied, (0, 0), 0.1, footprint, poses, 0.3, points)
+    on_grid = points[np.all((points >= 0) & (points < 3.0), axis=1)]
+    want = np.minimum(
+        brute_force(occupied, (0, 0), 0.1, footprint, poses, 0.3),
+        brute_force_points(on_grid, footprint, poses, 0.3),
+    )
+    assert got == pytest.approx(want, abs=1e-12)
+    assert (want < 0).sum() > 10 and (want < 0.3).sum() > 100

@@ -30,10 +30,10 @@ control tick:
      the disc does not already cover: its dist is L.
    - A polygon robot: its footprint at poses along the arc, no point of it moving more than
      half a cell between two, and the signed distance from the footprint to the obstacle
-     cells' centres there (footprint_clearance.py); with a dense scan (a laser's), the cells
-     that hold this scan's echoes count as obstacle cells too, whatever the map holds (it
-     judges a cell by the beam nearest its centre, which along a wall seen at a grazing angle
-     passes the wall and clears it). dist is the length the centre travels before that
+     cells' centres there (footprint_clearance.py); with a dense scan (a laser's), also from
+     this scan's echoes, where they are, in the cells the map does not hold (it judges a cell
+     by the beam nearest its centre, which along a wall seen at a grazing angle passes the
+     wall and clears it). dist is the length the centre travels before that
      distance falls below the margin, `margin_m` plus DRIFT_PERIODS T v: the robot drifts
      from the arc it was asked for while its drive catches up with the command (a skid-steer
      also turns faster than asked), the more the faster it goes. An arc is followed at most
@@ -55,14 +55,15 @@ control tick:
    aim is the goal (Fox), or with `follow_way` a point along the map's shortest way to it
    (as the global planner under BARN's DWA baseline, move_base, gives its local planner;
    Brock and Khatib's global dynamic window approach): the way keeps the robot's centre half
-   its width plus the margin from the obstacle cells (gridsearch.py, with a costmap's
-   inflation), and the aim lies `look_ahead_m` of the last command's speed along it. sigma
-   is a Gaussian over neighbouring samples (`smoothing`, in samples) in which inadmissible
-   samples count 0, so the choice keeps off blocked arcs. The admissible sample of greatest
-   G is the command. A robot that turns slowly (the Jackal: 4 rad/s^2) reaches headings
-   little apart within one window, so the heading term varies little across it and the
-   clearance term leads; following a way, which already keeps off obstacles, it does
-   better with less of it (`clearance_weight` 0.05).
+   its width plus the margin from the obstacle cells and, of a dense scan, the cells of its
+   echoes (gridsearch.py, with a costmap's inflation), and the aim lies `look_ahead_m` of
+   the last command's speed along it. sigma is a Gaussian over neighbouring samples
+   (`smoothing`, in samples) in which inadmissible samples count 0, so the choice keeps off
+   blocked arcs. The admissible sample of greatest G is the command. A robot that turns
+   slowly (the Jackal: 4 rad/s^2) reaches headings little apart within one window, so the
+   heading term varies little across it and the clearance term leads; following a way,
+   which already keeps off obstacles, it does better with less of it (`clearance_weight`
+   0.05).
 6. Force: the one the heading controller (vplane_mj/sim/control.py) turns into that command with
    the robot's gains k_v and k_w (`RobotBody.gains`): direction yaw + omega / k_w and
    magnitude v / (k_v cos(omega / k_w)).
@@ -370,10 +371,10 @@ class DwaPlanner(Planner):
 
     def _swept_free_distance(self, obs: Observation, speeds: np.ndarray, turns: np.ndarray) -> np.ndarray:
         """A polygon robot's dist(v, omega) (speeds, turns): length (m) along each arc before the
-        footprint comes within the margin of an obstacle cell, L when it never does; for a turn
-        on the spot, the length its outermost point travels (step 3 of the module docstring)."""
+        footprint comes within the margin of an obstacle, L when it never does; for a turn on
+        the spot, the length its outermost point travels (step 3 of the module docstring)."""
         p, reach = self.params, self.lookahead
-        occupied, origin = self._obstacle_cells(obs)
+        occupied, origin, echoes = self._obstacles(obs)
         first_cell = (int(origin[0]), int(origin[1]))
 
         margins = p.margin_m + DRIFT_PERIODS * self.period * speeds  # wider the faster (step 3)
@@ -381,7 +382,7 @@ class DwaPlanner(Planner):
 
         def clearance(poses: np.ndarray) -> np.ndarray:
             flat = self.footprint_clearance(
-                occupied, first_cell, self.map.cell_m, self.robot.footprint, poses.reshape(-1, 3), cap
+                occupied, first_cell, self.map.cell_m, self.robot.footprint, poses.reshape(-1, 3), cap, echoes
             )
             return flat.reshape(poses.shape[:-1])
 
@@ -395,19 +396,21 @@ class DwaPlanner(Planner):
             dist[0] = self._turns_free_distance(obs, turns, clearance, float(limits[0]))
         return dist
 
-    def _obstacle_cells(self, obs: Observation) -> tuple[np.ndarray, np.ndarray]:
-        """The map's obstacle cells (n, n) and its origin (world cell index of [0, 0]). With a
-        dense scan (a laser's narrow beams, each echo where its beam says), also the cells that
-        hold this scan's echoes: the map judges a cell by the beam nearest its centre, which
-        along a wall seen at a grazing angle passes the wall and clears it."""
+    def _obstacles(self, obs: Observation) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The map's obstacle cells (n, n), its origin (world cell index of [0, 0]) and, of a
+        dense scan (a laser's narrow beams, each echo where its beam says), the echoes (N, 2)
+        in cells the map does not hold: the map judges a cell by the beam nearest its centre,
+        which along a wall seen at a grazing angle passes the wall and clears it."""
         origin = self.map.origin
         assert origin is not None, "the map's update places its origin"
         occupied = self.map.grid >= self.params.map_threshold
-        if scan.is_dense(obs):
-            cells = np.floor(obs.echo_points() / self.map.cell_m).astype(int) - origin
-            inside = np.all((cells >= 0) & (cells < self.map.n), axis=1)
-            occupied[cells[inside, 0], cells[inside, 1]] = True
-        return occupied, origin
+        if not scan.is_dense(obs):
+            return occupied, origin, np.empty((0, 2))
+        echoes = obs.echo_points()
+        cells = np.floor(echoes / self.map.cell_m).astype(int) - origin
+        unmapped = np.all((cells >= 0) & (cells < self.map.n), axis=1)
+        unmapped[unmapped] = ~occupied[cells[unmapped, 0], cells[unmapped, 1]]
+        return occupied, origin, echoes[unmapped]
 
     def _arcs_free_distance(
         self,
@@ -480,7 +483,9 @@ class DwaPlanner(Planner):
         p, cell = self.params, self.map.cell_m
         if not p.follow_way:
             return obs.goal
-        occupied, origin = self._obstacle_cells(obs)
+        occupied, origin, echoes = self._obstacles(obs)
+        cells = np.floor(echoes / cell).astype(int) - origin
+        occupied[cells[:, 0], cells[:, 1]] = True
         passage = self.robot.half_width_m + p.margin_m
         cost = gridsearch.step_costs(
             occupied, np.zeros_like(occupied), cell, passage, WAY_INFLATION_M, WAY_INFLATION_WEIGHT, 0.0
