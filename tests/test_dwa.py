@@ -412,3 +412,29 @@ def test_a_laser_echo_blocks_the_arcs_before_the_map_is_sure_of_it():
         assert not jackal.map.any_cells(jackal.params.map_threshold)  # one scan: not yet sure
         dist = jackal.free_distance(obs, np.array([0.1]), np.array([0.0]))[0, 0]
         assert (dist < 1.05 - JACKAL_HALF_LENGTH) == blocked
+
+
+# -- The Jackal on BARN protocol worlds ----------------------------------------------------------
+
+
+def jackal_run(seed, *settings):
+    """A run of dwa with the Jackal on the first BARN protocol world of `seed` (start and goal
+    10 m apart, the goal's tolerance 1 m)."""
+    case = generate_protocol(1, seed)[0]
+    return run_scenario(parse_scenario(case.toml(), f"{case.name}.toml", ["planner.name=dwa", *settings]))
+
+
+def test_the_jackal_crosses_a_barn_protocol_world_at_full_speed_without_collision():
+    summary = jackal_run(3).summary
+    assert summary.robot_profile == "jackal" and summary.top_speed_mps == 2.0
+    assert summary.outcome == "reached" and summary.collisions == 0 and summary.min_clearance_m > 0.02
+    assert 9.0 < summary.path_length_m < 10.5
+    assert summary.time_to_goal_s < 15.0  # at 0.5 m/s (BARN's baseline) 9 m would take 18 s
+
+
+def test_following_the_maps_way_it_crosses_a_world_where_the_goals_heading_is_trapped():
+    fox = jackal_run(0).summary
+    assert fox.outcome == "stuck" and fox.collisions == 0 and fox.path_length_m < 3.0
+    way = jackal_run(0, "planner.follow_way=1", "planner.clearance_weight=0.05").summary
+    assert way.outcome == "reached" and way.collisions == 0 and way.min_clearance_m > 0.02
+    assert 9.0 < way.path_length_m < 10.5 and way.score == 0.5  # within twice the optimal time
