@@ -97,9 +97,10 @@ class LocalMapParams(PlannerParams):
         4, "", "certainty at which a map cell counts as an obstacle", ge=1, integer=True
     )
 
-    def local_map(self) -> LocalMap:
-        """A fresh, empty sonar map of this cell size and side."""
-        return LocalMap(self.map_cell_m, self.map_size_m)
+    def local_map(self, least_size_m: float = 0.0) -> LocalMap:
+        """A fresh, empty sonar map of this cell size and side, or of `least_size_m` (m) when
+        that is larger (a planner that looks farther than the side allows)."""
+        return LocalMap(self.map_cell_m, max(self.map_size_m, least_size_m))
 
 
 @dataclass(frozen=True)

@@ -615,24 +615,11 @@ class VPlanePlusPlanner(VPlanePlanner):
     def _way(self, window: gridsearch.Window, start: np.ndarray, end: np.ndarray) -> list[np.ndarray] | None:
         """Waypoints (m) of the map's shortest way from `start` to `end` (beyond the window:
         toward it in a straight line from the window's edge); None when there is none."""
-        shape = window.cost.shape
-        end_cell = window.cell_of(end)
-        if end_cell is not None:
-            window.clear_disc(end, self.radius)
-            targets, target_costs = np.array([np.ravel_multi_index(end_cell, shape)]), np.zeros(1)
-        else:
-            edge = np.zeros(shape, dtype=bool)
-            edge[[0, -1], :] = edge[:, [0, -1]] = True
-            targets = np.flatnonzero(edge)
-            centres = window.centres().reshape(-1, 2)[targets]
-            target_costs = np.hypot(*(centres - end).T)
-        costs = gridsearch.cost_to_go(window.cost, targets, target_costs, window.cell_m)
-        start_cell = window.free_cell_near(start, 2 * self.radius)
-        if start_cell is None or not np.isfinite(costs[start_cell]):
+        cells = gridsearch.way_to(window, start, end, self.radius)
+        if cells is None:
             return None
-        cells = gridsearch.descend(costs, start_cell, shape[0] * shape[1])
         way = [window.centre(c) for c in cells[1:]]
-        if end_cell is not None:
+        if window.cell_of(end) is not None:
             way.append(np.asarray(end, float))
         self.sight = window
         return way
