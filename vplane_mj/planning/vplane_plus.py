@@ -40,6 +40,7 @@ from vplane_mj.planning import fields, gridsearch, scan
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.localmap import LocalMap, angular_extremes
+from vplane_mj.planning.motion import Steering
 from vplane_mj.planning.params import param, with_default
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.planning.vectors import unit, wrap_angle
@@ -222,7 +223,8 @@ class VPlanePlusPlanner(VPlanePlanner):
         components["virtual"] = np.zeros(2) if self.following else self._planes_force(obs.position)
         components["map"] = self._nearest_cell_force(obs.position)
         decision.components = components
-        decision.force = self._governed(sum(components.values(), np.zeros(2)), obs)
+        steering = self._governed(sum(components.values(), np.zeros(2)), obs)
+        decision.force, decision.command = steering.force, steering.command
         decision.objective = self.temp_goal
         decision.planes = [(plane.e1, plane.e2) for plane in self.planes]
         return decision
@@ -262,6 +264,9 @@ class VPlanePlusPlanner(VPlanePlanner):
         components["attractive"] = pull * heading
         if not on_a_way:
             return
+        if not self.governor.idle:
+            components["repulsive"] = np.zeros(2)
+            return
         echoes = obs.echo_points()
         close = np.hypot(*(echoes - obs.position).T) < self.radius + CLOSE_ECHO_MARGIN_M
         fade = min(1.0, obs.distance_to_goal() / p.goal_fade_m) ** 2 if p.goal_fade_m > 0 else 1.0
@@ -270,13 +275,13 @@ class VPlanePlusPlanner(VPlanePlanner):
         near = fade * fields.repulsive_force(obs.position, echoes[close], gain, influence)
         components["repulsive"] = near + farther - min(float(farther @ heading), 0.0) * heading
 
-    def _governed(self, force: np.ndarray, obs: Observation) -> np.ndarray:
+    def _governed(self, force: np.ndarray, obs: Observation) -> Steering:
         """The force fitted to the robot's body (motion.py) among the echoes and the mapped
         cells around it (not swept), which remember what the sensor sees between its beams or
         behind; on a way, no faster than lets the robot turn along the way's next
         `BEND_HORIZON_M`."""
         if self.governor.idle:
-            return force
+            return Steering(force)
         cells = self._mapped_cells_near(obs.position, self.governor.reach_m)
         way = self.escape_way if self.temp_goal is not None else self.follow_way if self.following else []
         speed = math.inf
@@ -285,7 +290,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             travelled = np.cumsum(np.hypot(*np.diff(np.vstack((obs.position, ahead)), axis=0).T))
             speed = self.governor.policy.bend_speed(obs.position, obs.yaw, ahead[travelled <= BEND_HORIZON_M])
         points = np.vstack((obs.echo_points(), cells))
-        return self.governor.govern(force, obs.position, obs.yaw, points, speed)
+        return self.governor.steer(force, obs, points, speed)
 
     def _mapped_cells_near(self, position: np.ndarray, reach_m: float) -> np.ndarray:
         """Centres (N, 2) of the mapped obstacle cells (not swept) within a square of half side

@@ -144,7 +144,11 @@ JACKAL = RobotProfile(
     track_scale=1.9,
     wheel_friction=0.5,
     limits=DriveLimits(
-        max_speed_mps=2.0, max_turn_rate_radps=4.0, max_accel_mps2=2.0, max_turn_accel_radps2=4.0
+        max_speed_mps=2.0,
+        max_turn_rate_radps=4.0,
+        max_accel_mps2=2.0,
+        max_turn_accel_radps2=4.0,
+        turn_lag_s=0.1,
     ),
     ramped=True,
     gains=ControllerGains(
