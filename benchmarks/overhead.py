@@ -40,7 +40,8 @@ from vplane_mj.planning import Decision, Observation, Planner, PlannerParams
 from vplane_mj.planning.registry import register_planner
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.loop import run_scenario
-from vplane_mj.sim.world import SonarLayout, build_model
+from vplane_mj.sim.sensors import scan_bearings
+from vplane_mj.sim.world import build_model
 
 DEFAULT_SCENARIOS = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")
 HARNESS_SCENARIO = "open_field"
@@ -76,7 +77,7 @@ def replay_time(model: mujoco.MjModel, torques, steps: int, clock=time.process_t
 def logged_run(scenario, log_dir: Path) -> tuple[float, int]:
     """CPU time (s) of one run that writes its MCAP log into `log_dir`, and the log's bytes."""
     path = log_dir / f"{scenario.name}-{scenario.planner}.mcap"
-    bearings = SonarLayout.from_spec(scenario.sensors).bearings
+    bearings = scan_bearings(scenario)
     start = time.process_time()
     log = McapLog(path, scenario, bearings, {})
     result = run_scenario(scenario, observers=(log,))

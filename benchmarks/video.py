@@ -22,7 +22,7 @@ from vplane_mj.logs.reader import read_log
 from vplane_mj.logs.writer import McapLog
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.loop import run_scenario
-from vplane_mj.sim.world import SonarLayout
+from vplane_mj.sim.sensors import scan_bearings
 from vplane_mj.viz.video import FORMATS, frame_count, write_video
 
 DEFAULT_SCENARIOS = ("paper_c_escape", "paper_h_escape")
@@ -32,7 +32,7 @@ MP4_SPEED, GIF_SPEED = 1.0, 2.0
 def logged_run(scenario, path: Path) -> float:
     """Wall seconds of one run writing its MCAP log to `path`."""
     started = time.perf_counter()
-    bearings = SonarLayout.from_spec(scenario.sensors).bearings
+    bearings = scan_bearings(scenario)
     log = McapLog(path, scenario, bearings, {})
     result = run_scenario(scenario, observers=(log,))
     log.close(result.summary.to_dict())

@@ -135,10 +135,8 @@ def plane_field_figure(path: Path) -> None:
     u, v = np.zeros_like(xs), np.zeros_like(ys)
     for idx in np.ndindex(xs.shape):
         point = np.array([xs[idx], ys[idx]])
-        if plane.in_corridor(point, p["plane_influence_m"], p["plane_margin_m"]):
-            force = plane_force(
-                point, plane, p["plane_gain"], p["plane_influence_m"], p["plane_step_m"], p["slide_gain"]
-            )
+        if plane.in_corridor(point, p.plane_influence_m, p.plane_margin_m):
+            force = plane_force(point, plane, p.plane_gain, p.plane_influence_m, p.plane_step_m, p.slide_gain)
             u[idx], v[idx] = force
     magnitude = np.hypot(u, v)
     scale = np.where(magnitude > 0, np.log1p(magnitude) / np.maximum(magnitude, 1e-12), 0.0)

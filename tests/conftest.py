@@ -9,6 +9,7 @@ import math
 import os
 import re
 import shutil
+import sysconfig
 import tempfile
 import textwrap
 from pathlib import Path
@@ -45,6 +46,17 @@ def own_registry(monkeypatch):
 
 
 @pytest.fixture
+def console_script():
+    """The path of an installed command (a package's console script) of the Python running the
+    tests: in its scripts directory (a virtual environment's bin), whatever PATH holds."""
+
+    def find(name: str) -> str:
+        return str(Path(sysconfig.get_path("scripts")) / name)
+
+    return find
+
+
+@pytest.fixture
 def scenario_from():
     """Build a Scenario from TOML text (validated like a file)."""
 
@@ -65,15 +77,17 @@ def shipped():
 
 
 @pytest.fixture
-def readme_examples():
-    """The Python code blocks of a README section (`## TITLE`), joined into one script (a
-    block indented in a list item is dedented)."""
+def doc_examples():
+    """The Python code blocks of sections (`## TITLE`) of a documentation page (docs/PAGE), in
+    the page's order, joined into one script (a block indented in a list item is dedented)."""
 
-    def blocks(title: str) -> str:
-        text = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
-        section = text.split(f"\n## {title}\n", 1)[1].split("\n## ", 1)[0]
+    def blocks(page: str, *titles: str) -> str:
+        text = (Path(__file__).parents[1] / "docs" / page).read_text(encoding="utf-8")
+        sections = [text.split(f"\n## {title}\n", 1)[1].split("\n## ", 1)[0] for title in titles]
         return "\n".join(
-            textwrap.dedent(block) for block in re.findall(r"```python\n(.*?)```", section, re.S)
+            textwrap.dedent(block)
+            for section in sections
+            for block in re.findall(r"```python\n(.*?)```", section, re.S)
         )
 
     return blocks

@@ -1,6 +1,7 @@
-"""The Python API (README "Python API"): scenarios loaded and built in code, `run`, `sweep`, and
+"""The Python API (docs/python-api.md): scenarios loaded and built in code, `run`, `sweep`, and
 the command line as a thin layer over them."""
 
+import importlib
 import json
 import math
 import signal
@@ -123,11 +124,14 @@ def test_importing_the_package_loads_no_simulator_plotting_or_opengl():
 
 def test_every_public_name_resolves_and_is_listed():
     assert sorted(vplane_mj.__all__) == sorted(vplane_mj._MODULE_OF)
-    for name in vplane_mj.__all__:
-        assert getattr(vplane_mj, name) is not None
-    assert set(vplane_mj.__all__) <= set(dir(vplane_mj))
+    for name, module in vplane_mj._MODULE_OF.items():
+        assert getattr(vplane_mj, name) is getattr(importlib.import_module(module), name), name
     with pytest.raises(AttributeError, match="no attribute 'nonsense'"):
         vplane_mj.nonsense  # noqa: B018
+    # dir() lists the public names before their first use, which imports them (a fresh process).
+    script = "import vplane_mj\nprint(sorted(set(vplane_mj.__all__) - set(dir(vplane_mj))))\n"
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "[]"
 
 
 def test_a_scenario_built_in_code_equals_the_same_file():
@@ -159,6 +163,9 @@ def test_numpy_values_are_accepted_like_numbers(tmp_path):
         run={"seed": np.uint8(3)},
     )
     assert built.robot.start == (0.75, 2.0) and built.run.seed == 3
+    # Plain Python numbers (a numpy scalar compares equal to one, but is not TOML).
+    assert [type(v) for v in (*built.robot.start, *built.world.size)] == [float] * 4
+    assert type(built.run.seed) is int
     assert load_scenario(str(built.save(tmp_path / "np.toml"))) == built
 
 
@@ -216,6 +223,7 @@ def test_overrides_apply_to_built_and_loaded_scenarios_alike():
     built = built_trap(overrides=["run.seed=9", "world.obstacles[0].yaw_deg=45"])
     loaded = parse_scenario(TRAP, "trap.toml", ["run.seed=9", "world.obstacles[0].yaw_deg=45"])
     assert built == loaded and built.run.seed == 9
+    assert built.world.obstacles[0].yaw == pytest.approx(math.radians(45.0))
 
 
 def test_run_reaches_the_goal_and_returns_its_summary_trajectory_events_and_files(tmp_path):
@@ -342,9 +350,11 @@ def test_sweep_rejects_invalid_input_before_any_run_and_leaves_no_directory(tmp_
     assert not (tmp_path / "new").exists()
 
 
-def test_the_readme_examples_run(tmp_path, monkeypatch, readme_examples, capsys):
+@pytest.mark.slow
+def test_the_documented_examples_run(tmp_path, monkeypatch, doc_examples, capsys):
     monkeypatch.chdir(tmp_path)
-    exec(compile(readme_examples("Python API"), "README.md", "exec"), {})
+    script = doc_examples("python-api.md", "Run a scenario", "Build a scenario in code", "Sweep")
+    exec(compile(script, "docs/python-api.md", "exec"), {})
     assert load_scenario("my_trap.toml").name == "my_trap"
     assert (tmp_path / "logs" / "paper_c_escape-vplane-3.json").exists()
     assert json.loads((tmp_path / "results" / "bench.json").read_text())["table"][0]["runs"] == 6

@@ -7,6 +7,7 @@ import json
 import os
 import shlex
 import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -16,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from vplane_mj.bench import sweep as sweep_module
 from vplane_mj.bench.failures import FAILED_SCENARIO_KEY
 from vplane_mj.bench.sweep import (
     JOURNAL,
@@ -30,6 +32,8 @@ from vplane_mj.bench.sweep import (
 )
 from vplane_mj.cli import main
 from vplane_mj.errors import VPlaneError
+from vplane_mj.planning.plugins import FILE_MODULE_PREFIX
+from vplane_mj.planning.registry import load_planner
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.summary import without_timing
 
@@ -91,7 +95,6 @@ def test_a_sweep_writes_rows_table_and_plot_and_resumes(tmp_path, capsys):
         (["--seeds", "x"], "--seeds"),
         (["--planners", "apf,nope"], "--planners: unknown planner 'nope'"),
         (["--jobs", "0"], "--jobs"),
-        (["--scheduler", "tcp://127.0.0.1:8786"], "--scheduler"),
         (["--set", "sensors.dropout=2"], "sensors.dropout"),
     ],
 )
@@ -99,6 +102,18 @@ def test_invalid_input_exits_2_and_writes_nothing(tmp_path, capsys, extra, fragm
     assert main(["bench", "open_field", *extra, "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("error: ") and fragment in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_unreachable_scheduler_exits_2_and_writes_nothing(tmp_path, capsys, monkeypatch):
+    pytest.importorskip("distributed")
+    monkeypatch.setattr(sweep_module, "SCHEDULER_TIMEOUT_S", 0.5)  # Dask retries until then
+    with socket.socket() as refusing:
+        refusing.bind(("127.0.0.1", 0))  # bound and not listening: a connection is refused at once
+        address = f"tcp://127.0.0.1:{refusing.getsockname()[1]}"
+        assert main(["bench", "open_field", "--scheduler", address, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: --scheduler: cannot reach a Dask scheduler at {address}: "), err
     assert list(tmp_path.iterdir()) == []
 
 
@@ -111,6 +126,7 @@ def test_parse_seeds():
             parse_seeds(bad)
 
 
+@pytest.mark.slow
 def test_a_dask_cluster_gives_the_same_rows_as_the_local_pool(tmp_path, capsys):
     distributed = pytest.importorskip("distributed")
     local, remote = tmp_path / "local", tmp_path / "dask"
@@ -118,7 +134,9 @@ def test_a_dask_cluster_gives_the_same_rows_as_the_local_pool(tmp_path, capsys):
     remote.mkdir()
     args = ["bench", "open_field", "paper_c_escape", "--planners", "apf,vplane", "--seeds", "0"]
     assert main([*args, "--jobs", "2", "--out", str(local)]) == 0
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster:
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
         assert main([*args, "--scheduler", cluster.scheduler_address, "--out", str(remote)]) == 0
     assert "on the Dask cluster at" in capsys.readouterr().err
 
@@ -135,22 +153,105 @@ def test_family_of_a_generated_scenario():
     assert family_of("paper_c_avoid") == "paper_c_avoid"
 
 
-# A sweep in its own process, interrupted as a user or a service manager would. A finer physics
-# step makes each run (8 simulated seconds) last about a second, so that a signal lands mid-sweep
-# and a sweep that waited for its remaining runs (three rounds of two) rather than stop would show.
-SWEEP = ["open_field", "single_box", "--planners", "apf", "--seeds", "0-3", "--jobs", "2"]
-SWEEP_KEYS = {(s, "apf", seed) for s in ("open_field", "single_box") for seed in range(4)}
-SLOW_RUNS = ["--set", "run.physics_dt_s=0.0005", "--set", "run.time_limit_s=8"]
+# A sweep in its own process, interrupted as a user or a service manager would. Its runs are
+# open_field and single_box, each by apf and by `gated`, an apf held mid-run until the test
+# opens a gate (GATED_PLANNER): with two workers, the two apf runs of open_field finish, then
+# both workers hold a gated run, so the test acts at a known point of the sweep, whatever the
+# speed of the machine, and a sweep that waited for its runs rather than stop would never end.
+SEEDS = (0, 1)
+SWEEP_KEYS = {(s, p, seed) for s in ("open_field", "single_box") for p in ("apf", "gated") for seed in SEEDS}
+TIME_LIMIT = "run.time_limit_s=8"
+
+GATED_PLANNER = """
+import time
+import uuid
+from pathlib import Path
+
+from vplane_mj.planning.apf import ApfPlanner
+
+GATE = Path(__file__).parent
+HOLD_AT_S = 0.5
+WAIT_AT_MOST_S = 300.0  # a run whose gate a failed test never opened ends by itself
 
 
-def bench_command(out_dir):
-    return [sys.executable, "-m", "vplane_mj", "bench", *SWEEP, *SLOW_RUNS, "--out", str(out_dir)]
+class Gated(ApfPlanner):
+    name = "gated"
+    summary = "apf, held mid-run (once) until its gate opens"
+    citation = "none"
+    held = False
+
+    def step(self, obs):
+        if not self.held and obs.time_s >= HOLD_AT_S:
+            self.held = True
+            (GATE / f"held-{uuid.uuid4().hex}").touch()
+            deadline = time.monotonic() + WAIT_AT_MOST_S
+            while not (GATE / "open").exists():
+                if time.monotonic() > deadline:
+                    raise TimeoutError("the gate never opened")
+                time.sleep(0.01)
+        return super().step(obs)
+"""
 
 
-def start_bench(out_dir):
-    """The sweep as the leader of its own process group, like a command started from a shell."""
+@dataclasses.dataclass
+class Gate:
+    """The gated planner's file, and its gate: a `held-*` file per run that reached it, and
+    the file `open`, which lets every held run go on (and the later ones pass)."""
+
+    directory: Path
+
+    @property
+    def spec(self) -> str:
+        return f"{self.directory.resolve() / 'gated_planner.py'}:Gated"
+
+    def held(self) -> int:
+        return len(list(self.directory.glob("held-*")))
+
+    def open(self) -> None:
+        (self.directory / "open").touch()
+
+
+@pytest.fixture
+def gate(tmp_path, own_registry):
+    """A closed gate, its planner registered in this process too (to plan its jobs here)."""
+    directory = tmp_path / "gate"
+    directory.mkdir()
+    (directory / "gated_planner.py").write_text(GATED_PLANNER)
+    found = Gate(directory)
+    load_planner(found.spec)
+    yield found
+    found.open()  # nothing stays held
+    sys.modules.pop(f"{FILE_MODULE_PREFIX}gated_planner", None)  # the next test's file is another
+
+
+def bench_arguments(out_dir, gate):
+    return [
+        *["bench", "open_field", "single_box", "--planners", f"apf,{gate.spec}", "--seeds", "0-1"],
+        *["--jobs", "2", "--set", TIME_LIMIT, "--out", str(out_dir)],
+    ]
+
+
+def bench_command(out_dir, gate):
+    return [sys.executable, "-m", "vplane_mj", *bench_arguments(out_dir, gate)]
+
+
+PATIENT_SWEEP = """
+import sys
+from vplane_mj.bench import pool
+from vplane_mj.cli import main
+
+pool.JOIN_TIMEOUT_S = 600.0
+sys.exit(main(sys.argv[1:]))
+"""
+"""`vplane-mj` whose sweep would wait 600 s, not 5, for a worker to end by itself before it
+terminates it: a sweep that stopped its workers other than at once would outlast the test."""
+
+
+def start_bench(out_dir, gate):
+    """The sweep (PATIENT_SWEEP) as the leader of its own process group, like a command started
+    from a shell."""
     return subprocess.Popen(
-        bench_command(out_dir),
+        [sys.executable, "-c", PATIENT_SWEEP, *bench_arguments(out_dir, gate)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -158,15 +259,28 @@ def start_bench(out_dir):
     )
 
 
-def wait_for_a_finished_run(out_dir, process, seconds=60.0):
-    """Wait until the journal holds a complete line: the sweep is under way."""
-    journal = out_dir / JOURNAL
+def wait_until(condition, process, what, seconds=60.0):
+    """Wait until `condition()` holds; fail when the sweep ends first or it takes `seconds`."""
     deadline = time.monotonic() + seconds
-    while time.monotonic() < deadline and process.poll() is None:
-        if journal.exists() and b"\n" in journal.read_bytes():
-            return
+    while not condition():
+        if process.poll() is not None or time.monotonic() > deadline:
+            raise AssertionError(f"{what} did not happen (sweep status {process.poll()})")
         time.sleep(0.02)
-    raise AssertionError(f"the sweep finished no run (status {process.poll()})")
+
+
+def journal_lines(out_dir) -> int:
+    """The complete lines of the sweep's journal."""
+    journal = out_dir / JOURNAL
+    return journal.read_bytes().count(b"\n") if journal.exists() else 0
+
+
+def hold_both_workers(out_dir, gate, process):
+    """Wait until the sweep has written its two apf rows of open_field and both workers hold
+    a gated run; the pids of its workers."""
+    wait_until(lambda: journal_lines(out_dir) == 2 and gate.held() == 2, process, "two rows, two held runs")
+    workers = descendants(process.pid)
+    assert len(workers) == 2, "the sweep does not have its two worker processes"
+    return workers
 
 
 def proc_stat(pid):
@@ -234,9 +348,11 @@ def assert_only_complete_files(out_dir):
     return rows
 
 
-def assert_the_rerun_completes_the_sweep(out_dir, done):
-    """The same command again runs only what the journal lacks and writes one row per run."""
-    finished = subprocess.run(bench_command(out_dir), capture_output=True, text=True, timeout=120)
+def assert_the_rerun_completes_the_sweep(out_dir, gate, done):
+    """With the gate open, the same command again runs only what the journal lacks and writes
+    one row per run."""
+    gate.open()
+    finished = subprocess.run(bench_command(out_dir, gate), capture_output=True, text=True, timeout=120)
     assert finished.returncode == 0, finished.stderr
     assert f"{len(SWEEP_KEYS)} runs: {done} already done, {len(SWEEP_KEYS) - done} to run" in finished.stderr
     assert len(assert_only_complete_files(out_dir)) == len(SWEEP_KEYS)
@@ -252,56 +368,60 @@ def assert_the_rerun_completes_the_sweep(out_dir, done):
     [(signal.SIGINT, False), (signal.SIGINT, True), (signal.SIGTERM, False), (signal.SIGTERM, True)],
     ids=["SIGINT-process", "SIGINT-group", "SIGTERM-process", "SIGTERM-group"],
 )
+@pytest.mark.slow
 def test_an_interrupted_sweep_keeps_its_finished_runs_stops_its_workers_and_resumes(
-    tmp_path, signum, whole_group
+    tmp_path, gate, signum, whole_group
 ):
-    process = start_bench(tmp_path)
+    out_dir = tmp_path / "out"
+    process = start_bench(out_dir, gate)
     try:
-        wait_for_a_finished_run(tmp_path, process)
-        workers = descendants(process.pid)
-        assert workers, "the sweep has no worker processes"
+        workers = hold_both_workers(out_dir, gate, process)
         # Ctrl-C in a terminal signals the whole foreground process group, workers included.
-        signalled = time.monotonic()
         (os.killpg if whole_group else os.kill)(process.pid, signum)
-        _, err = process.communicate(timeout=30)
-        assert time.monotonic() - signalled < 2.0, "the sweep waited for its remaining runs"
+        try:
+            _, err = process.communicate(timeout=30)
+        except subprocess.TimeoutExpired:
+            raise AssertionError("the sweep waited for its workers, held at the gate, to end") from None
         assert process.returncode == 128 + signum, err
         assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
         messages = [line for line in err.splitlines() if "interrupted" in line]
         assert messages == [
-            f"interrupted by {signal.Signals(signum).name}: finished runs are kept in {tmp_path / JOURNAL}; "
+            f"interrupted by {signal.Signals(signum).name}: finished runs are kept in {out_dir / JOURNAL}; "
             "run the same command again to complete the sweep"
         ]
-        assert not wait_until_gone(workers, seconds=2.0), "worker processes outlived the sweep"
+        # Held at the closed gate, a worker would run on for minutes: gone means stopped.
+        assert not wait_until_gone(workers, seconds=30.0), "worker processes outlived the sweep"
     finally:
         end_session(process)
-    done = len(assert_only_complete_files(tmp_path))
-    assert 1 <= done < len(SWEEP_KEYS)
-    assert_the_rerun_completes_the_sweep(tmp_path, done)
+    assert gate.held() == 2  # no run started after the interruption
+    assert len(assert_only_complete_files(out_dir)) == 2
+    assert_the_rerun_completes_the_sweep(out_dir, gate, done=2)
 
 
-def test_a_killed_sweep_leaves_a_journal_the_rerun_resumes_from(tmp_path):
-    process = start_bench(tmp_path)
+@pytest.mark.slow
+def test_a_killed_sweep_leaves_a_journal_the_rerun_resumes_from(tmp_path, gate):
+    out_dir = tmp_path / "out"
+    process = start_bench(out_dir, gate)
     try:
-        wait_for_a_finished_run(tmp_path, process)
-        workers = descendants(process.pid)
+        workers = hold_both_workers(out_dir, gate, process)
         process.kill()
         process.communicate(timeout=30)
-        # Orphaned workers notice that the sweep is gone and exit rather than run on.
-        assert not wait_until_gone(workers, seconds=5.0), "worker processes outlived the killed sweep"
+        # Orphaned workers notice that the sweep is gone and exit rather than run on (held at
+        # the closed gate, they would run on for minutes).
+        assert not wait_until_gone(workers, seconds=30.0), "worker processes outlived the killed sweep"
     finally:
         end_session(process)
-    done = len(read_journal(tmp_path / JOURNAL))
-    assert 1 <= done < len(SWEEP_KEYS)
-    assert {path.name for path in tmp_path.iterdir()} == {JOURNAL}
-    assert_the_rerun_completes_the_sweep(tmp_path, done)
+    assert len(read_journal(out_dir / JOURNAL)) == 2
+    assert {path.name for path in out_dir.iterdir()} == {JOURNAL}
+    assert_the_rerun_completes_the_sweep(out_dir, gate, done=2)
 
 
 # ----------------------------------------------------------------- runs that fail, workers that die
 
 
-def planned_jobs(*overrides):
-    return plan_jobs(["open_field", "single_box"], ["apf"], range(4), overrides)
+def gated_jobs():
+    """The jobs of the gated sweep, planned in this process."""
+    return plan_jobs(["open_field", "single_box"], ["apf", "gated"], SEEDS, [TIME_LIMIT])
 
 
 def broken(job):
@@ -309,9 +429,11 @@ def broken(job):
     return dataclasses.replace(job, seed=7, toml=job.toml.replace('name = "apf"', 'name = "nope"'))
 
 
-def saved_text(saved: Path, job) -> str:
-    """A failed run's saved scenario: the command that runs it again, then the job's scenario."""
-    return f"# A run of a sweep that ended in error; to run it again:\n# vplane-mj run {saved}\n{job.toml}"
+def saved_text(saved: Path, job, planner_spec: str = "") -> str:
+    """A failed run's saved scenario: the command that runs it again (with `--planner SPEC` for a
+    planner registered in the sweep's process), then the job's scenario."""
+    rerun = f"vplane-mj run {saved}" + (f" --planner {planner_spec}" if planner_spec else "")
+    return f"# A run of a sweep that ended in error; to run it again:\n# {rerun}\n{job.toml}"
 
 
 def test_a_run_that_raises_is_an_error_row_with_its_scenario_saved_and_the_sweep_goes_on(tmp_path, capsys):
@@ -355,51 +477,56 @@ def test_a_run_that_raises_is_an_error_row_with_its_scenario_saved_and_the_sweep
     assert len((tmp_path / JOURNAL).read_text().splitlines()) == 3
 
 
-def test_a_worker_killed_mid_sweep_is_an_error_row_and_every_other_run_finishes(tmp_path):
-    process = start_bench(tmp_path)
+@pytest.mark.slow
+def test_a_worker_killed_mid_sweep_is_an_error_row_and_every_other_run_finishes(tmp_path, gate):
+    out_dir = tmp_path / "out"
+    process = start_bench(out_dir, gate)
     try:
-        wait_for_a_finished_run(tmp_path, process)
-        workers = descendants(process.pid)
-        assert len(workers) == 2, "the sweep does not have its two worker processes"
-        os.kill(min(workers), signal.SIGKILL)
+        killed = min(hold_both_workers(out_dir, gate, process))
+        os.kill(killed, signal.SIGKILL)
+        assert not wait_until_gone({killed}, seconds=30.0)
+        gate.open()  # the other held run, and those to come, go on
         out, err = process.communicate(timeout=120)
     finally:
         end_session(process)
     assert process.returncode == 0, err
-    rows = [json.loads(line) for line in (tmp_path / JOURNAL).read_text().splitlines()]
+    rows = [json.loads(line) for line in (out_dir / JOURNAL).read_text().splitlines()]
     assert sorted((r["scenario"], r["planner"], r["seed"]) for r in rows) == sorted(SWEEP_KEYS)
     [error] = [row for row in rows if row["outcome"] == "error"]
     assert error["failure"] == "worker_died" and not error["success"] and error["collisions"] == 0
     assert error["message"] == "the worker process running this run died: killed by SIGKILL"
     assert all(row["steps"] > 0 for row in rows if row is not error)  # the queued runs were not lost
-    job = next(j for j in planned_jobs(*SLOW_RUNS[1::2]) if j.key == error["key"])
-    saved = tmp_path / "failed" / f"{job.scenario}-apf-{job.seed}.toml"
-    assert error["failed_scenario"] == str(saved) and saved.read_text() == saved_text(saved, job)
-    assert [path.name for path in (tmp_path / "failed").iterdir()] == [saved.name]
-    assert f"1 of 8 runs ended in error; their scenarios are in {tmp_path / 'failed'}" in out
-    died = (
-        f"  {job.scenario}, apf, seed {job.seed}: the worker process running this run died: killed by SIGKILL"
-    )
-    assert f"{died}\n    vplane-mj run {saved}\n" in out
-    assert json.loads((tmp_path / "bench.json").read_text())["table"][0]["errors"] == 1
-    with open(tmp_path / "bench.csv", newline="") as stream:
-        table = list(csv.DictReader(stream))
-    assert sorted(row["outcome"] == "error" for row in table) == [False] * 7 + [True]
+    job = next(j for j in gated_jobs() if j.key == error["key"])
+    assert (job.scenario, job.planner) == ("open_field", "gated")  # the run the worker held
+    saved = out_dir / "failed" / f"open_field-gated-{job.seed}.toml"
+    assert error["failed_scenario"] == str(saved) and saved.read_text() == saved_text(saved, job, gate.spec)
+    assert [path.name for path in (out_dir / "failed").iterdir()] == [saved.name]
+    assert f"1 of 8 runs ended in error; their scenarios are in {out_dir / 'failed'}" in out
+    died = f"open_field, gated, seed {job.seed}: the worker process running this run died: killed by SIGKILL"
+    assert f"\n  {died}\n    vplane-mj run {saved} --planner {gate.spec}\n" in out
+    table = {line["planner"]: line for line in json.loads((out_dir / "bench.json").read_text())["table"]}
+    assert (table["apf"]["errors"], table["gated"]["errors"]) == (0, 1)
+    with open(out_dir / "bench.csv", newline="") as stream:
+        csv_rows = list(csv.DictReader(stream))
+    assert sorted(row["outcome"] == "error" for row in csv_rows) == [False] * 7 + [True]
 
     # Resuming runs nothing again.
-    again = subprocess.run(bench_command(tmp_path), capture_output=True, text=True, timeout=120)
+    again = subprocess.run(bench_command(out_dir, gate), capture_output=True, text=True, timeout=120)
     assert again.returncode == 0, again.stderr
     assert "8 runs: 8 already done, 0 to run" in again.stderr
-    assert len((tmp_path / JOURNAL).read_text().splitlines()) == 8
+    assert len((out_dir / JOURNAL).read_text().splitlines()) == 8
 
 
+@pytest.mark.slow
 def test_a_failed_dask_task_is_the_same_error_row_as_in_the_local_pool(tmp_path):
     distributed = pytest.importorskip("distributed")
     good = plan_jobs(["open_field"], ["apf"], [0])[0]
     failing = broken(good)
     (tmp_path / "local").mkdir()
     local = run_sweep([failing], tmp_path / "local", workers=1)
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True) as cluster:
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
         rows = run_sweep([good, failing], tmp_path, 1, cluster.scheduler_address)
     assert [row["outcome"] for row in rows] == ["reached", "error"]
     saved = tmp_path / "failed" / "open_field-apf-7.toml"
@@ -408,35 +535,44 @@ def test_a_failed_dask_task_is_the_same_error_row_as_in_the_local_pool(tmp_path)
     assert {**rows[1], **elsewhere} == {**local[0], **elsewhere}
 
 
-def test_a_dask_worker_that_dies_mid_run_is_an_error_row(tmp_path):
+@pytest.mark.slow
+def test_a_dask_worker_that_dies_mid_run_is_an_error_row(tmp_path, gate):
     distributed = pytest.importorskip("distributed")
     import dask
 
-    [job] = planned_jobs(*SLOW_RUNS[1::2])[:1]
+    job = next(j for j in gated_jobs() if j.planner == "gated")
+    (tmp_path / "out").mkdir()
     # No second attempt for a task whose worker died: the first death fails it (KilledWorker).
     with (
         dask.config.set({"distributed.scheduler.allowed-failures": 0}),
-        distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True) as cluster,
+        distributed.LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
         distributed.Client(cluster) as client,
     ):
         [worker_pid] = client.run(os.getpid).values()
+        killed = []
 
         def kill_the_worker_mid_run():
             deadline = time.monotonic() + 60
-            while not any(client.processing().values()) and time.monotonic() < deadline:
-                time.sleep(0.05)
-            time.sleep(0.3)
-            os.kill(worker_pid, signal.SIGKILL)
+            while gate.held() == 0 and time.monotonic() < deadline:
+                time.sleep(0.02)
+            if gate.held():
+                os.kill(worker_pid, signal.SIGKILL)
+                killed.append(worker_pid)
+            else:
+                gate.open()  # the run never got to the gate: let it end, and fail below
 
         killer = threading.Thread(target=kill_the_worker_mid_run)
         killer.start()
-        [row] = run_sweep([job], tmp_path, 1, cluster.scheduler_address)
+        [row] = run_sweep([job], tmp_path / "out", 1, cluster.scheduler_address)
         killer.join()
-    assert row["outcome"] == "error" and row["failure"] == "worker_died"
+    assert killed, "the run never reached the gate"
+    assert row["outcome"] == "error" and row["failure"] == "worker_died", row
     assert row["message"].startswith("distributed.scheduler.KilledWorker: ")
     assert "all those workers died while running it" in row["message"]
-    saved = tmp_path / "failed" / f"{job.scenario}-apf-{job.seed}.toml"
-    assert row["failed_scenario"] == str(saved) and saved.read_text() == saved_text(saved, job)
+    saved = tmp_path / "out" / "failed" / f"{job.scenario}-gated-{job.seed}.toml"
+    assert row["failed_scenario"] == str(saved) and saved.read_text() == saved_text(saved, job, gate.spec)
 
 
 FAILING_PLANNER = """

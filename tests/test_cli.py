@@ -188,9 +188,10 @@ def test_usage_error_exits_2(capsys):
     assert run_cli(capsys, "frobnicate")[0] == 2
 
 
-@pytest.mark.parametrize("launcher", [["vplane-mj"], [sys.executable, "-m", "vplane_mj"]])
-def test_installed_entry_points(launcher):
-    done = subprocess.run([*launcher, "check", "single_box"], capture_output=True, text=True, timeout=120)
+@pytest.mark.parametrize("launcher", ["script", "module"])
+def test_installed_entry_points(launcher, console_script):
+    command = [console_script("vplane-mj")] if launcher == "script" else [sys.executable, "-m", "vplane_mj"]
+    done = subprocess.run([*command, "check", "single_box"], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert "ok: single_box" in done.stdout
 

@@ -14,6 +14,8 @@ from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim.loop import run_scenario
 from vplane_mj.worlds.families import generate
 
+pytestmark = pytest.mark.slow  # a long suite: `python -m pytest -m slow` runs it
+
 RADIUS = robot_radius_m()
 
 

@@ -13,6 +13,8 @@ from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.loop import run_scenario
 from vplane_mj.sim.summary import without_timing
 
+pytestmark = pytest.mark.slow  # a long suite: `python -m pytest -m slow` runs it
+
 EVERY_FAULT = [
     "sensors.noise_std=0.02",
     "sensors.dropout=0.1",

@@ -1,4 +1,4 @@
-"""The dm_env environment (README "dm_env environment"): dm_env's own contract checks, the specs,
+"""The dm_env environment (docs/environments.md): dm_env's own contract checks, the specs,
 determinism and its seeds, the step types and discounts of every ending, and the same trajectory
 as `vplane-mj run` under the planner's own decisions."""
 
@@ -187,9 +187,10 @@ def test_bad_options_are_clear_errors():
         env.step(np.zeros(3))
 
 
-def test_the_readme_examples_run(tmp_path, monkeypatch, readme_examples, capsys):
+@pytest.mark.slow
+def test_the_documented_examples_run(tmp_path, monkeypatch, doc_examples, capsys):
     monkeypatch.chdir(tmp_path)
-    exec(compile(readme_examples("dm_env environment"), "README.md", "exec"), {})
+    exec(compile(doc_examples("environments.md", "dm_env"), "docs/environments.md", "exec"), {})
     printed_digest = capsys.readouterr().out.splitlines()[-1]
     main(["run", "paper_c_escape", "--seed", "0", "--no-log", "--no-render", "--out", str(tmp_path)])
     summary = json.loads((tmp_path / "paper_c_escape-vplane-0.json").read_text())

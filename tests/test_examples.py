@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.slow  # a long suite: `python -m pytest -m slow` runs it
+
 EXAMPLES = Path(__file__).parents[1] / "examples"
 SUMMARY_LINE = re.compile(
     r"^(?P<scenario>\w+) \[(?P<planner>\w+), seed (?P<seed>\d+)\]: (?P<outcome>\w+) after "
@@ -170,7 +172,23 @@ def test_compare_planners_sweeps_the_custom_planner_with_built_in_ones(tmp_path)
     assert png_size(tmp_path / "bench.png")[0] > 500
 
 
-def test_the_readme_drawing_example_runs(tmp_path, monkeypatch, readme_examples):
+def test_the_documented_drawing_example_runs(tmp_path, monkeypatch, doc_examples):
     monkeypatch.chdir(tmp_path)
-    exec(compile(readme_examples("Examples"), "README.md", "exec"), {})
+    exec(compile(doc_examples("python-api.md", "Examples"), "docs/python-api.md", "exec"), {})
     assert png_size(tmp_path / "paper_c_escape.png")[0] >= 600
+
+
+def test_pixel_strip_saves_both_cameras_views_of_one_episode(tmp_path):
+    stdout = run_example(
+        "pixel_strip.py", "open_field", "--frames", "3", "--size", "48", "--out", str(tmp_path)
+    )
+    line = re.search(
+        r"^open_field \[vplane, seed 0\]: reached after ([\d.]+) s simulated, (\d+) observations; "
+        r"the strip shows t = 0\.0, [\d.]+, ([\d.]+) s$",
+        stdout,
+        re.M,
+    )
+    assert line and abs(float(line[1]) - float(line[3])) <= 0.05 and int(line[2]) > 100  # the last one shown
+    (path,) = written(stdout)
+    assert png_size(path) == (3 * 64 + 2 * 4, 2 * 48 + 4)  # 3 pictures of 64 x 48 px a row, 2 rows
+    assert run_example("pixel_strip.py", "--frames", "1", expect=2).startswith("error: --frames")

@@ -9,6 +9,8 @@ from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import load_scenario
 from vplane_mj.worlds.families import BARN_CELL_M, FAMILIES, barn_cells, cell_rectangles
 
+pytestmark = pytest.mark.slow  # a long suite: `python -m pytest -m slow` runs it
+
 
 @pytest.mark.parametrize("family", ["traps", "clutter", "corridors", "barn"])
 def test_a_family_is_deterministic_valid_and_solvable(tmp_path, capsys, family):

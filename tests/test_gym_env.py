@@ -1,4 +1,4 @@
-"""The Gymnasium environment (README "Gymnasium environment"): Gymnasium's checks, determinism,
+"""The Gymnasium environment (docs/environments.md): Gymnasium's checks, determinism,
 the reward and endings, and the same trajectory as `vplane-mj run` under the planner's own decisions."""
 
 import json
@@ -27,6 +27,7 @@ def episode(env, actions, seed):
     return steps
 
 
+@pytest.mark.slow
 def test_gymnasium_checks_pass_for_both_kinds_of_action():
     made = gymnasium.make(ENV_ID, scenario="single_box")
     check_env(made.unwrapped)
@@ -111,9 +112,10 @@ def test_bad_options_are_clear_errors():
         VPlaneNavEnv("single_box", overrides=["sensors.dropout=2"])
 
 
-def test_the_readme_examples_run(tmp_path, monkeypatch, readme_examples, capsys):
+@pytest.mark.slow
+def test_the_documented_examples_run(tmp_path, monkeypatch, doc_examples, capsys):
     monkeypatch.chdir(tmp_path)
-    exec(compile(readme_examples("Gymnasium environment"), "README.md", "exec"), {})
+    exec(compile(doc_examples("environments.md", "Gymnasium"), "docs/environments.md", "exec"), {})
     printed_digest = capsys.readouterr().out.splitlines()[-1]
     main(["run", "paper_c_escape", "--seed", "0", "--no-log", "--no-render", "--out", str(tmp_path)])
     summary = json.loads((tmp_path / "paper_c_escape-vplane-0.json").read_text())

@@ -459,6 +459,7 @@ def count_rejection(code: int, err: str, source: str, touched: list[str], tally:
     event("rejected")
 
 
+@pytest.mark.slow
 def test_check_accepts_or_rejects_fuzzed_scenarios_cleanly(capsys):
     """`check` on mutated scenario files: ok (exit 0), or exit 2 naming a key path the mutation explains."""
     tally: Counter = Counter()
@@ -482,6 +483,7 @@ def test_check_accepts_or_rejects_fuzzed_scenarios_cleanly(capsys):
     assert tally["accepted"] > 0 and tally["rejected"] > 0
 
 
+@pytest.mark.slow
 def test_run_accepts_or_rejects_fuzzed_scenarios_cleanly(capsys):
     """`run` on mutated files: a finished run (exit 0/1, its summary) or exit 2 with nothing written."""
     tally: Counter = Counter()
@@ -631,6 +633,7 @@ def override_lists(draw) -> tuple[list[str], list[str]]:
     return texts, touched
 
 
+@pytest.mark.slow
 def test_run_accepts_or_rejects_fuzzed_overrides_cleanly(capsys):
     """`run --set ...`: a finished run, or exit 2 naming the override's key path, and nothing written."""
     tally: Counter = Counter()
@@ -768,6 +771,7 @@ def test_a_thousand_obstacles_run_and_have_a_reference_path():
     assert straight - 0.15 <= summary.optimal_length_m <= 1.1 * straight
 
 
+@pytest.mark.slow
 def test_a_100_m_arena_runs_and_its_reference_path_stays_small():
     """100 x 100 m, a 90 m wall to go round: the reference grid is bounded in memory (and time)."""
     wall = {"kind": "wall", "from": [0.0, 50.0], "to": [90.0, 50.0], "thickness": 0.2}

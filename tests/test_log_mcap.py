@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
+import importlib.util
 import itertools
 import json
 import math
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -37,7 +37,8 @@ from vplane_mj.planning.events import Event, EventKind
 from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import load_scenario, parse_scenario
 from vplane_mj.sim.loop import run_scenario
-from vplane_mj.sim.world import OBSTACLE_HEIGHT_M, SonarLayout
+from vplane_mj.sim.sensors import scan_bearings
+from vplane_mj.sim.world import OBSTACLE_HEIGHT_M
 
 TIME_LIMIT_S = 12.0  # vplane detects the trap at ~5.5 s and finishes its escape at ~10.5 s
 
@@ -69,7 +70,7 @@ class Recorder:
 
 
 def make_log(path: Path, scenario, metadata=None) -> McapLog:
-    bearings = SonarLayout.from_spec(scenario.sensors).bearings
+    bearings = scan_bearings(scenario)
     return McapLog(path, scenario, bearings, metadata or {})
 
 
@@ -388,7 +389,7 @@ _CHILD = textwrap.dedent(
     from vplane_mj.robots.facts import robot_radius_m
     from vplane_mj.scenario import load_scenario
     from vplane_mj.sim.loop import run_scenario
-    from vplane_mj.sim.world import SonarLayout
+    from vplane_mj.sim.sensors import scan_bearings
 
     class Slow:  # keep the run going until it is killed
         def on_tick(self, tick):
@@ -397,7 +398,7 @@ _CHILD = textwrap.dedent(
             pass
 
     scenario = load_scenario("paper_c_escape", ["run.time_limit_s=300"])
-    bearings = SonarLayout.from_spec(scenario.sensors).bearings
+    bearings = scan_bearings(scenario)
     log = McapLog(Path(sys.argv[1]), scenario, bearings, {})
     run_scenario(scenario, observers=(log, Slow()))
     log.close()
@@ -493,9 +494,10 @@ def test_cylinders_no_border_and_a_planner_without_virtual_parts(scenario_from, 
     assert len(contents.times_ns) == len(result.times) + 1 and contents.complete
 
 
-@pytest.mark.skipif(shutil.which("pymcap-cli") is None, reason="pymcap-cli is not installed")
-def test_pymcap_cli_doctor_accepts_the_file(run):
-    done = subprocess.run(["pymcap-cli", "doctor", str(run["path"])], capture_output=True, text=True)
+@pytest.mark.skipif(importlib.util.find_spec("pymcap_cli") is None, reason="pymcap-cli is not installed")
+def test_pymcap_cli_doctor_accepts_the_file(run, console_script):
+    command = [console_script("pymcap-cli"), "doctor", str(run["path"])]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stdout + done.stderr
 
 

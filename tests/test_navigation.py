@@ -6,14 +6,14 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
 
 from vplane_mj.geometry import shapes
 from vplane_mj.planning.events import EventKind
 from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim.loop import run_scenario
 from vplane_mj.worlds.families import cup_case, rotated, trap_suite
+
+pytestmark = pytest.mark.slow  # a long suite: `python -m pytest -m slow` runs it
 
 PAPER = ["paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape"]
 
@@ -91,12 +91,31 @@ def test_trap_suite_vplane_succeeds_where_apf_is_trapped():
     assert rate["apf"] <= 0.1
 
 
-@settings(max_examples=4, deadline=None)
-@given(st.floats(min_value=0.0, max_value=360.0))
-def test_a_rotated_trap_gives_the_same_outcome(angle):
+ROTATIONS_DEG = (37.0, 128.0, 211.0, 302.0)
+"""Turns of the whole trap case about the arena's centre (deg), none a multiple of 90."""
+
+
+@pytest.fixture(scope="module")
+def unrotated_trap():
+    """The U trap case with its mouth toward the start, and its run's summary."""
     case = cup_case("u_front", 0.0)
-    base = run_scenario(parse_scenario(case.toml(), "base.toml")).summary
-    turned = run_scenario(parse_scenario(rotated(case, angle).toml(), "rotated.toml")).summary
+    return case, run_scenario(parse_scenario(case.toml(), "base.toml")).summary
+
+
+def heading_deg(scenario) -> float:
+    """The direction from the start to the goal (deg)."""
+    (x0, y0), (x1, y1) = scenario.robot.start, scenario.robot.goal
+    return math.degrees(math.atan2(y1 - y0, x1 - x0))
+
+
+@pytest.mark.parametrize("angle", ROTATIONS_DEG)
+def test_a_rotated_trap_gives_the_same_outcome(unrotated_trap, angle):
+    case, base = unrotated_trap
+    scenario = parse_scenario(rotated(case, angle).toml(), "rotated.toml")
+    turn = heading_deg(scenario) - heading_deg(parse_scenario(case.toml(), "base.toml"))
+    assert math.isclose(turn % 360.0, angle, abs_tol=1e-4)  # the case is turned, start and goal too
+    assert scenario.world.obstacles[0].yaw == pytest.approx(math.radians(angle))
+    turned = run_scenario(scenario).summary
     assert base.success and turned.success
     assert turned.escapes == base.escapes
     assert turned.path_length_m == pytest.approx(base.path_length_m, rel=0.2)

@@ -79,6 +79,7 @@ def test_a_missing_or_foreign_log_is_a_clear_error(tmp_path, capsys, content):
     assert not (tmp_path / "x.png").exists()
 
 
+@pytest.mark.slow
 def test_plot_from_the_log(tmp_path, capsys):
     run_logged(tmp_path, capsys, "paper_c_escape")
     target = tmp_path / "plot.png"
@@ -91,6 +92,7 @@ def test_plot_from_the_log(tmp_path, capsys):
     assert main(["plot", log, "-o", str(tmp_path / "missing" / "x.png")]) == 2
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("planner", ["vfh", "bug2", "dwa"])
 def test_plot_of_a_planner_without_a_potential_field(tmp_path, capsys, planner):
     """The field panel falls back to APF's gains for planners that have none of their own."""

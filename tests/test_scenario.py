@@ -559,9 +559,23 @@ def test_local_scenarios_folder_comes_first(builtin_dir):
     assert load_scenario("alpha_one").name == "local_copy"
 
 
+SHIPPED = [
+    "corridor",
+    "open_field",
+    "paper_c_avoid",
+    "paper_c_escape",
+    "paper_h_avoid",
+    "paper_h_escape",
+    "single_box",
+]
+"""The scenarios the package ships (docs/scenarios.md), sorted by name."""
+
+
 def test_shipped_scenarios_all_validate():
-    names = [name for name, _ in builtin_scenarios()]
-    assert names == sorted(names)
+    listed = builtin_scenarios()
+    assert [name for name, _ in listed] == SHIPPED
+    assert all(description for _, description in listed)
+    assert [load_scenario(name).name for name in SHIPPED] == SHIPPED  # each validated, as any file
 
 
 # --------------------------------------------------------------------------- overrides

@@ -33,12 +33,24 @@ def decode(path) -> tuple[dict, list[np.ndarray]]:
     return meta, frames
 
 
+def decode_size(path) -> tuple[int, int]:
+    """The (width, height) of a video's frames (px)."""
+    reader = imageio_ffmpeg.read_frames(str(path))
+    try:
+        return next(reader)["size"]
+    finally:
+        reader.close()
+
+
+@pytest.mark.slow
 def test_run_writes_an_h264_mp4_in_real_time_beside_the_log(logged, capsys):
     video = logged / "paper_c_escape-vplane-0.mp4"
     assert video.is_file() and not list(logged.glob(".*partial"))
     meta, frames = decode(video)
     assert meta["codec"].startswith("h264") and meta["fps"] == 25
-    assert meta["size"] == (720, meta["size"][1]) and meta["size"][1] % 2 == 0
+    width, height = meta["size"]
+    assert width == 720 and height % 2 == 0  # even, as H.264 wants
+    assert 0.6 * width < height < 1.8 * width  # title, caption and the plot at an aspect of 0.5 to 1.6
     assert len(frames) == TIME_LIMIT_S * 25 + 1 + 25  # every 40 ms of the run, then a 1 s hold
     first, last = frames[0].astype(int), frames[-1].astype(int)
     assert np.abs(first - last).mean() > 0.5  # the robot moved and the path grew
@@ -47,6 +59,7 @@ def test_run_writes_an_h264_mp4_in_real_time_beside_the_log(logged, capsys):
     assert orange > 20  # sonar echoes
 
 
+@pytest.mark.slow
 def test_gif_at_a_speed(logged, capsys, tmp_path):
     target = tmp_path / "run.gif"
     log = logged / "paper_c_escape-vplane-0.mcap"
@@ -54,6 +67,8 @@ def test_gif_at_a_speed(logged, capsys, tmp_path):
     assert f"wrote {target}" in capsys.readouterr().out
     with Image.open(target) as gif:
         assert gif.format == "GIF" and gif.size[0] == 480
+        mp4_width, mp4_height = decode_size(logged / "paper_c_escape-vplane-0.mp4")
+        assert gif.size[1] == pytest.approx(mp4_height * 480 / mp4_width, abs=2)  # the same picture
         frames = gif.n_frames
         assert gif.info.get("loop") == 0 and gif.info.get("duration") == 100
     assert frames == TIME_LIMIT_S / 3 * 10 + 1 + 10

@@ -100,6 +100,7 @@ def test_a_plane_never_spans_a_gap_the_robot_fits_through():
     assert float(box.distance(span).min()) > 2 * RADIUS  # and not on to the box
 
 
+@pytest.mark.slow
 def test_no_giving_up_while_the_map_shows_a_way():
     """Held still in the cup, escape after escape fails: the planner follows the map's way
     instead of giving up, and its way leaves through the mouth."""
@@ -112,6 +113,7 @@ def test_no_giving_up_while_the_map_shows_a_way():
     assert min(point[0] for point in planner.follow_way) < 4.4 - RADIUS  # out through the mouth
 
 
+@pytest.mark.slow
 def test_it_gives_up_when_the_map_holds_no_way():
     closed = """
 [[world.obstacles]]

@@ -1,6 +1,6 @@
 """vplane-mj: artificial potential fields and the virtual-plane escape from local minima in MuJoCo.
 
-The Python API (README "Python API"): `load_scenario` and `build_scenario` (with the obstacle
+The Python API (docs/python-api.md): `load_scenario` and `build_scenario` (with the obstacle
 helpers `box`, `wall`, `cylinder`, `cup`, `h_shape`), `run` and `sweep`. Each name is imported
 on first use, so `import vplane_mj` loads neither MuJoCo nor any plotting or OpenGL library.
 

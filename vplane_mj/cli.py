@@ -1,4 +1,4 @@
-"""The `vplane-mj` command line (README "Commands"). `main(argv) -> exit status`."""
+"""The `vplane-mj` command line (docs/command-line.md). `main(argv) -> exit status`."""
 
 from __future__ import annotations
 

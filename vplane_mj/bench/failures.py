@@ -13,6 +13,7 @@ from __future__ import annotations
 import re
 import shlex
 import signal
+import tomllib
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
@@ -21,6 +22,7 @@ from vplane_mj import __version__
 from vplane_mj.bench.job import Job
 from vplane_mj.files import write_atomically
 from vplane_mj.planning.registry import command_line_spec
+from vplane_mj.robots.profiles import PROFILES
 from vplane_mj.sim.failure import FailureKind, RunFailure, failure_of
 from vplane_mj.sim.summary import Outcome, RunSummary
 
@@ -62,12 +64,17 @@ def _signal_name(number: int) -> str:
 
 
 def error_row(job: Job, failure: RunFailure) -> dict[str, Any]:
-    """The sweep's row for a job that ended in `failure`: a summary with outcome `error`."""
+    """The sweep's row for a job that ended in `failure`: a summary with outcome `error`, of the
+    job's robot and sensor."""
+    document = tomllib.loads(job.toml)
+    profile = document.get("robot", {}).get("profile", "default")
     summary = RunSummary(
         scenario=job.scenario,
         planner=job.planner,
         seed=job.seed,
         outcome=Outcome.ERROR,
+        robot_profile=profile,
+        sensor_kind=document.get("sensors", {}).get("kind", PROFILES[profile].sensors["kind"]),
         score=0.0,  # not a success: it counts against the planner's mean score
         message=failure.message,
         version=__version__,

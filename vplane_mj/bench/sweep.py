@@ -181,6 +181,11 @@ def _ends_with_a_newline(path: Path) -> bool:
         return stream.read(1) == b"\n"
 
 
+SCHEDULER_TIMEOUT_S = 5.0
+"""How long a sweep tries to reach its Dask scheduler (s); Dask retries until then, even a
+refused connection."""
+
+
 def _dask_results(jobs: list[Job], scheduler: str) -> Generator[tuple[Job, dict | RunFailure], None, None]:
     """Jobs with their rows or failures as the workers of a Dask distributed cluster finish
     them (the [dask] extra).
@@ -194,7 +199,7 @@ def _dask_results(jobs: list[Job], scheduler: str) -> Generator[tuple[Job, dict 
     except ImportError as exc:
         raise VPlaneError("--scheduler needs Dask: pip install 'vplane-mj[dask]'") from exc
     try:
-        client = Client(scheduler, timeout=5)
+        client = Client(scheduler, timeout=SCHEDULER_TIMEOUT_S)
     except OSError as exc:
         raise VPlaneError(f"--scheduler: cannot reach a Dask scheduler at {scheduler}: {exc}") from exc
 

@@ -1,11 +1,16 @@
 """Reinforcement-learning environments over the run loop: the navigation task they share
-(`task`), Gymnasium's `VPlaneNavEnv` (`gym_env`) and dm_env's `VPlaneNavDmEnv` (`dm_environment`).
-Each is imported on first use (Gymnasium is an optional extra)."""
+(`task`), Gymnasium's `VPlaneNavEnv` (`gym_env`) and dm_env's `VPlaneNavDmEnv` (`dm_environment`)
+on dm_control's Physics (`physics`), and `PlannerPolicy` (`policy`), a planner as a dm_env
+policy. Each is imported on first use (Gymnasium is an optional extra)."""
 
 import importlib
 from typing import Any
 
-_EXPORTS = {"VPlaneNavEnv": "vplane_mj.envs.gym_env", "VPlaneNavDmEnv": "vplane_mj.envs.dm_environment"}
+_EXPORTS = {
+    "VPlaneNavEnv": "vplane_mj.envs.gym_env",
+    "VPlaneNavDmEnv": "vplane_mj.envs.dm_environment",
+    "PlannerPolicy": "vplane_mj.envs.policy",
+}
 __all__ = sorted(_EXPORTS)
 
 

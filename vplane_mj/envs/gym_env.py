@@ -5,7 +5,7 @@ One `step` is one control tick of `vplane_mj.sim.loop.Run`: the action takes the
 planner's decision, then the run senses again (`vplane_mj.envs.task`, which the dm_env
 environment shares). Importing this module registers the environment as ENV_ID, so
 `gymnasium.make("vplane_mj/Navigation-v0")` builds it. The spaces, the reward and the ending
-of an episode are those of the README's "Gymnasium environment".
+of an episode are those of docs/environments.md.
 """
 
 from __future__ import annotations
@@ -68,7 +68,7 @@ class VPlaneNavEnv(gymnasium.Env):
         and is the run's `run.seed` (sensor noise and faults), as `vplane-mj run --seed SEED`."""
         super().reset(seed=seed)
         episode_seed = seed if seed is not None else int(self.np_random.integers(2**31))
-        return self.task.begin(episode_seed)
+        return self.task.begin(self.task.episode_scenario(episode_seed))
 
     def step(self, action: np.ndarray) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         """One control tick with `action` in place of the planner's decision."""

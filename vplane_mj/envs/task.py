@@ -15,18 +15,21 @@ import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from vplane_mj.errors import VPlaneError
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.robots.facts import SONAR_MOUNT_RADIUS_M
-from vplane_mj.robots.profiles import ControllerGains
+from vplane_mj.robots.profiles import PROFILES, ControllerGains
 from vplane_mj.scenario import MAX_ARENA_M, Scenario, load_scenario, parse_scenario
 from vplane_mj.sim.loop import Run
 from vplane_mj.sim.summary import Outcome
 from vplane_mj.worlds.families import FAMILIES, Case, generate
+
+if TYPE_CHECKING:
+    import mujoco
 
 ACTIONS = ("force", "velocity")
 """What an action is: a planner's force (world frame), or a body speed and turn rate."""
@@ -126,8 +129,10 @@ class NavigationTask:
         self.action = action
         self.reward_weights = reward or Reward()
         self.expose_observation = expose_observation
-        self.gains = ControllerGains()
-        sensors = self.episode_scenario(0).sensors  # the overrides checked now; the ring is every episode's
+        first = self.episode_scenario(0)  # the overrides checked now; robot and ring are every episode's
+        self.gains: ControllerGains = PROFILES[first.robot.profile].gains
+        """The robot's controller limits, which bound a `velocity` action."""
+        sensors = first.sensors
         self.sonar_count = sensors.count
         self.reach_m = sensors.range_max + SONAR_MOUNT_RADIUS_M
         """A sonar's reach from the robot's centre (m): what `ranges` reads where there is no echo."""
@@ -140,6 +145,12 @@ class NavigationTask:
     def over(self) -> bool:
         """No episode goes on: none has begun, the last one has ended, or the task was closed."""
         return self._observation is None
+
+    @property
+    def observation(self) -> Observation | None:
+        """What the scenario's planner would see on the tick that goes on (None when no episode
+        goes on): the Observation a policy made of a planner decides on."""
+        return self._observation
 
     @property
     def _episode_run(self) -> Run:
@@ -159,10 +170,13 @@ class NavigationTask:
         case = family_case(self.family, episode_seed)
         return parse_scenario(case.toml(), case.name, overrides)
 
-    def begin(self, episode_seed: int) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
-        """Start the episode of `episode_seed` (see `episode_scenario`); its first observation and info."""
-        scenario = self.episode_scenario(episode_seed)
-        self.run = Run(scenario, external=True)
+    def begin(
+        self, scenario: Scenario, physics: tuple[mujoco.MjModel, mujoco.MjData] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        """Start an episode of `scenario` (one that `episode_scenario` made); its first observation
+        and info. `physics`: the fresh model and data of its world to step (see `Run`), when
+        another owner holds them (dm_control's Physics); by default the run builds its own."""
+        self.run = Run(scenario, external=True, physics=physics)
         self._distance = self._true_distance()
         self._collisions = 0
         self._observation = self.run.observe()
@@ -196,7 +210,7 @@ class NavigationTask:
 
     # -- the bounds of observations and actions ----------------------------------------------
     def observation_bounds(self) -> dict[str, Bounds]:
-        """Each entry of the observation (see `_agent_observation`; units in the README)."""
+        """Each entry of the observation (see `_agent_observation`; units in docs/environments.md)."""
         count, speed_turn = self.sonar_count, np.array(VELOCITY_BOUND)
         return {
             "ranges": Bounds.box((count,), np.float32, 0.0, self.reach_m),

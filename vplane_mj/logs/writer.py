@@ -1,4 +1,4 @@
-"""The MCAP log of one run (docs/interface.md section 4, README "Replaying a run in Foxglove"),
+"""The MCAP log of one run (docs/interface.md section 4, docs/foxglove.md),
 written with foxglove-sdk (the scene drawn by `log_scene`, read back by `log_read`).
 
 Writing: `McapLog` is an `Observer` of `run_scenario`. It owns a private

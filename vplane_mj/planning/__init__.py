@@ -1,7 +1,7 @@
 """Planning: numpy (numba for a laser's map update), no MuJoCo. What a planner receives each
 control tick and what it answers.
 
-The names for writing a planner of one's own (README, "Your own planner"):
+The names for writing a planner of one's own (docs/own-planner.md):
 
 - `Planner`: the base class (name, summary, citation, Params; `step(obs) -> Decision`);
 - `RobotBody`, `DriveLimits`, `HeadingGains`: the robot a planner is built for (footprint,

@@ -95,7 +95,7 @@ def build_scenario(
     `size`, `start` and `goal` are `world.size`, `robot.start` and `robot.goal` (m);
     `robot` holds the further `[robot]` keys (`start_yaw_deg`, `goal_tolerance`, the faults),
     `planner` and `planner_params` the `[planner]` table, `sensors` and `run` those tables
-    (key for key as in a file, see the README's "Scenario files"); `overrides` are `--set`
+    (key for key as in a file, see docs/scenarios.md); `overrides` are `--set`
     strings applied after. `Scenario.to_toml()` gives the file that loads back equal.
     """
     try:

@@ -1,7 +1,7 @@
 """Every key a scenario file may hold, as data: its type, bounds and where its value goes.
 
-The contract these tables encode is docs/interface.md section 1 (and the README's
-"Scenario files" for the further keys); `fields.py` is the engine that applies them.
+The contract these tables encode is docs/interface.md section 1 (and docs/scenarios.md
+for the further keys); `fields.py` is the engine that applies them.
 Lengths in metres, times in seconds, angles in degrees in the file (radians once read).
 """
 

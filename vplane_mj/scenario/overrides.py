@@ -1,4 +1,4 @@
-"""`--set KEY=VALUE` overrides applied to a parsed scenario document (README "Commands").
+"""`--set KEY=VALUE` overrides applied to a parsed scenario document (docs/command-line.md).
 
 A key is a dotted path with optional indices (`world.obstacles[0].yaw_deg`, or
 `world.obstacles.0.yaw_deg`); a value is a TOML value, or a bare string when it is not

@@ -127,14 +127,24 @@ class RunResult:
 class Run:
     """One run of a scenario, a control tick at a time (see the module docstring)."""
 
-    def __init__(self, scenario: Scenario, observers: tuple[Observer, ...] = (), external: bool = False):
+    def __init__(
+        self,
+        scenario: Scenario,
+        observers: tuple[Observer, ...] = (),
+        external: bool = False,
+        physics: tuple[mujoco.MjModel, mujoco.MjData] | None = None,
+    ):
         """`external`: the decisions come from outside through `observe` and `apply` (a learned
         policy, say), not from the scenario's planner, which is then not made; the summary
-        names the planner EXTERNAL_PLANNER."""
+        names the planner EXTERNAL_PLANNER. `physics`: the model and data to step, when another
+        owner holds them (dm_control's Physics, say); built from the scenario, without
+        rangefinders (`world.build_model`), and fresh; by default the run builds its own."""
         self.scenario = scenario
         self.observers = observers
-        self.model = build_model(scenario, rangefinders=False)
-        self.data = mujoco.MjData(self.model)
+        if physics is None:
+            physics = build_model(scenario, rangefinders=False), None
+        self.model = physics[0]
+        self.data = physics[1] if physics[1] is not None else mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
         profile = scenario.robot.profile
         self.drive = Drive(self.model, self.data, scenario.run.control_hz, profile)

@@ -31,7 +31,7 @@ class Outcome(StrEnum):
 @dataclass(frozen=True)
 class RunSummary:
     """The `.json` summary of one run; field for field the keys of docs/interface.md section 3
-    and the README's table, in the order they are written."""
+    and docs/outputs.md's table, in the order they are written."""
 
     scenario: str
     planner: str

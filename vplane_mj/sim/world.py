@@ -4,8 +4,10 @@ The robot is its profile's model (`vplane_mj.robots.profiles`, models/*.xml). El
 predictable: obstacle geoms are `obstacle<i>_<part>` (parts per kind in PART_NAMES) and
 border walls `border_<side>`, all in the static body `obstacles`; sonar ray sites are
 `robot/sonar<k>_ray<j>`, in order, so their poses are contiguous, and so are the readings of
-the rangefinders of the same names. A laser is not a MuJoCo sensor: `vplane_mj.sim.laser` casts
-it in 2D against the same pieces the obstacles are built from.
+the rangefinders of the same names. The cameras are `top` (above the arena) and `robot/chase`
+(behind the robot); the site `goal` marks the goal (a disc of the goal tolerance on the floor,
+seen by cameras only: sites neither collide nor stop rays). A laser is not a MuJoCo sensor:
+`vplane_mj.sim.laser` casts it in 2D against the same pieces the obstacles are built from.
 """
 
 from __future__ import annotations
@@ -38,8 +40,18 @@ PART_NAMES: dict[type, tuple[str, ...]] = {
 BORDER_SIDES = ("west", "east", "south", "north")
 RENDER_PIXELS = 800
 """Longest side (px) of the offscreen buffer that the top camera renders into."""
+TOP_CAMERA = "top"
+"""The orthographic camera above the arena that frames it whole (the renders' camera)."""
+CHASE_CAMERA = "chase"
+"""The camera that follows the robot (named `robot/chase` in the world)."""
+CHASE_BACK_M, CHASE_UP_M, CHASE_PITCH_DEG = 1.2, 0.9, 35.0
 SONAR_SITE_SIZE_M = 0.004
 SONAR_SITE_RGBA = (0.1, 0.7, 0.2, 0.6)
+GOAL_SITE = "goal"
+GOAL_SITE_RGBA = (0.95, 0.75, 0.0, 1.0)
+GOAL_SITE_HALF_HEIGHT_M = 0.002
+CAMERA_MARGIN_M = 2 * shapes.BORDER_THICKNESS_M + 0.1
+"""What the top camera shows around the arena on each axis (m): the border and a little floor."""
 
 
 @dataclass(frozen=True)
@@ -91,6 +103,7 @@ def build_spec(scenario: Scenario, rangefinders: bool = True) -> mujoco.MjSpec:
     arena = mujoco.MjSpec.from_file(str(model_path("arena.xml")))
     arena.option.timestep = scenario.run.physics_dt_s
     _size_camera(arena, scenario.world.size)
+    _add_goal_marker(arena, scenario.robot)
     statics = arena.worldbody.add_body(name=OBSTACLES_BODY)
     if scenario.world.border:
         for side, rect in zip(BORDER_SIDES, shapes.border_footprint(scenario.world.size), strict=True):
@@ -121,6 +134,7 @@ def build_spec(scenario: Scenario, rangefinders: bool = True) -> mujoco.MjSpec:
         name=ROBOT_PREFIX, pos=[x, y, 0.0], quat=[math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]
     )
     mount.add_freejoint(name=ROBOT_PREFIX)
+    _add_chase_camera(robot)
     arena.attach(robot, prefix=ROBOT_PREFIX, frame=mount.add_frame())
     return arena
 
@@ -136,16 +150,47 @@ def standalone_xml(scenario: Scenario) -> str:
     return build_spec(scenario).to_xml()
 
 
+def _add_chase_camera(robot: mujoco.MjSpec) -> None:
+    """A camera that follows the robot from behind and above, looking ahead and down
+    (`robot/chase`): CHASE_BACK_M behind base_link, CHASE_UP_M above it, pitched CHASE_PITCH_DEG
+    below the horizon. A camera looks along its -z, its image's x and y being its own."""
+    pitch = math.radians(CHASE_PITCH_DEG)
+    right = [0.0, -1.0, 0.0]  # the image's x: the robot's right
+    up = [math.sin(pitch), 0.0, math.cos(pitch)]  # the image's y: up, leaning ahead
+    camera = robot.body(BASE_BODY).add_camera(
+        name=CHASE_CAMERA, mode=mujoco.mjtCamLight.mjCAMLIGHT_FIXED, pos=[-CHASE_BACK_M, 0.0, CHASE_UP_M]
+    )
+    camera.fovy = 60.0
+    camera.alt.type = mujoco.mjtOrientation.mjORIENTATION_XYAXES
+    camera.alt.xyaxes = right + up
+
+
+def top_view_extent(size: tuple[float, float]) -> tuple[float, float]:
+    """The width and height (m) of the floor the top camera frames: the arena of `size` (m)
+    with CAMERA_MARGIN_M around it."""
+    return size[0] + CAMERA_MARGIN_M, size[1] + CAMERA_MARGIN_M
+
+
 def _size_camera(arena: mujoco.MjSpec, size: tuple[float, float]) -> None:
     """Centre the orthographic top camera on the arena and fit the arena plus its border."""
-    w, h = size
-    margin = 2 * shapes.BORDER_THICKNESS_M + 0.1
-    camera = arena.camera("top")
-    camera.pos = [w / 2, h / 2, 20.0]
-    camera.fovy = h + margin  # orthographic: the vertical extent in metres
-    scale = RENDER_PIXELS / max(w + margin, h + margin)
-    arena.visual.global_.offwidth = max(64, round((w + margin) * scale))
-    arena.visual.global_.offheight = max(64, round((h + margin) * scale))
+    width, height = top_view_extent(size)
+    camera = arena.camera(TOP_CAMERA)
+    camera.pos = [size[0] / 2, size[1] / 2, 20.0]
+    camera.fovy = height  # orthographic: the vertical extent in metres
+    scale = RENDER_PIXELS / max(width, height)
+    arena.visual.global_.offwidth = max(64, round(width * scale))
+    arena.visual.global_.offheight = max(64, round(height * scale))
+
+
+def _add_goal_marker(arena: mujoco.MjSpec, robot: RobotSpec) -> None:
+    """The site GOAL_SITE: a flat disc of the goal tolerance's radius lying on the floor at the goal."""
+    site = arena.worldbody.add_site(
+        name=GOAL_SITE,
+        type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+        pos=[*robot.goal, GOAL_SITE_HALF_HEIGHT_M],
+        rgba=list(GOAL_SITE_RGBA),
+    )
+    site.size = [robot.goal_tolerance, GOAL_SITE_HALF_HEIGHT_M, 0.0]
 
 
 def _add_piece(body: mujoco.MjsBody, name: str, piece: shapes.Piece, material: str) -> None:

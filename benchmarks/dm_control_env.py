@@ -1,0 +1,147 @@
+"""What dm_control costs and saves in the dm_env environment (docs/environments.md).
+
+1. A step of `VPlaneNavDmEnv` on a scenario, plain and through dm_control's pixel wrapper with
+   each camera at two image sizes: medians over `--steps` steps (velocity actions on an arc).
+2. A `reset`: the dm_env environment's (its world built and wrapped in dm_control's Physics)
+   against the shared task's begin without a Physics (the Gymnasium environment's).
+3. Building and compiling a world: with MuJoCo's MjSpec (`vplane_mj.sim.world.build_model`, what
+   a run does) and with `dm_control.mjcf` (the arena and robot files parsed, the obstacles, the
+   border and the sonar sites added, the robot attached, the XML compiled; without the bump
+   sensor, camera sizing, goal marker and motor faults, which favours mjcf).
+
+    python benchmarks/dm_control_env.py [SCENARIO] [--steps 200] [--repeat 20]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import statistics
+import sys
+import time
+from collections.abc import Callable
+
+import mujoco
+import numpy as np
+
+import vplane_mj  # before dm_control: OSMesa unless MUJOCO_GL is set
+from vplane_mj.envs import VPlaneNavDmEnv
+from vplane_mj.envs.task import NavigationTask
+from vplane_mj.files import model_path
+from vplane_mj.geometry import shapes
+from vplane_mj.robots.facts import BASE_BODY
+from vplane_mj.robots.profiles import PROFILES
+from vplane_mj.scenario import Scenario, load_scenario
+from vplane_mj.sim.world import BORDER_SIDES, OBSTACLE_HEIGHT_M, SonarLayout, build_model
+
+# isort: split
+from dm_control import mjcf
+from dm_control.suite.wrappers import pixels
+
+SIZES = ((84, 84), (240, 320))
+"""(height, width) of the pixel observations timed (px)."""
+
+
+def median_ms(action: Callable[[], object], repeat: int) -> float:
+    """Median wall time (ms) of `repeat` calls of `action`, after one untimed call."""
+    action()
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        action()
+        times.append(time.perf_counter() - start)
+    return 1e3 * statistics.median(times)
+
+
+def step_table(scenario: str, steps: int) -> None:
+    """A step's median wall time, plain and with each camera's pixels at each size."""
+    print("| environment | step ms |\n|---|---:|")
+    with VPlaneNavDmEnv(scenario, action="velocity") as env:
+        views = [("no pixels", env)]
+        for camera in ("top", "robot/chase"):
+            for height, width in SIZES:
+                view = pixels.Wrapper(
+                    env, render_kwargs={"height": height, "width": width, "camera_id": camera}
+                )
+                views.append((f"pixels {camera} {height} x {width}", view))
+        arc = np.array([0.3, 0.4])
+        for name, view in views:
+            view.reset()
+            print(f"| {name} | {median_ms(lambda view=view: view.step(arc), steps):.2f} |")
+            sys.stdout.flush()
+
+
+def reset_table(scenario: str, repeat: int) -> None:
+    """A reset with dm_control's Physics against the task's begin without one."""
+    with VPlaneNavDmEnv(scenario) as env:
+        with_physics = median_ms(env.reset, repeat)
+    task = NavigationTask(scenario)
+    without = median_ms(lambda: task.begin(task.episode_scenario(0)), repeat)
+    print(f"\n| reset | ms |\n|---|---:|\n| dm_env, with a Physics | {with_physics:.1f} |")
+    print(f"| the task's begin, without | {without:.1f} |")
+
+
+def mjcf_model(scenario: Scenario) -> mujoco.MjModel:
+    """The scenario's world built with dm_control.mjcf and compiled (see the module docstring)."""
+    arena = mjcf.from_path(str(model_path("arena.xml")))
+    arena.option.timestep = scenario.run.physics_dt_s
+    statics = arena.worldbody.add("body", name="obstacles")
+    half_z = OBSTACLE_HEIGHT_M / 2
+    pieces = []
+    if scenario.world.border:
+        border = shapes.border_footprint(scenario.world.size)
+        pieces += [
+            (f"border_{side}", piece, "border") for side, piece in zip(BORDER_SIDES, border, strict=True)
+        ]
+    for index, obstacle in enumerate(scenario.world.obstacles):
+        pieces += [
+            (f"obstacle{index}_{k}", piece, "obstacle") for k, piece in enumerate(obstacle.footprint())
+        ]
+    for name, piece, material in pieces:
+        if isinstance(piece, shapes.Disc):
+            shape = {"type": "cylinder", "size": [piece.radius, half_z], "pos": [*piece.center, half_z]}
+        else:
+            shape = {"type": "box", "size": [*piece.half, half_z], "pos": [*piece.center, half_z]}
+            shape["euler"] = [0.0, 0.0, piece.yaw]
+        statics.add("geom", name=name, material=material, **shape)
+    robot = mjcf.from_path(str(model_path(PROFILES[scenario.robot.profile].model_file)))
+    base = robot.find("body", BASE_BODY)
+    layout = SonarLayout.from_spec(scenario.sensors, scenario.robot.profile)
+    for k, bearing in enumerate(layout.bearings):
+        for j, offset in enumerate(layout.ray_offsets):
+            ray = [math.cos(bearing + offset), math.sin(bearing + offset), 0.0]
+            mount = [*layout.mounts[k], layout.height_m]
+            base.add("site", name=f"sonar{k}_ray{j}", pos=mount, zaxis=ray, size=[0.004])
+    frame = arena.attach(robot)
+    frame.pos = [*scenario.robot.start, 0.0]
+    frame.add("freejoint")
+    return mujoco.MjModel.from_xml_string(arena.to_xml_string(), arena.get_assets())
+
+
+def build_table(scenario: str, repeat: int) -> None:
+    """Building and compiling the world with MjSpec and with dm_control.mjcf."""
+    world = load_scenario(scenario)
+    spec_ms = median_ms(lambda: build_model(world, rangefinders=False), repeat)
+    mjcf_ms = median_ms(lambda: mjcf_model(world), repeat)
+    print(f"\n| building the {scenario} world | ms |\n|---|---:|")
+    print(f"| MjSpec | {spec_ms:.1f} |\n| dm_control.mjcf | {mjcf_ms:.1f} |")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scenario", nargs="?", default="paper_c_escape")
+    parser.add_argument("--steps", type=int, default=200, help="steps timed per variant")
+    parser.add_argument("--repeat", type=int, default=20, help="resets and builds timed")
+    args = parser.parse_args(argv)
+    try:
+        step_table(args.scenario, args.steps)
+        reset_table(args.scenario, args.repeat)
+        build_table(args.scenario, args.repeat)
+    except vplane_mj.VPlaneError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

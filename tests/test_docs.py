@@ -1,0 +1,238 @@
+"""The documentation says what is true: the getting-started page's commands, run as a user types
+them after the set-up, exit 0 and print and write what the page shows; its set-up commands are
+the README's; and every relative link of README.md, CHANGELOG.md and docs/ points at a file (and
+a heading) that exists."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sysconfig
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+ROOT = Path(__file__).parents[1]
+GETTING_STARTED = ROOT / "docs" / "getting-started.md"
+PAGES = sorted([ROOT / "README.md", ROOT / "CHANGELOG.md", *(ROOT / "docs").rglob("*.md")])
+REPOSITORY_DATA = ("scenarios", "examples", "tests/data/barn")
+"""What the page's commands read from the repository, copied beside them (a user runs them in
+the repository's directory, where the set-up installed the package)."""
+FENCE = re.compile(r"^```(\w*)[^\n]*\n(.*?)^```[ \t]*$", re.M | re.S)
+NUMBER = re.compile(r"-?\d+(?:\.\d+)?")
+OMITTED = "..."
+"""In a page's output: a line of its own skips any lines; within a line, any text."""
+LINK = re.compile(r"!?\[(?:[^\[\]]|\[[^\]]*\])*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
+INLINE_CODE = re.compile(r"(`+)(?:(?!\1).)+?\1", re.S)
+
+
+@dataclass(frozen=True)
+class Step:
+    """A shell block of the page and the output shown right under it (lines, maybe none)."""
+
+    command: str
+    output: tuple[str, ...]
+
+
+def fenced_blocks(text: str) -> list[tuple[str, str, int, int]]:
+    """The page's fenced code blocks: (language, body, start, end offset)."""
+    return [(m[1], m[2], m.start(), m.end()) for m in FENCE.finditer(text)]
+
+
+def page_steps(text: str) -> list[Step]:
+    """The commands a user types after the set-up: every `sh` block but the set-up's (those
+    install with apt-get), each with the `text` block that directly follows it, if any."""
+    blocks = fenced_blocks(text)
+    found = []
+    for k, (language, body, _, end) in enumerate(blocks):
+        if language != "sh" or "apt-get" in body:
+            continue
+        output: tuple[str, ...] = ()
+        if k + 1 < len(blocks):
+            next_language, next_body, next_start, _ = blocks[k + 1]
+            if next_language == "text" and not text[end:next_start].strip():
+                output = tuple(next_body.splitlines())
+        found.append(Step(body, output))
+    return found
+
+
+def setup_blocks(text: str) -> list[str]:
+    """The set-up commands of a page: its `sh` blocks that install with apt-get."""
+    blocks = fenced_blocks(text)
+    return [body.strip() for language, body, _, _ in blocks if language == "sh" and "apt-get" in body]
+
+
+STEPS = page_steps(GETTING_STARTED.read_text(encoding="utf-8"))
+
+
+def normalised(line: str) -> str:
+    """A line with its runs of white space made one space."""
+    return " ".join(line.split())
+
+
+def line_pattern(shown: str) -> re.Pattern[str]:
+    """What a line the page shows stands for: its text, with any number in place of each number
+    (times and the last digits of floating point vary between machines) and any text in place of
+    `...`."""
+
+    def literal(part: str) -> str:
+        pieces, last = [], 0
+        for number in NUMBER.finditer(part):
+            pieces += [re.escape(part[last : number.start()]), NUMBER.pattern]
+            last = number.end()
+        return "".join([*pieces, re.escape(part[last:])])
+
+    return re.compile(".*".join(literal(part) for part in normalised(shown).split(OMITTED)))
+
+
+def unmatched(shown: tuple[str, ...], printed: str) -> list[str]:
+    """The lines the page shows that the command did not print, in the page's order."""
+    lines = [normalised(line) for line in printed.splitlines()]
+    missing, at = [], 0
+    for line in shown:
+        if normalised(line) == OMITTED or not line.strip():
+            continue
+        pattern = line_pattern(line)
+        found = next((k for k in range(at, len(lines)) if pattern.fullmatch(lines[k])), None)
+        if found is None:
+            missing.append(line)
+        else:
+            at = found + 1
+    return missing
+
+
+def user_environment(home: Path) -> dict[str, str]:
+    """The environment of a shell after the set-up: the package's console script on the PATH,
+    this checkout's package imported, and an empty reference-path cache of its own."""
+    scripts = Path(sysconfig.get_path("scripts"))
+    assert (scripts / "vplane-mj").is_file(), f"no vplane-mj in {scripts}: set up as the README says"
+    return {
+        **os.environ,
+        "PATH": f"{scripts}{os.pathsep}{os.environ.get('PATH', '')}",
+        "PYTHONPATH": str(ROOT),
+        "VPLANE_MJ_CACHE": str(home / ".cache" / "vplane-mj"),
+    }
+
+
+@pytest.fixture(scope="module")
+def session(tmp_path_factory) -> tuple[Path, list[subprocess.CompletedProcess[str]]]:
+    """The page's commands run one after the other in a temporary copy of the repository's data,
+    as one user would: (that directory, what each command did)."""
+    home = tmp_path_factory.mktemp("user")
+    for data in REPOSITORY_DATA:
+        shutil.copytree(ROOT / data, home / data)
+    environment = user_environment(home)
+    done = []
+    for step in STEPS:
+        done.append(
+            subprocess.run(
+                ["bash", "-e", "-o", "pipefail", "-c", step.command],
+                cwd=home,
+                env=environment,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.STDOUT,
+                text=True,
+                timeout=600,
+            )
+        )
+    return home, done
+
+
+def test_the_page_has_commands_with_their_output():
+    assert len(STEPS) >= 10
+    assert sum(1 for step in STEPS if step.output) >= 8
+    assert any(step.command.startswith("vplane-mj run paper_c_escape\n") for step in STEPS)
+
+
+@pytest.mark.parametrize("index", range(len(STEPS)), ids=[step.command.split("\n")[0][:60] for step in STEPS])
+def test_a_command_of_the_page_exits_0_and_prints_and_writes_what_it_shows(session, index):
+    home, done = session
+    step, result = STEPS[index], done[index]
+    assert result.returncode == 0, f"$ {step.command}\n{result.stdout}"
+    assert "Traceback" not in result.stdout, result.stdout
+    assert unmatched(step.output, result.stdout) == [], f"$ {step.command}\n{result.stdout}"
+    for line in step.output:
+        if line.startswith("wrote "):
+            path = home / line.removeprefix("wrote ")
+            assert path.is_file() and path.stat().st_size > 0, path
+
+
+def test_shown_output_must_match_what_was_printed():
+    printed = "run [vplane, seed 2]: reached after 30.00 s\nwrote logs/a.json\n"
+    assert unmatched(("run [vplane, seed 0]: reached after 31.5 s", "wrote logs/a.json"), printed) == []
+    assert unmatched(("run [vplane, seed 0]: stuck after 31.5 s",), printed) != []
+    assert unmatched(("wrote logs/a.json", "run ... reached after 1 s"), printed) != []  # order
+    assert unmatched(("...", "wrote logs/a.json"), printed) == []
+    assert unmatched(("wrote logs/b.json",), printed) != []
+
+
+def test_the_set_up_commands_are_the_readme_s():
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    page = GETTING_STARTED.read_text(encoding="utf-8")
+    assert setup_blocks(page) == setup_blocks(readme)
+    assert len(setup_blocks(page)) == 2
+
+
+def without_code(text: str) -> str:
+    """Markdown without its code blocks and code spans (where brackets are code, not links)."""
+    return INLINE_CODE.sub("", FENCE.sub("", text))
+
+
+def heading_anchors(page: Path) -> set[str]:
+    """The anchors of a Markdown page's headings, as GitHub and MkDocs make them."""
+    anchors = set()
+    for line in without_code(page.read_text(encoding="utf-8")).splitlines():
+        if re.match(r"#{1,6} ", line):
+            title = re.sub(r"[^\w\- ]", "", line.lstrip("#").strip().lower())
+            anchors |= {title.replace(" ", "-"), re.sub(r"[-\s]+", "-", title).strip("-")}
+    return anchors
+
+
+def relative_links(page: Path) -> list[str]:
+    """The targets of a page's links and images that are neither web addresses nor anchors alone."""
+    targets = LINK.findall(without_code(page.read_text(encoding="utf-8")))
+    return [target for target in targets if not re.match(r"[a-z][a-z0-9+.-]*:", target) and target[0] != "#"]
+
+
+@pytest.mark.parametrize("page", PAGES, ids=[str(page.relative_to(ROOT)) for page in PAGES])
+def test_every_relative_link_points_at_a_file_that_exists(page):
+    assert [link for link in relative_links(page) if not points_at_something(page, link)] == []
+
+
+def points_at_something(page: Path, link: str) -> bool:
+    """Whether a relative link of `page` names a file that exists and, in a Markdown file, a
+    heading that exists."""
+    path, _, anchor = link.partition("#")
+    target = (page.parent / path).resolve()
+    if not target.exists():
+        return False
+    return not (anchor and target.suffix == ".md" and anchor not in heading_anchors(target))
+
+
+def test_links_are_found_and_judged():
+    assert "images/paper_c_escape-vplane-0.png" in relative_links(GETTING_STARTED)
+    assert "your-own-planner" in heading_anchors(GETTING_STARTED)
+    assert points_at_something(GETTING_STARTED, "robots.md#the-laser")
+    assert not points_at_something(GETTING_STARTED, "robots.md#no-such-heading")
+    assert not points_at_something(GETTING_STARTED, "no-such-page.md")
+
+
+def test_the_own_planner_page_s_half_speed_planner_reads_the_robot_it_drives(doc_examples, own_registry):
+    import vplane_mj
+
+    script = doc_examples("own-planner.md", "Parameters and class attributes")
+    names: dict[str, Any] = {}
+    exec(compile(script, "docs/own-planner.md", "exec"), names)
+    own_registry.register(names["HalfSpeedPlanner"])
+    times = {}
+    for profile in ("default", "turtlebot3_burger", "pioneer3dx"):
+        overrides = ["planner.name=half_speed", f"robot.profile={profile}"]
+        summary = vplane_mj.run(vplane_mj.load_scenario("open_field", overrides), out=None).summary
+        assert summary.reached, profile
+        times[profile] = summary.time_to_goal_s
+    # top speeds 0.5, 0.22 and 1.2 m/s: half of each over the same 5.5 m
+    assert times["pioneer3dx"] < times["default"] < times["turtlebot3_burger"]
