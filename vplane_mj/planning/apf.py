@@ -38,8 +38,9 @@ class ApfPlanner(Planner):
     def step(self, obs: Observation) -> Decision:
         components = self.params.firas_components(obs)
         total = components["attractive"] + components["repulsive"]
-        if not self.governor.idle:
-            total = self.governor.govern(total, obs.position, obs.yaw, obs.echo_points())
-        decision = Decision(force=total, mode="normal", components=components)
+        steering = self.governor.steer(total, obs, obs.echo_points())
+        decision = Decision(
+            force=steering.force, mode="normal", components=components, command=steering.command
+        )
         report_trap(self.detector, obs, decision, self.params.patience_s)
         return decision

@@ -226,6 +226,11 @@ class Bug2Planner(Planner):
             return Decision(force=np.zeros(2), mode="gave_up", events=events, gave_up=True)
         components = self._go_to_goal(obs) if self.mode == "go_to_goal" else self._follow(obs)
         force = np.sum(list(components.values()), axis=0)
-        if not self.governor.idle:
-            force = self.governor.govern(force, position, obs.yaw, obs.echo_points())
-        return Decision(force=force, mode=self.mode, components=components, events=events)
+        steering = self.governor.steer(force, obs, obs.echo_points())
+        return Decision(
+            force=steering.force,
+            mode=self.mode,
+            components=components,
+            events=events,
+            command=steering.command,
+        )

@@ -1,26 +1,32 @@
 """How a robot of a given body may move near obstacle points: room ahead, turns, speed.
 
-The potential-field planners ask their body (body.py) three things before they answer a
-force, each from obstacle points (echoes or map cells) in the world frame, metres:
+The potential-field planners hand their force to their body's `Governor`, which answers the
+body speed and turn rate to drive (`Steering`), from obstacle points (echoes and map cells)
+in the world frame, metres:
 
-- `room_ahead`: how far the robot can drive straight along its heading before a point in
-  its way comes within a margin of its circumscribed disc. A robot passes a gap aligned with
-  it, so the points in its way are those ahead of its front within its width
-  (`half_width_m`) plus a small side margin; it stops where its circumscribed disc clears
-  them by a margin, so that it can still turn there.
-- `free_turn`: how far the footprint can turn in place toward a side before it comes within
-  the margin of a point it is not already that close to. Turning is what sweeps the
-  circumscribed radius (`radius_m`): a 0.51 x 0.43 m rectangle's corners reach 0.33 m.
-  A round robot's turn sweeps nothing new, so it is always free.
-- `SpeedPolicy`: the force magnitude that asks the heading controller (v = k_v |F| cos e) for
-  no more than the speed the robot can still brake from within the room ahead, after one
-  control period at that speed, at most its top speed: v (t + v / 2a) <= room; and, on a
-  known way ahead, no more than lets it turn toward each of the way's points before it gets
-  there (`bend_speed`).
+- The drive as the governor's commands move it (`DriveModel`): a ramped drive moves the
+  command it drives toward the one asked for at its accelerations; the robot's speed follows
+  that ramp, its turn rate follows it `turn_lag_s` late (a skid-steer robot's tyres slip).
+  So the robot goes on turning after its turn command changes: a turn at omega coasts
+  omega |omega| / 2 alpha (and the lag's turn) before it stops, as a speed v brakes in v^2 / 2a.
+- The check of a command (`intrusion`): the footprint along the motion it predicts (the
+  command for one control period, then braking to rest) must keep a margin from every point,
+  the margin growing with the way the outline sweeps (`PREDICTION_ERROR`: the prediction is
+  the less sure the farther it reaches); a point already closer may come no closer.
+- The command: the heading controller's (v = k_v |F| cos e, omega = k_w e) with a turn rate
+  it can brake from before it faces the force (`brake_speed`), or the nearest one that passes
+  the check, slower first, then turning less. The direction is the force's when the turn in
+  place there is free (`free_turn`: turning is what sweeps the circumscribed radius, a 0.51 x
+  0.43 m rectangle's corners reach 0.33 m), else as far toward it as is free while the robot
+  can creep ahead (`room_ahead`). A robot shut in (that way shut, no room ahead, or only
+  standing still passing the check) backs off until the turn is free, or if it cannot, turns
+  the other way round.
+- `SpeedPolicy`: on a known way ahead, no faster than lets the robot turn toward each of the
+  way's points before it gets there (`bend_speed`), and the force magnitude of a speed.
 
-A robot that brakes from its top speed within `SHAPED_STOP_M` (the default robot: 0.03 m,
-the TurtleBot3: 0.01 m) is not slowed by the policy: its fields' own repulsion stops it, and
-its decisions stay as they were.
+A round robot that brakes from its top speed within `SHAPED_STOP_M` (the default robot:
+0.03 m) is not governed: its fields' own repulsion stops it, and its decisions stay as they
+were.
 """
 
 from __future__ import annotations
@@ -35,7 +41,7 @@ from vplane_mj.planning.types import Observation
 from vplane_mj.planning.vectors import wrap_angle
 
 SHAPED_STOP_M = 0.1
-"""A robot whose braking distance from its top speed is at most this (m) is not slowed."""
+"""A round robot whose braking distance from its top speed is at most this (m) is not governed."""
 TURN_STEP_RAD = math.radians(7.5)
 """Turns in place are checked at orientations this far apart (rad)."""
 BLOCKED_TURN_RAD = math.radians(2.0)
@@ -44,6 +50,8 @@ MOTION_STEP_S = 0.01
 """Time step (s) of a predicted motion (the drive's motor period)."""
 CREEP_SHARE = 0.02
 """A command slower than this share of the top speed and of the top turn rate stands still."""
+SQUEEZED_SHARE = 1 / 3
+"""A robot that no motion keeps its turn margin from obstacles moves keeping this share of it."""
 PREDICTION_ERROR = 0.2
 """How far (m) a predicted motion may be off per metre its outline sweeps (travel plus radius
 times turn): the margin it keeps grows by this along it."""
@@ -119,24 +127,6 @@ def free_turn(body: RobotBody, local: np.ndarray, side: float, limit_rad: float,
     return float(abs(angles[int(np.argmax(blocked))]))  # the last orientation before the first blocked one
 
 
-def turn_direction(
-    body: RobotBody, local: np.ndarray, yaw: float, direction: float, margin_m: float, room_m: float
-) -> float:
-    """The direction (rad, world) to steer toward instead of `direction` so the robot never
-    turns its footprint into a point: `direction` when the turn there is free; else as far
-    toward it as is free, so the robot turns while it creeps ahead; else, when that way is
-    shut and the robot cannot creep (no room ahead), as far the other way round as is free."""
-    error = float(wrap_angle(direction - yaw))
-    side = 1.0 if error >= 0 else -1.0
-    reach = free_turn(body, local, side, abs(error), margin_m)
-    if reach >= abs(error):
-        return direction
-    if reach >= BLOCKED_TURN_RAD or room_m > 0.0:
-        return yaw + side * reach
-    other = free_turn(body, local, -side, 2 * math.pi - abs(error), margin_m)
-    return yaw - side * other if other >= BLOCKED_TURN_RAD else yaw
-
-
 def brake_speed(distance: float, accel: float, delay_s: float) -> float:
     """The largest speed (or turn rate) v from which a drive that keeps it for `delay_s` (s) and
     then brakes at `accel` stops within `distance`: v t + v^2 / 2a <= distance (any units)."""
@@ -172,6 +162,9 @@ class DriveModel:
     command: tuple[float, float] = (0.0, 0.0)
     """The command given last."""
     time_s: float | None = None
+    period_s: float = 0.05
+    """The control period (s): the time between the last two ticks (the default run's 20 Hz
+    before the second)."""
     past: list[tuple[float, float]] = field(default_factory=list)
     """(time in s, ramped turn rate in rad/s) at the ticks within the lag, oldest first."""
 
@@ -183,6 +176,7 @@ class DriveModel:
             self.ramp = (float(measured[0]), float(measured[1]))
         else:
             elapsed = max(0.0, time_s - self.time_s)
+            self.period_s = elapsed or self.period_s
             dv, dw = limits.max_accel_mps2 * elapsed, limits.max_turn_accel_radps2 * elapsed
             v, w = self.ramp
             self.ramp = (
@@ -265,11 +259,10 @@ def intrusion(body: RobotBody, local: np.ndarray, poses: np.ndarray, margin_m: f
 
 @dataclass(frozen=True)
 class SpeedPolicy:
-    """The largest speed (m/s) a body can brake from within a distance, as a force magnitude
-    (see the module docstring). `period_s` is the control period: a command holds that long."""
+    """The speeds (m/s) a body may drive at along a way, and their force magnitudes (see the
+    module docstring)."""
 
     body: RobotBody
-    period_s: float = 0.05
 
     @property
     def active(self) -> bool:
@@ -277,15 +270,6 @@ class SpeedPolicy:
         exceeds `SHAPED_STOP_M`."""
         limits = self.body.limits
         return limits.max_speed_mps**2 / (2 * limits.max_accel_mps2) > SHAPED_STOP_M
-
-    def safe_speed(self, room_m: float) -> float:
-        """The largest speed v (m/s, at most the top speed) with v t + v^2 / 2a <= room_m."""
-        limits = self.body.limits
-        if not math.isfinite(room_m):
-            return limits.max_speed_mps
-        a, t = limits.max_accel_mps2, self.period_s
-        v = a * (math.sqrt(t * t + 2 * max(0.0, room_m) / a) - t)
-        return min(limits.max_speed_mps, v)
 
     def bend_speed(self, position: np.ndarray, yaw: float, way: np.ndarray) -> float:
         """The largest speed (m/s, at most the top speed) at which the robot at `position`, `yaw`
@@ -335,12 +319,12 @@ class Steering:
 
 @dataclass(eq=False)
 class Governor:
-    """A planner's last word on its force, for its body: steered away from a turn in place that
-    would sweep the footprint into a point (`turn_direction`, margin `turn_margin_m`), then
-    shortened to the speed the robot can brake from within the room ahead (`SpeedPolicy`,
-    margin `stop_margin_m`). A robot the margins shut in (no turn, no room) moves as long as
-    its footprint touches nothing. For a round robot that `SpeedPolicy` never slows, the force
-    as it is."""
+    """A planner's last word on its force, for its body: the body speed and turn rate to drive
+    for it (`steer`, see the module docstring), with margins `stop_margin_m` (the room ahead
+    a robot creeps into while it turns, and the braking of its back-off) and `turn_margin_m`
+    (what turns and every predicted motion keep from obstacles). It follows its own commands
+    (`drive`) and what a shut-in robot is doing about it (`maneuver`). For a round robot that
+    `SpeedPolicy` never slows, idle: the force as it is."""
 
     body: RobotBody
     stop_margin_m: float
@@ -361,43 +345,25 @@ class Governor:
     @property
     def reach_m(self) -> float:
         """How far (m) from base_link's origin obstacles matter to the governor: the
-        circumscribed radius, one control period at the top speed, the braking from it and the
-        larger margin."""
-        limits, period = self.body.limits, self.policy.period_s
-        travel = limits.max_speed_mps * (period + limits.max_speed_mps / (2 * limits.max_accel_mps2))
-        return self.body.radius_m + travel + max(self.stop_margin_m, self.turn_margin_m)
+        circumscribed radius, the longest motion it predicts (one control period at the top
+        speed and the braking from it), the larger margin and the margin's growth along that
+        motion and the longest coast of a turn."""
+        limits, period = self.body.limits, self.drive.period_s
+        top, rate = limits.max_speed_mps, limits.max_turn_rate_radps
+        travel = top * (period + top / (2 * limits.max_accel_mps2))
+        turn = rate * (period + limits.turn_lag_s) + rate * rate / (2 * limits.max_turn_accel_radps2)
+        swept = travel + self.body.radius_m * turn
+        return (
+            self.body.radius_m
+            + travel
+            + max(self.stop_margin_m, self.turn_margin_m)
+            + PREDICTION_ERROR * swept
+        )
 
     @property
     def idle(self) -> bool:
         """Whether the governor leaves every force as it is (a round robot that brakes short)."""
         return self.body.disc and not self.policy.active
-
-    def govern(
-        self,
-        force: np.ndarray,
-        position: np.ndarray,
-        yaw: float,
-        points: np.ndarray,
-        speed_mps: float = math.inf,
-    ) -> np.ndarray:
-        """`force` (world frame) made safe for the body at `position`, `yaw` among obstacle
-        `points` (N, 2; world, m), asking for at most `speed_mps` (m/s) besides."""
-        length = float(np.hypot(force[0], force[1]))
-        if self.idle or length < 1e-9 or not math.isfinite(length):
-            return force
-        local = body_frame(points, position, yaw)
-        room = room_ahead(self.body, local, self.stop_margin_m, self.turn_margin_m)
-        if not self.body.disc:
-            wanted = math.atan2(force[1], force[0])
-            direction = turn_direction(self.body, local, yaw, wanted, self.turn_margin_m, room)
-            if direction == yaw and room <= 0.0:
-                # Shut in with the margins: move as long as the footprint touches nothing.
-                room = room_ahead(self.body, local, 0.0, 0.0)
-                direction = turn_direction(self.body, local, yaw, wanted, 0.0, room)
-            if direction != wanted:
-                force = length * np.array([math.cos(direction), math.sin(direction)])
-        policy = self.policy
-        return policy.limit(force, min(speed_mps, policy.safe_speed(room))) if policy.active else force
 
     def steer(
         self, force: np.ndarray, obs: Observation, points: np.ndarray, speed_mps: float = math.inf
@@ -416,17 +382,12 @@ class Governor:
             return Steering(force, (0.0, 0.0))
         local = body_frame(points, obs.position, obs.yaw)
         wanted = math.atan2(force[1], force[0])
-        side = 1.0 if wrap_angle(wanted - obs.yaw) >= 0 else -1.0
-        direction = self._heading(local, obs.yaw, wanted)
-        command = None if direction is None else self._forward(local, obs.yaw, direction, length, speed_mps)
-        if command is None:
-            command = self._back_off(local, side)
-        if command is None:  # nowhere to back off to: round the other way
-            self.maneuver = "round"
-            direction = self._heading(local, obs.yaw, wanted)
-            command = (
-                (0.0, 0.0) if direction is None else self._forward(local, obs.yaw, direction, length, 0.0)
-            )
+        maneuver = self.maneuver
+        for margin in (self.turn_margin_m, SQUEEZED_SHARE * self.turn_margin_m):
+            self.maneuver = maneuver
+            direction, command = self._command(local, obs.yaw, wanted, length, speed_mps, margin)
+            if command is not None:
+                break
         command = command or (0.0, 0.0)
         self.drive.commanded(command)
         shown = (
@@ -436,13 +397,36 @@ class Governor:
         )
         return Steering(self.policy.limit(length * shown, abs(command[0])), command)
 
-    def _heading(self, local: np.ndarray, yaw: float, wanted: float) -> float | None:
+    def _command(
+        self, local: np.ndarray, yaw: float, wanted: float, length: float, speed_mps: float, margin: float
+    ) -> tuple[float | None, tuple[float, float] | None]:
+        """The direction steered toward (None: backing off) and the command for a force of
+        `length` toward `wanted` (rad, world), every turn and motion keeping `margin` (m): ahead
+        (`_heading`, `_forward`), else backing off, else round the other way or on ahead; None
+        when only standing still keeps the margin."""
+        side = 1.0 if wrap_angle(wanted - yaw) >= 0 else -1.0
+        direction = self._heading(local, yaw, wanted, margin)
+        command = (
+            None if direction is None else self._forward(local, yaw, direction, length, speed_mps, margin)
+        )
+        if command is None:
+            command = self._back_off(local, side, margin)
+        if command is None:  # nowhere to back off to: round the other way, else on ahead
+            self.maneuver = "round"
+            direction = self._heading(local, yaw, wanted, margin)
+            heading = yaw if direction is None else direction
+            command = self._forward(local, yaw, heading, length, speed_mps, margin)
+        return direction, command
+
+    def _heading(self, local: np.ndarray, yaw: float, wanted: float, margin: float) -> float | None:
         """The direction (rad, world) to steer toward for the `wanted` one, or None to back off:
         `wanted` when the turn in place there is free (`free_turn`); else as far toward it as is
         free, the robot creeping ahead while there is room (`room_ahead`); once that way is shut
-        with no room ahead, back off (`maneuver` "back") until the turn is free, or when backing
-        is not safe, turn the other way round ("round") as far as is free."""
-        body, margin = self.body, self.turn_margin_m
+        with no room ahead, back off (`maneuver` "back", the caller's) until the turn is free;
+        when backing is not safe (the caller sets "round"), turn the other way round as far as is
+        free (a quarter turn ahead at a time, so the turn stays that way round), and when that is
+        shut too, the heading itself."""
+        body = self.body
         error = float(wrap_angle(wanted - yaw))
         side = 1.0 if error >= 0 else -1.0
         reach = abs(error) if body.disc else free_turn(body, local, side, abs(error), margin)
@@ -458,12 +442,12 @@ class Governor:
             return None
         other = free_turn(body, local, -side, 2 * math.pi - abs(error), margin)
         if other >= BLOCKED_TURN_RAD:
-            return yaw - side * other
+            return yaw - side * min(other, math.pi / 2)  # a quarter turn at most: the way round stays
         self.maneuver = None
         return yaw
 
     def _forward(
-        self, local: np.ndarray, yaw: float, direction: float, length: float, speed_mps: float
+        self, local: np.ndarray, yaw: float, direction: float, length: float, speed_mps: float, margin: float
     ) -> tuple[float, float] | None:
         """The command toward `direction` for a force of `length`: the heading controller's
         speed (at most `speed_mps`) and a turn rate it can brake from before it faces that
@@ -472,17 +456,19 @@ class Governor:
         limits, gains = self.body.limits, self.body.gains
         error = float(wrap_angle(direction - yaw))
         speed = min(limits.max_speed_mps, gains.speed_gain * length * max(0.0, math.cos(error)), speed_mps)
-        delay = limits.turn_lag_s + self.policy.period_s
+        delay = limits.turn_lag_s + self.drive.period_s
         rate = min(
             limits.max_turn_rate_radps,
             gains.turn_gain * abs(error),
             brake_speed(abs(error), limits.max_turn_accel_radps2, delay),
         )
-        return self._admissible((speed, math.copysign(rate, error)), local)
+        return self._admissible((speed, math.copysign(rate, error)), local, margin)
 
-    def _admissible(self, wanted: tuple[float, float], local: np.ndarray) -> tuple[float, float] | None:
+    def _admissible(
+        self, wanted: tuple[float, float], local: np.ndarray, margin: float
+    ) -> tuple[float, float] | None:
         """The command nearest `wanted` (v, omega) whose predicted motion keeps the footprint
-        `turn_margin_m` from every point of `local` (robot frame; `intrusion`): slower first,
+        `margin` (m) from every point of `local` (robot frame; `intrusion`): slower first,
         then turning less. None when only standing still is safe but `wanted` moves (a
         command slower than a CREEP_SHARE of the top speed and turn rate stands still)."""
         if not self._moves(wanted):
@@ -492,7 +478,7 @@ class Governor:
             (speed * f, turn * g) for g in (1.0, 0.5, 0.0) for f in (1.0, 0.5, 0.25, 0.0)
         )
         for command in candidates:
-            if self._moves(command) and self._safe(command, local):
+            if self._moves(command) and self._safe(command, local, margin):
                 return command
         return None
 
@@ -504,20 +490,20 @@ class Governor:
             or abs(command[1]) > CREEP_SHARE * limits.max_turn_rate_radps
         )
 
-    def _back_off(self, local: np.ndarray, side: float) -> tuple[float, float] | None:
+    def _back_off(self, local: np.ndarray, side: float, margin: float) -> tuple[float, float] | None:
         """A safe command that backs the robot off, turning its front toward `side` (+1 left) if
         that is safe; None when no back-off is safe."""
         back = -self.back_off_speed
         for command in ((back, side * self.back_off_turn), (back, 0.0), (back / 2, 0.0)):
-            if self._safe(command, local):
+            if self._safe(command, local, margin):
                 self.maneuver = "back"
                 return command
         return None
 
-    def _safe(self, command: tuple[float, float], local: np.ndarray) -> bool:
-        """Whether the motion predicted for `command` keeps its margins (`intrusion`)."""
-        poses = self.drive.poses(command, self.policy.period_s)
-        return intrusion(self.body, local, poses, self.turn_margin_m) <= INTRUSION_TOLERANCE_M
+    def _safe(self, command: tuple[float, float], local: np.ndarray, margin: float) -> bool:
+        """Whether the motion predicted for `command` keeps `margin` (m) and its growth (`intrusion`)."""
+        poses = self.drive.poses(command, self.drive.period_s)
+        return intrusion(self.body, local, poses, margin) <= INTRUSION_TOLERANCE_M
 
     @property
     def back_off_speed(self) -> float:
@@ -525,7 +511,7 @@ class Governor:
         `stop_margin_m`, at most its top speed."""
         limits = self.body.limits
         return min(
-            limits.max_speed_mps, brake_speed(self.stop_margin_m, limits.max_accel_mps2, self.policy.period_s)
+            limits.max_speed_mps, brake_speed(self.stop_margin_m, limits.max_accel_mps2, self.drive.period_s)
         )
 
     @property

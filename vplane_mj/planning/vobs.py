@@ -84,9 +84,8 @@ class VobsPlanner(Planner):
             self.virtual = [v for v in self.virtual if v not in expired]
         points = np.array([position for _, position in self.virtual]).reshape(-1, 2)
         components["virtual"] = fields.repulsive_force(obs.position, points, p.vobs_gain, p.vobs_influence_m)
-        decision.force = sum(components.values(), np.zeros(2))
-        if not self.governor.idle:
-            decision.force = self.governor.govern(decision.force, obs.position, obs.yaw, obs.echo_points())
+        steering = self.governor.steer(sum(components.values(), np.zeros(2)), obs, obs.echo_points())
+        decision.force, decision.command = steering.force, steering.command
         decision.mode = "escaping" if len(self.virtual) else "normal"
         decision.planes = []
         return decision

@@ -148,7 +148,7 @@ JACKAL = RobotProfile(
         max_turn_rate_radps=4.0,
         max_accel_mps2=2.0,
         max_turn_accel_radps2=4.0,
-        turn_lag_s=0.1,
+        turn_lag_s=0.05,
     ),
     ramped=True,
     gains=ControllerGains(
