@@ -2,7 +2,7 @@
 
 This is the baseline the paper improves on: it has no escape, so once the
 local-minimum detector has held it trapped for `patience_s` it gives up (outcome
-`stuck`). The governor (motion.py) fits the force to the robot's body.
+`stuck`). The governor (motion.py) drives the force on the robot's body.
 """
 
 from __future__ import annotations

@@ -50,6 +50,8 @@ MOTION_STEP_S = 0.01
 """Time step (s) of a predicted motion (the drive's motor period)."""
 CREEP_SHARE = 0.02
 """A command slower than this share of the top speed and of the top turn rate stands still."""
+MEMORY_CELL_M = 0.02
+"""The governor remembers one obstacle point per square this wide (m)."""
 SQUEEZED_SHARE = 1 / 3
 """A robot that no motion keeps its turn margin from obstacles moves keeping this share of it."""
 PREDICTION_ERROR = 0.2
@@ -307,6 +309,19 @@ class SpeedPolicy:
         return force * (cap / length) if length > cap else force
 
 
+def _in_view(obs: Observation, bearings: np.ndarray) -> np.ndarray:
+    """Whether each of `bearings` (rad, robot frame) lies in the field of view of the scan of
+    `obs`: within the span of its beams' bearings, widened by half a beam each way."""
+    if not len(obs.bearings):
+        return np.zeros(len(bearings), dtype=bool)
+    half = obs.beam_width / 2
+    low, high = float(np.min(obs.bearings)) - half, float(np.max(obs.bearings)) + half
+    if high - low >= 2 * math.pi:
+        return np.ones(len(bearings), dtype=bool)
+    offset = np.mod(np.asarray(bearings) - low, 2 * math.pi)
+    return offset <= high - low
+
+
 @dataclass(frozen=True)
 class Steering:
     """What the governor makes of a force: the force to show (the direction the robot steers
@@ -334,6 +349,8 @@ class Governor:
     maneuver: str | None = field(default=None, init=False)
     """What a shut-in robot is doing about it: "back" (backing off) or "round" (turning the
     other way round), None while it is not shut in."""
+    remembered: np.ndarray = field(default_factory=lambda: np.empty((0, 2)), init=False)
+    """The obstacle points (N, 2; world, m) given at earlier ticks within `reach_m`."""
 
     def __post_init__(self) -> None:
         self.drive = DriveModel(self.body.limits)
@@ -380,7 +397,7 @@ class Governor:
             self.maneuver = None
             self.drive.commanded((0.0, 0.0))
             return Steering(force, (0.0, 0.0))
-        local = body_frame(points, obs.position, obs.yaw)
+        local = body_frame(self._with_unseen(points, obs), obs.position, obs.yaw)
         wanted = math.atan2(force[1], force[0])
         maneuver = self.maneuver
         for margin in (self.turn_margin_m, SQUEEZED_SHARE * self.turn_margin_m):
@@ -396,6 +413,20 @@ class Governor:
             else (np.array([math.cos(direction), math.sin(direction)]))
         )
         return Steering(self.policy.limit(length * shown, abs(command[0])), command)
+
+    def _with_unseen(self, points: np.ndarray, obs: Observation) -> np.ndarray:
+        """`points` (N, 2; world, m) and the remembered points within `reach_m` that the sensor
+        does not look at now: outside its field of view (the span of its bearings, a half beam
+        wider each way; none for a sensor that looks all round), as behind a 270-degree laser.
+        Remembers `points` and those, one per MEMORY_CELL_M square, for the next ticks."""
+        points = np.asarray(points, float).reshape(-1, 2)
+        rel = self.remembered - obs.position
+        near = np.hypot(rel[:, 0], rel[:, 1]) < self.reach_m
+        unseen = near & ~_in_view(obs, np.arctan2(rel[:, 1], rel[:, 0]) - obs.yaw)
+        known = np.vstack((points, self.remembered[unseen]))
+        _, first = np.unique(np.floor(known / MEMORY_CELL_M), axis=0, return_index=True)
+        self.remembered = known[np.sort(first)]
+        return known
 
     def _command(
         self, local: np.ndarray, yaw: float, wanted: float, length: float, speed_mps: float, margin: float

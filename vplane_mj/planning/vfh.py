@@ -9,8 +9,8 @@ valleys, the directions half a wide valley in from each border. The cost
 5 |c - goal| + 2 |c - heading| + 2 |c - previous| picks one (VFH+'s weights). The force
 is a unit vector that way, shortened within 1 m of the goal. With no valley the robot
 stops; the local-minimum detector then makes it give up after `patience_s` (`stuck`).
-The governor (motion.py) then fits the force to the robot's body: no turn in place into an
-obstacle, and no faster than the robot can brake within the room ahead.
+The governor (motion.py) then drives the force on the robot's body: its commands keep the
+footprint off the obstacles over the motion they start.
 """
 
 from __future__ import annotations
@@ -91,7 +91,7 @@ class VfhPlanner(Planner):
         return decision
 
     def _governed(self, force: np.ndarray, obs: Observation) -> Steering:
-        """The force fitted to the robot's body among the echoes and the mapped cells near it."""
+        """The command for the force (motion.py) among the echoes and the mapped cells near it."""
         if self.governor.idle:
             return Steering(force)
         cells, _ = self.map.cells(self.params.map_threshold, obs.position, self.governor.reach_m)

@@ -4,7 +4,7 @@ On each local-minimum detection a virtual obstacle (a FIRAS repulsive point, eqs
 placed at the robot's position and pushes it out of the minimum. A virtual obstacle is
 cleared after `vobs_lifetime_s`; the robot may then fall back into the same minimum, the
 weakness the virtual-plane method addresses. After `max_virtual` obstacles the planner
-gives up (outcome `stuck`). The governor (motion.py) fits the force to the robot's body.
+gives up (outcome `stuck`). The governor (motion.py) drives the force on the robot's body.
 """
 
 from __future__ import annotations

@@ -173,7 +173,7 @@ class VPlanePlanner(Planner):
         return decision
 
     def _governed(self, force: np.ndarray, obs: Observation) -> Steering:
-        """The force fitted to the robot's body (motion.py) among the echoes and the mapped
+        """The command for the force (motion.py) among the echoes and the mapped
         cells around it, which remember what the sensor sees between its beams or behind."""
         if self.governor.idle:
             return Steering(force)

@@ -22,8 +22,12 @@ unknown counted as free):
   map holds no way to the goal at all for `no_way_patience_s`. A dense scan (a laser: scan.py)
   maps the obstacles it sees as they are from the first scan, so with one the robot follows
   the map's way from the start;
-- the governor (motion.py) fits the force to the robot's body: no turn in place into an
-  obstacle, and no faster than the robot can brake within the room ahead.
+- the governor (motion.py) drives a robot that is not a small disc for the force: its
+  commands keep the footprint off the echoes and the mapped cells over the motion they start
+  (the drive's ramp and the coast of a turn included), and back the robot off where it is shut
+  in. On a way of the map such a robot is not repelled by the echoes: the way keeps it off the
+  mapped obstacles and the governor off everything else, and the repulsion would only turn
+  it off the way where it passes close to an obstacle.
 
 Every decision is an event (`/events`), and objectives and planes appear in `/virtual`.
 """
@@ -258,7 +262,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         every narrow gap, since an echo is placed on its sonar's axis, up to half a beam away
         from the obstacle that returned it. Echoes closer than the robot radius plus
         CLOSE_ECHO_MARGIN_M, and without a way (the map shows none) all echoes, repel in full,
-        as in normal mode."""
+        as in normal mode. A governed robot on a way is not repelled (module docstring)."""
         p = self.params
         heading = unit(waypoint - obs.position)
         components["attractive"] = pull * heading
@@ -276,7 +280,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         components["repulsive"] = near + farther - min(float(farther @ heading), 0.0) * heading
 
     def _governed(self, force: np.ndarray, obs: Observation) -> Steering:
-        """The force fitted to the robot's body (motion.py) among the echoes and the mapped
+        """The command for the force (motion.py) among the echoes and the mapped
         cells around it (not swept), which remember what the sensor sees between its beams or
         behind; on a way, no faster than lets the robot turn along the way's next
         `BEND_HORIZON_M`."""
