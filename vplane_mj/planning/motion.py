@@ -53,7 +53,8 @@ CREEP_SHARE = 0.02
 MEMORY_CELL_M = 0.02
 """The governor remembers one obstacle point per square this wide (m)."""
 SQUEEZED_SHARE = 1 / 3
-"""A robot that no motion keeps its turn margin from obstacles moves keeping this share of it."""
+"""A robot that no motion keeps its turn margin from obstacles creeps straight on or back
+keeping this share of it."""
 PREDICTION_ERROR = 0.2
 """How far (m) a predicted motion may be off per metre its outline sweeps (travel plus radius
 times turn): the margin it keeps grows by this along it."""
@@ -399,13 +400,9 @@ class Governor:
             return Steering(force, (0.0, 0.0))
         local = body_frame(self._with_unseen(points, obs), obs.position, obs.yaw)
         wanted = math.atan2(force[1], force[0])
-        maneuver = self.maneuver
-        for margin in (self.turn_margin_m, SQUEEZED_SHARE * self.turn_margin_m):
-            self.maneuver = maneuver
-            direction, command = self._command(local, obs.yaw, wanted, length, speed_mps, margin)
-            if command is not None:
-                break
-        command = command or (0.0, 0.0)
+        direction, command = self._command(local, obs.yaw, wanted, length, speed_mps, self.turn_margin_m)
+        if command is None:
+            command = self._creep(local, obs.yaw, wanted) or (0.0, 0.0)
         self.drive.commanded(command)
         shown = (
             np.array([math.cos(wanted), math.sin(wanted)])
@@ -448,6 +445,18 @@ class Governor:
             heading = yaw if direction is None else direction
             command = self._forward(local, yaw, heading, length, speed_mps, margin)
         return direction, command
+
+    def _creep(self, local: np.ndarray, yaw: float, wanted: float) -> tuple[float, float] | None:
+        """For a robot that no motion keeps the turn margin: straight on at the back-off speed or
+        half of it, toward `wanted` (rad, world) first (ahead or back), keeping a SQUEEZED_SHARE
+        of the margin; None when that does not either."""
+        margin = SQUEEZED_SHARE * self.turn_margin_m
+        first = 1.0 if math.cos(wrap_angle(wanted - yaw)) >= 0 else -1.0
+        for sign in (first, -first):
+            for command in ((sign * self.back_off_speed, 0.0), (sign * self.back_off_speed / 2, 0.0)):
+                if self._safe(command, local, margin):
+                    return command
+        return None
 
     def _heading(self, local: np.ndarray, yaw: float, wanted: float, margin: float) -> float | None:
         """The direction (rad, world) to steer toward for the `wanted` one, or None to back off:
