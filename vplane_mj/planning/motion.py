@@ -46,6 +46,8 @@ TURN_STEP_RAD = math.radians(7.5)
 """Turns in place are checked at orientations this far apart (rad)."""
 BLOCKED_TURN_RAD = math.radians(2.0)
 """A turn that sweeps free less far than this (rad) counts as impossible that way."""
+LATERAL_ACCEL_MPS2 = 1.0
+"""A turning robot drives no faster than keeps its sideways acceleration v * omega within this (m/s^2)."""
 MOTION_STEP_S = 0.01
 """Time step (s) of a predicted motion (the drive's motor period)."""
 CREEP_SHARE = 0.02
@@ -502,6 +504,7 @@ class Governor:
             gains.turn_gain * abs(error),
             brake_speed(abs(error), limits.max_turn_accel_radps2, delay),
         )
+        speed = min(speed, LATERAL_ACCEL_MPS2 / max(rate, 1e-9))
         return self._admissible((speed, math.copysign(rate, error)), local, margin)
 
     def _admissible(
