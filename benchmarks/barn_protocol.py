@@ -118,13 +118,13 @@ def plot(table: list[dict], path: Path) -> None:
     names = [row["planner"] for row in table]
     x = np.arange(len(names))
     figure, (left, right) = plt.subplots(1, 2, figsize=(4 + 1.1 * len(names), 4))
-    left.bar(x, [100 * row["success_rate"] for row in table], color="tab:green")
+    left.bar(x, [100 * row["success_rate"] for row in table], color="tab:green", zorder=2)
     left.axhline(85, color="tab:red", linestyle="--", label="BARN DWA baseline (85%)")
     left.set_ylabel("success, % of runs")
     left.set_ylim(0, 100)
-    right.bar(x, [row["mean_score"] for row in table], color="tab:blue")
+    right.bar(x, [row["mean_score"] for row in table], color="tab:blue", zorder=2)
     right.axhline(0.159, color="tab:red", linestyle="--", label="BARN DWA baseline (0.159)")
-    right.axhspan(0.40, 0.48, color="tab:orange", alpha=0.3, label="BARN best entries (0.40-0.48)")
+    right.axhspan(0.40, 0.48, color="tab:orange", alpha=0.3, zorder=0, label="BARN best entries (0.40-0.48)")
     right.set_ylabel("mean BARN score")
     right.set_ylim(0, 0.5)
     for ax in (left, right):
