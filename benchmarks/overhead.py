@@ -39,6 +39,7 @@ from vplane_mj.logs.writer import McapLog
 from vplane_mj.planning import Decision, Observation, Planner, PlannerParams
 from vplane_mj.planning.registry import register_planner
 from vplane_mj.scenario import load_scenario
+from vplane_mj.sim.laser import LaserScanner
 from vplane_mj.sim.loop import run_scenario
 from vplane_mj.sim.sensors import scan_bearings
 from vplane_mj.sim.world import build_model
@@ -61,6 +62,30 @@ class StraightToGoal(Planner):
         dx, dy = obs.goal[0] - obs.position[0], obs.goal[1] - obs.position[1]
         distance = max(math.hypot(dx, dy), 1e-9)
         return Decision(force=np.array([dx / distance, dy / distance]), mode="normal")
+
+
+class LaserClock:
+    """The CPU time (s) a run's laser scans take (`LaserScanner.read`: cast, noise, dropout),
+    added up while the clock is installed."""
+
+    def __init__(self):
+        self.seconds = 0.0
+        self._read = LaserScanner.read
+
+    def __enter__(self) -> LaserClock:
+        read = self._read
+
+        def timed_read(scanner, x, y, yaw):
+            start = time.process_time()
+            ranges = read(scanner, x, y, yaw)
+            self.seconds += time.process_time() - start
+            return ranges
+
+        LaserScanner.read = timed_read
+        return self
+
+    def __exit__(self, *exc) -> None:
+        LaserScanner.read = self._read
 
 
 def replay_time(model: mujoco.MjModel, torques, steps: int, clock=time.process_time) -> float:
@@ -92,7 +117,7 @@ def measure(ref: str, planner: str, repeat: int, log_dir: Path | None) -> dict:
     floor.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_SENSOR
     run_scenario(scenario)  # warm up: imports, caches
     times: dict[str, list[float]] = {
-        key: [] for key in ("run", "floor", "built", "log", "run wall", "floor wall")
+        key: [] for key in ("run", "floor", "built", "log", "run wall", "floor wall", "laser")
     }
     one_tick = load_scenario(
         ref, [f"planner.name={planner}", f"run.time_limit_s={1 / scenario.run.control_hz}"]
@@ -103,8 +128,10 @@ def measure(ref: str, planner: str, repeat: int, log_dir: Path | None) -> dict:
         run_scenario(one_tick)
         setup = time.process_time() - start
         start = time.process_time()
-        result = run_scenario(scenario)
+        with LaserClock() as laser:
+            result = run_scenario(scenario)
         times["run"].append(time.process_time() - start - setup)
+        times["laser"].append(laser.seconds)
         summary = result.summary
         times["run wall"].append(summary.wall_time_s)
         times["floor"].append(replay_time(floor, result.torques, summary.steps))
@@ -123,6 +150,7 @@ def measure(ref: str, planner: str, repeat: int, log_dir: Path | None) -> dict:
         "log": median["log"] / median["floor"] if "log" in median else None,
         "built": median["built"] / median["floor"],
         "run_vs_built": median["run"] / median["built"],
+        "laser": median["laser"] / median["floor"] if scenario.sensors.kind == "laser" else None,
         "run_wall": median["run wall"] / median["floor wall"],
         "floor_us": 1e6 * median["floor"] / summary.steps,
         "planner_ms": summary.planner_cpu_ms_mean,
@@ -168,18 +196,21 @@ def report(scenarios: list[str], planners: list[str], repeat: int, log_dir: Path
     print(f"median of {repeat} interleaved repeats, CPU time; mujoco {mujoco.__version__}\n")
     print(
         "| scenario | planner | outcome | physics steps | floor us/step | run / floor | run with log / floor "
-        "| as built / floor | run / as built | run / floor, wall clock | planner ms/tick | log MB/min |"
+        "| as built / floor | run / as built | run / floor, wall clock | laser / floor | planner ms/tick "
+        "| log MB/min |"
     )
-    print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for planner in planners:
         for ref in scenarios:
             row = measure(ref, planner, repeat, log_dir)
             logged = "-" if row["log"] is None else f"{row['log']:.2f}"
             size = "-" if row["log"] is None else f"{row['log_mb_per_min']:.2f}"
+            laser = "-" if row["laser"] is None else f"{row['laser']:.2f}"
             print(
                 f"| {row['scenario']} | `{row['planner']}` | {row['outcome']} | {row['steps']} "
                 f"| {row['floor_us']:.1f} | {row['run']:.2f} | {logged} | {row['built']:.2f} "
-                f"| {row['run_vs_built']:.2f} | {row['run_wall']:.2f} | {row['planner_ms']:.3f} | {size} |"
+                f"| {row['run_vs_built']:.2f} | {row['run_wall']:.2f} | {laser} | {row['planner_ms']:.3f} "
+                f"| {size} |"
             )
             sys.stdout.flush()
 

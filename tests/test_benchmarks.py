@@ -97,6 +97,13 @@ def test_startup_times_runs_against_their_loop_and_the_main_job_with_its_log_and
         assert number(line[1]) > 0 and RATIO_BOUNDS[0] < number(line[2]) < RATIO_BOUNDS[1]
 
 
+def test_footprint_clearance_times_the_kernel_against_numpy_on_the_same_poses(tmp_path):
+    text = run_benchmark("footprint_clearance.py", "--points", "1", "--repeat", "1", cwd=tmp_path)
+    (line,) = [line for line in text.splitlines() if re.match(r"\| [0-9]", line)]
+    poses, kernel_ms, numpy_ms, _, difference = map(float, line.strip("| ").split("|"))
+    assert poses > 1000 and kernel_ms > 0 and numpy_ms > 0 and difference < 1e-9
+
+
 def test_laser_cast_times_both_casters_on_both_worlds_and_the_first_calls(tmp_path):
     text = run_benchmark("laser_cast.py", "--origins", "2", "--repeat", "1", cwd=tmp_path)
     for world in ("BARN-size", "paper-size"):

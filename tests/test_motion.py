@@ -1,7 +1,7 @@
-"""The governor that fits a planner's force to the robot's body (vplane_mj/planning/motion.py),
+"""The governor that drives a planner's force on the robot's body (vplane_mj/planning/motion.py),
 the dense scan's reduction (scan.py) and the gap sizing by the robot's width, on synthetic
-observations; and real runs of the Jackal on a BARN protocol world and of the Pioneer in the
-paper's H trap."""
+observations; the drive model against the Jackal in MuJoCo; and real runs of the Jackal on BARN
+protocol worlds and of the Pioneer and the TurtleBot3 in the paper's four scenarios."""
 
 import math
 
@@ -43,25 +43,106 @@ def test_a_turn_in_place_is_refused_where_a_corner_would_strike_a_post():
     assert motion.free_turn(DEFAULT, np.array([[0.0, 0.12]]), 1.0, math.pi, 0.03) == math.pi
 
 
-def test_a_blocked_turn_becomes_a_partial_turn_while_creeping_or_the_other_way_round():
-    post = np.array([[0.15, 0.3]])  # ahead-left, inside the swept disc
-    wanted = math.radians(120)  # the force points back-left
-    turned = motion.turn_direction(JACKAL, post, 0.0, wanted, 0.03, room_m=1.0)
-    assert 0.0 <= turned < wanted  # as far as is free, creeping ahead
-    # No room ahead and the way left shut at once: as far as is free the other way round.
-    boxed = np.array([[0.2, 0.24], [0.6, 0.0]])  # beside the front-left corner, and ahead
-    other = motion.turn_direction(JACKAL, boxed, 0.0, wanted, 0.03, room_m=0.0)
-    assert other < 0.0
+def _observation(velocity=(0.0, 0.0), time_s=0.0) -> Observation:
+    """The robot at the origin facing +x (no scan: the governor is given its points)."""
+    return Observation(
+        time_s, np.zeros(2), 0.0, np.array([9.0, 0.0]), 0.2, np.zeros(0), np.zeros(0), 0.1, velocity
+    )
 
 
-def test_the_speed_policy_brakes_within_the_room_and_bends_and_never_slows_the_default_robot():
+def _driving(governor: motion.Governor, command: tuple[float, float], seconds: float) -> float:
+    """Let `governor`'s drive model follow `command` for `seconds` (its ramp), as if the
+    governor had commanded it; the time (s) reached."""
+    time_s = 0.0
+    governor.drive.advance(time_s, (0.0, 0.0))
+    while time_s < seconds:
+        governor.drive.commanded(command)
+        time_s += 0.05
+        governor.drive.advance(time_s, (0.0, 0.0))
+    return time_s
+
+
+def test_the_drive_model_ramps_the_commands_and_turns_its_lag_late():
+    model = motion.DriveModel(JACKAL.limits)
+    model.advance(0.0, (0.3, -0.5))  # the first tick: the measured velocity
+    assert model.ramp == (0.3, -0.5)
+    model.commanded((2.0, 4.0))
+    model.advance(0.05, (9.0, 9.0))  # later ticks: the ramp the commands make
+    assert model.ramp == pytest.approx((0.3 + 2.0 * 0.05, -0.5 + 4.0 * 0.05)) and model.period_s == 0.05
+    # At 1 m/s and 2 rad/s steadily, a stop coasts v^2 / 2a ahead and turns omega^2 / 2 alpha
+    # plus what the body still owes the ramp (its lag at 2 rad/s).
+    governor = motion.Governor(JACKAL, 0.1, 0.03)
+    _driving(governor, (1.0, 2.0), 2.0)
+    stop = governor.drive.poses((0.0, 0.0), 0.05)[-1]
+    lag = JACKAL.limits.turn_lag_s
+    assert stop[2] == pytest.approx(2.0 * lag + 2.0**2 / (2 * 4.0), abs=0.02)
+    straight = motion.Governor(JACKAL, 0.1, 0.03)
+    _driving(straight, (1.0, 0.0), 2.0)
+    assert straight.drive.poses((0.0, 0.0), 0.05)[-1] == pytest.approx(
+        [1.0**2 / (2 * 2.0), 0.0, 0.0], abs=0.01
+    )
+
+
+def test_a_predicted_motion_keeps_a_growing_margin_and_nears_no_close_point():
+    poses = np.column_stack((np.linspace(0.0, 0.5, 26), np.zeros(26), np.zeros(26)))
+    end_margin = 0.03 + motion.PREDICTION_ERROR * 0.5
+    ahead = np.array([[JACKAL.front_m + 0.5 + end_margin + 0.01, 0.0]])
+    assert motion.intrusion(JACKAL, ahead, poses, 0.03) == 0.0
+    nearer = ahead - [0.05, 0.0]
+    assert motion.intrusion(JACKAL, nearer, poses, 0.03) == pytest.approx(0.04)
+    # A point 0.01 m beside the robot: driving on past it is safe, moving toward it is not.
+    beside = np.array([[0.0, JACKAL.half_width_m + 0.01]])
+    assert motion.intrusion(JACKAL, beside, poses, 0.03) == 0.0
+    sideways = np.column_stack((np.zeros(5), np.linspace(0.0, 0.008, 5), np.zeros(5)))
+    assert motion.intrusion(JACKAL, beside, sideways, 0.03) == pytest.approx(0.008)
+
+
+def test_a_turn_is_commanded_to_stop_facing_the_force_and_the_default_robot_is_left_alone():
+    governor = motion.Governor(JACKAL, 0.1, 0.03)
+    steering = governor.steer(np.array([0.0, 1.0]), _observation(), np.empty((0, 2)))
+    period, lag = governor.drive.period_s, JACKAL.limits.turn_lag_s
+    assert steering.command == pytest.approx((0.0, motion.brake_speed(math.pi / 2, 4.0, lag + period)))
+    default = motion.Governor(DEFAULT, 0.1, 0.03)
+    force = np.array([0.3, -0.2])
+    assert default.idle
+    idle = default.steer(force, _observation(), np.array([[0.15, 0.0]]))
+    assert idle.force is force and idle.command is None
+
+
+def test_the_governor_brakes_short_of_a_wall_and_passes_beside_one():
+    # At 2 m/s braking takes 1 m: with the margin grown along it, the front stops 1.6 m ahead.
+    wall = np.column_stack((np.full(40, 1.55), np.linspace(-1.0, 1.0, 40)))
+    governor = motion.Governor(JACKAL, 0.1, 0.03)
+    time_s = _driving(governor, (2.0, 0.0), 1.5)
+    steering = governor.steer(np.array([1.0, 0.0]), _observation((2.0, 0.0), time_s), wall)
+    speed, turn = steering.command
+    assert 0.0 < speed < 2.0 and turn == 0.0
+    assert motion.intrusion(JACKAL, wall, governor.drive.poses(steering.command, 0.05), 0.03) == 0.0
+    beside = np.column_stack((np.linspace(-1.0, 3.0, 80), np.full(80, JACKAL.half_width_m + 0.3)))
+    free = motion.Governor(JACKAL, 0.1, 0.03)
+    time_s = _driving(free, (2.0, 0.0), 1.5)
+    assert free.steer(np.array([1.0, 0.0]), _observation((2.0, 0.0), time_s), beside).command == (2.0, 0.0)
+
+
+def test_a_shut_in_robot_backs_off_and_else_turns_the_other_way_round():
+    # A post just above the front-left corner (a left turn sweeps into it) and one ahead (no
+    # room to creep): the robot that wants to go back-left backs off.
+    pocket = np.array([[0.25, JACKAL.half_width_m + 0.035], [0.4, 0.0]])
+    wanted = np.array([math.cos(math.radians(120)), math.sin(math.radians(120))])
+    governor = motion.Governor(JACKAL, 0.1, 0.03)
+    speed, _ = governor.steer(wanted, _observation(), pocket).command
+    assert speed < 0.0 and governor.maneuver == "back"
+    # A post close behind its left side too: it cannot back off, so it turns right, the other
+    # way round (which swings that side forward, away from the post).
+    boxed = np.vstack((pocket, [[-0.28, 0.15]]))
+    governor = motion.Governor(JACKAL, 0.1, 0.03)
+    speed, turn = governor.steer(wanted, _observation(), boxed).command
+    assert speed >= 0.0 and turn < 0.0 and governor.maneuver == "round"
+
+
+def test_the_speed_policy_slows_for_the_ways_bends():
     policy = motion.SpeedPolicy(JACKAL)
     assert policy.active and not motion.SpeedPolicy(DEFAULT).active
-    assert policy.safe_speed(math.inf) == 2.0
-    for room in (0.05, 0.3, 0.8):
-        v = policy.safe_speed(room)
-        assert v * policy.period_s + v * v / (2 * JACKAL.limits.max_accel_mps2) == pytest.approx(room)
-    assert policy.safe_speed(0.0) == 0.0
     # speed_gain converts speed to force: the Jackal's 2 (m/s) per unit.
     force = policy.limit(np.array([3.0, 4.0]), 1.0)
     assert np.hypot(*force) == pytest.approx(0.5) and force[1] / force[0] == pytest.approx(4 / 3)
@@ -70,23 +151,6 @@ def test_the_speed_policy_brakes_within_the_room_and_bends_and_never_slows_the_d
     corner = np.vstack((straight[:4], np.column_stack((np.full(20, 0.4), np.linspace(0.1, 2.0, 20)))))
     assert policy.bend_speed(np.zeros(2), 0.0, straight) == 2.0
     assert policy.bend_speed(np.zeros(2), 0.0, corner) < 1.5
-    # The default robot: the governor leaves every force as it is.
-    governor = motion.Governor(DEFAULT, 0.1, 0.03)
-    assert governor.idle
-    f = np.array([0.3, -0.2])
-    assert governor.govern(f, np.zeros(2), 0.0, np.array([[0.15, 0.0]])) is f
-
-
-def test_the_governor_stops_a_fast_robot_short_of_a_wall_but_lets_it_pass_beside_one():
-    governor = motion.Governor(JACKAL, 0.1, 0.03)
-    wall = np.column_stack((np.full(40, 1.0), np.linspace(-1.0, 1.0, 40)))
-    slowed = governor.govern(np.array([1.0, 0.0]), np.zeros(2), 0.0, wall)
-    assert np.hypot(*slowed) * JACKAL.gains.speed_gain == pytest.approx(
-        governor.policy.safe_speed(1.0 - JACKAL.radius_m - 0.1)
-    )
-    beside = np.column_stack((np.linspace(-1.0, 2.0, 40), np.full(40, 0.3)))
-    free = governor.govern(np.array([1.0, 0.0]), np.zeros(2), 0.0, beside)
-    assert np.allclose(free, [1.0, 0.0])
 
 
 def test_a_dense_scan_repels_through_its_nearest_echo_per_ring_sector():
@@ -119,7 +183,10 @@ def test_a_body_with_other_limits_gets_its_own_reach():
     )
     governor = motion.Governor(slow, 0.1, 0.03)
     assert not governor.idle  # brakes in 0.5 m
-    assert governor.reach_m == pytest.approx(0.2 + 1.0 * (0.05 + 0.5) + 0.1)
+    # One control period at 1 m/s and braking from it; the coast of a 2.5 rad/s turn (30 rad/s^2).
+    travel, turn = 1.0 * (0.05 + 0.5), 2.5 * 0.05 + 2.5**2 / 60
+    swept = travel + 0.2 * turn
+    assert governor.reach_m == pytest.approx(0.2 + travel + 0.1 + motion.PREDICTION_ERROR * swept)
 
 
 def _run(scenario_text_or_name: str, overrides: list[str]):
@@ -129,17 +196,37 @@ def _run(scenario_text_or_name: str, overrides: list[str]):
     return run_scenario(load_scenario(scenario_text_or_name, overrides)).summary
 
 
-def test_a_jackal_crosses_a_barn_protocol_world_fast_and_without_a_collision(tmp_path):
+@pytest.fixture(scope="module")
+def protocol_worlds(tmp_path_factory):
+    """The first 27 BARN protocol worlds of seed 0 as scenario files."""
     from vplane_mj.worlds.barn_protocol import generate_protocol
 
-    case = generate_protocol(2, 0)[1]
-    path = tmp_path / f"{case.name}.toml"
-    path.write_text(case.toml(), encoding="utf-8")
-    summary = _run(str(path), ["planner.name=vplane_plus", "run.seed=0"])
+    out = tmp_path_factory.mktemp("barn")
+    paths = []
+    for case in generate_protocol(27, 0):
+        path = out / f"{case.name}.toml"
+        path.write_text(case.toml(), encoding="utf-8")
+        paths.append(str(path))
+    return paths
+
+
+@pytest.mark.parametrize(
+    ("world", "seed", "least_score"),
+    [
+        (1, 0, 0.4),  # measured 0.50: within twice the reference path's time at 2 m/s
+        (16, 0, 0.3),  # the robot's turn coasted it into a post on every seed before the turn lag
+        (26, 2, 0.3),  # the robot wedged itself between posts before it could back off
+    ],
+)
+def test_a_jackal_crosses_barn_protocol_worlds_without_a_collision(protocol_worlds, world, seed, least_score):
+    overrides = ["planner.name=vplane_plus", f"run.seed={seed}", "sensors.noise_std=0.01"]
+    summary = _run(protocol_worlds[world], overrides)
     assert summary.outcome == "reached" and summary.collisions == 0
-    assert summary.score > 0.4  # measured 0.50: within twice the reference path's time at 2 m/s
+    assert summary.score > least_score
 
 
-def test_the_pioneer_escapes_the_paper_h_trap_without_a_collision():
-    summary = _run("paper_h_escape", ["planner.name=vplane", "robot.profile=pioneer3dx", "run.seed=0"])
+@pytest.mark.parametrize("profile", ["pioneer3dx", "turtlebot3_burger"])
+@pytest.mark.parametrize("scenario", ["paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape"])
+def test_the_sonar_and_small_laser_robots_solve_the_paper_scenarios_without_a_collision(profile, scenario):
+    summary = _run(scenario, ["planner.name=vplane", f"robot.profile={profile}", "run.seed=0"])
     assert summary.outcome == "reached" and summary.collisions == 0

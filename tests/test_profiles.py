@@ -204,10 +204,13 @@ class Run:
         return float(np.mean(signal[len(signal) // 2 :]))
 
 
-def drive_from_standing(profile: RobotProfile, speed: float, turn: float, ramp: bool, seconds: float) -> Run:
+def drive_from_standing(
+    profile: RobotProfile, speed: float, turn: float, ramp: bool, seconds: float, stop_s: float = math.inf
+) -> Run:
     """Command (speed m/s, turn rad/s) from standing, ramped at the profile's accelerations or
     stepped (as today's drive does), through a wheel-speed PI loop per side at the motor rate
-    (as vplane_mj.sim.drive runs it), the wheel targets from the track times the track_scale."""
+    (as vplane_mj.sim.drive runs it), the wheel targets from the track times the track_scale;
+    from `stop_s` (s) on, command a stop."""
     model = attached_model(profile)
     data = mujoco.MjData(model)
     gains, limits = profile.gains, profile.limits
@@ -222,13 +225,15 @@ def drive_from_standing(profile: RobotProfile, speed: float, turn: float, ramp: 
     trace = []
     started = time.perf_counter()
     for _ in range(round(seconds / dt)):
+        wanted = (speed, turn) if data.time < stop_s else (0.0, 0.0)
         if ramp:
+            dv, dw = limits.max_accel_mps2 * dt, limits.max_turn_accel_radps2 * dt
             commanded = (
-                min(speed, commanded[0] + limits.max_accel_mps2 * dt),
-                min(turn, commanded[1] + limits.max_turn_accel_radps2 * dt),
+                commanded[0] + float(np.clip(wanted[0] - commanded[0], -dv, dv)),
+                commanded[1] + float(np.clip(wanted[1] - commanded[1], -dw, dw)),
             )
         else:
-            commanded = (speed, turn)
+            commanded = wanted
         targets = wheel_targets(
             *commanded, facts.track_m * profile.track_scale, facts.wheel_radius_m, gains.max_wheel_speed
         )
@@ -271,6 +276,21 @@ def test_each_robot_turns_in_place_at_its_top_turn_rate(name):
     else:  # stepped commands: the limit lies between the mean rise and the start's peak
         peak = float(np.max(np.diff(run.yaw_rate) / np.diff(run.time)))
         assert accel <= profile.limits.max_turn_accel_radps2 <= peak
+
+
+@pytest.mark.parametrize("name", [name for name in NAMES if PROFILES[name].ramped])
+def test_each_robot_stops_turning_its_turn_lag_after_its_ramp(name):
+    # Turning in place, then stopped: the drive ramps the turn rate down at the top turn
+    # acceleration (omega^2 / 2 alpha of turn); the robot turns its turn lag x omega beyond.
+    profile = PROFILES[name]
+    limits = profile.limits
+    for share in (0.5, 1.0):
+        turn = share * limits.max_turn_rate_radps
+        run = drive_from_standing(profile, 0.0, turn, ramp=True, seconds=5.0, stop_s=3.0)
+        after = run.time > 3.0
+        coast = float(np.sum(run.yaw_rate[after] * np.diff(run.time, prepend=0.0)[after]))
+        beyond = (coast - turn * turn / (2 * limits.max_turn_accel_radps2)) / turn
+        assert beyond == pytest.approx(limits.turn_lag_s, abs=0.03)
 
 
 def test_a_profile_is_frozen_data():

@@ -2,7 +2,7 @@
 
 This is the baseline the paper improves on: it has no escape, so once the
 local-minimum detector has held it trapped for `patience_s` it gives up (outcome
-`stuck`). The governor (motion.py) fits the force to the robot's body.
+`stuck`). The governor (motion.py) drives the force on the robot's body.
 """
 
 from __future__ import annotations
@@ -38,8 +38,9 @@ class ApfPlanner(Planner):
     def step(self, obs: Observation) -> Decision:
         components = self.params.firas_components(obs)
         total = components["attractive"] + components["repulsive"]
-        if not self.governor.idle:
-            total = self.governor.govern(total, obs.position, obs.yaw, obs.echo_points())
-        decision = Decision(force=total, mode="normal", components=components)
+        steering = self.governor.steer(total, obs, obs.echo_points())
+        decision = Decision(
+            force=steering.force, mode="normal", components=components, command=steering.command
+        )
         report_trap(self.detector, obs, decision, self.params.patience_s)
         return decision

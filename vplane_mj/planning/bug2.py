@@ -7,7 +7,7 @@ the goal direction) it records the hit point and switches to "following", keepin
 on one side at `wall_distance_m`. It leaves the wall when it is back on the m-line closer
 to the goal than the hit point and the way to the goal is clear. It gives up when it comes
 back to the hit point after a loop around the obstacle (the goal is unreachable) or after
-`max_follow_s` of following. The governor (motion.py) fits the force to the robot's body.
+`max_follow_s` of following. The governor (motion.py) drives the force on the robot's body.
 """
 
 from __future__ import annotations
@@ -226,6 +226,11 @@ class Bug2Planner(Planner):
             return Decision(force=np.zeros(2), mode="gave_up", events=events, gave_up=True)
         components = self._go_to_goal(obs) if self.mode == "go_to_goal" else self._follow(obs)
         force = np.sum(list(components.values()), axis=0)
-        if not self.governor.idle:
-            force = self.governor.govern(force, position, obs.yaw, obs.echo_points())
-        return Decision(force=force, mode=self.mode, components=components, events=events)
+        steering = self.governor.steer(force, obs, obs.echo_points())
+        return Decision(
+            force=steering.force,
+            mode=self.mode,
+            components=components,
+            events=events,
+            command=steering.command,
+        )

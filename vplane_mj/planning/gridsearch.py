@@ -204,6 +204,32 @@ def cost_to_go(cost: np.ndarray, targets: np.ndarray, target_costs: np.ndarray, 
     return costs[:n].reshape(nx, ny)
 
 
+def way_to(
+    window: Window, start: np.ndarray, end: np.ndarray, radius_m: float
+) -> list[tuple[int, int]] | None:
+    """The cells of the window's shortest way from `start` toward `end` (m), the start's first:
+    to the end's cell when the window holds it (made passable within `radius_m` of the end),
+    else to the window's edge, each edge cell starting at its straight distance to the end.
+    The start is the free cell nearest it within 2 `radius_m`; None when there is none, or no
+    way from it."""
+    shape = window.cost.shape
+    end_cell = window.cell_of(end)
+    if end_cell is not None:
+        window.clear_disc(end, radius_m)
+        targets, target_costs = np.array([np.ravel_multi_index(end_cell, shape)]), np.zeros(1)
+    else:
+        edge = np.zeros(shape, dtype=bool)
+        edge[[0, -1], :] = edge[:, [0, -1]] = True
+        targets = np.flatnonzero(edge)
+        centres = window.centres().reshape(-1, 2)[targets]
+        target_costs = np.hypot(*(centres - end).T)
+    costs = cost_to_go(window.cost, targets, target_costs, window.cell_m)
+    start_cell = window.free_cell_near(start, 2 * radius_m)
+    if start_cell is None or not np.isfinite(costs[start_cell]):
+        return None
+    return descend(costs, start_cell, shape[0] * shape[1])
+
+
 def descend(costs: np.ndarray, start: tuple[int, int], max_cells: int) -> list[tuple[int, int]]:
     """The cells from `start` down the cost to the target (steepest descent over 8 neighbours),
     at most `max_cells` steps; just `start` when it has no finite cost."""

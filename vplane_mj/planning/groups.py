@@ -4,7 +4,7 @@ A planner's parameters combine them by inheritance (bases listed last group firs
 `PlannerParams`): `FieldParams` (Khatib's fields, eqs. 2-6), `DetectorParams` (the
 local-minimum detector), `MinimumParams` (the detector and the patience of a planner without
 an escape), `LocalMapParams` (the sonar certainty grid), `SonarMapParams` (the grid and its
-polar histogram) and `MotionParams` (the margins of the governor that fits a force to the
+polar histogram) and `MotionParams` (the margins of the governor that drives a force on the
 robot's body).
 """
 
@@ -47,17 +47,22 @@ class FieldParams(PlannerParams):
 
 @dataclass(frozen=True)
 class MotionParams(PlannerParams):
-    """The margins of the governor that fits a force to the robot's body (motion.py)."""
+    """The margins of the governor that drives a force on the robot's body (motion.py)."""
 
     stop_margin_m: float = param(
-        0.1, "m", "the speed allows braking to a stop this far short of an obstacle ahead", ge=0, le=1.0
+        0.1,
+        "m",
+        "a robot turning creeps ahead while its disc has this much room; backing off brakes in it",
+        ge=0,
+        le=1.0,
     )
     turn_margin_m: float = param(
-        0.03, "m", "a turn in place keeps the footprint this far from obstacles", ge=0, le=1.0
+        0.03, "m", "turns and predicted motions keep the footprint this far from obstacles", ge=0, le=1.0
     )
 
     def governor(self, body: RobotBody) -> Governor:
-        """The governor of forces for `body` with these margins."""
+        """A governor of forces for `body` with these margins (one per planner: it follows
+        the planner's commands)."""
         return Governor(body, self.stop_margin_m, self.turn_margin_m)
 
 
@@ -97,9 +102,10 @@ class LocalMapParams(PlannerParams):
         4, "", "certainty at which a map cell counts as an obstacle", ge=1, integer=True
     )
 
-    def local_map(self) -> LocalMap:
-        """A fresh, empty sonar map of this cell size and side."""
-        return LocalMap(self.map_cell_m, self.map_size_m)
+    def local_map(self, least_size_m: float = 0.0) -> LocalMap:
+        """A fresh, empty sonar map of this cell size and side, or of `least_size_m` (m) when
+        that is larger (a planner that looks farther than the side allows)."""
+        return LocalMap(self.map_cell_m, max(self.map_size_m, least_size_m))
 
 
 @dataclass(frozen=True)

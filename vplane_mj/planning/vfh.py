@@ -9,8 +9,8 @@ valleys, the directions half a wide valley in from each border. The cost
 5 |c - goal| + 2 |c - heading| + 2 |c - previous| picks one (VFH+'s weights). The force
 is a unit vector that way, shortened within 1 m of the goal. With no valley the robot
 stops; the local-minimum detector then makes it give up after `patience_s` (`stuck`).
-The governor (motion.py) then fits the force to the robot's body: no turn in place into an
-obstacle, and no faster than the robot can brake within the room ahead.
+The governor (motion.py) then drives the force on the robot's body: its commands keep the
+footprint off the obstacles over the motion they start.
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ from vplane_mj.planning.base import Planner
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.groups import MinimumParams, MotionParams, SonarMapParams
 from vplane_mj.planning.minima import report_trap
+from vplane_mj.planning.motion import Steering
 from vplane_mj.planning.params import param
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.planning.vectors import wrap_angle
@@ -78,23 +79,24 @@ class VfhPlanner(Planner):
         goal_bearing = math.atan2(to_goal[1], to_goal[0])
         direction = self._choose(histogram.find_valleys(h > p.histogram_threshold), goal_bearing, obs.yaw)
         decision = Decision(force=np.zeros(2), mode="normal")
+        force = np.zeros(2)
         if direction is None:
             decision.mode = "blocked"
         else:
             self.previous = direction
-            scale = min(1.0, obs.distance_to_goal())
-            force = scale * np.array([math.cos(direction), math.sin(direction)])
-            decision.force = self._governed(force, obs)
+            force = min(1.0, obs.distance_to_goal()) * np.array([math.cos(direction), math.sin(direction)])
+        steering = self._governed(force, obs)
+        decision.force, decision.command = steering.force, steering.command
         decision.components = {"steering": decision.force}
         report_trap(self.detector, obs, decision, p.patience_s)
         return decision
 
-    def _governed(self, force: np.ndarray, obs: Observation) -> np.ndarray:
-        """The force fitted to the robot's body among the echoes and the mapped cells near it."""
+    def _governed(self, force: np.ndarray, obs: Observation) -> Steering:
+        """The command for the force (motion.py) among the echoes and the mapped cells near it."""
         if self.governor.idle:
-            return force
+            return Steering(force)
         cells, _ = self.map.cells(self.params.map_threshold, obs.position, self.governor.reach_m)
-        return self.governor.govern(force, obs.position, obs.yaw, np.vstack((obs.echo_points(), cells)))
+        return self.governor.steer(force, obs, np.vstack((obs.echo_points(), cells)))
 
     def _choose(self, valleys: list[histogram.Valley], goal: float, heading: float) -> float | None:
         """The VFH+ candidate direction of least cost, or None when every sector is blocked."""

@@ -4,7 +4,7 @@ On each local-minimum detection a virtual obstacle (a FIRAS repulsive point, eqs
 placed at the robot's position and pushes it out of the minimum. A virtual obstacle is
 cleared after `vobs_lifetime_s`; the robot may then fall back into the same minimum, the
 weakness the virtual-plane method addresses. After `max_virtual` obstacles the planner
-gives up (outcome `stuck`). The governor (motion.py) fits the force to the robot's body.
+gives up (outcome `stuck`). The governor (motion.py) drives the force on the robot's body.
 """
 
 from __future__ import annotations
@@ -84,9 +84,8 @@ class VobsPlanner(Planner):
             self.virtual = [v for v in self.virtual if v not in expired]
         points = np.array([position for _, position in self.virtual]).reshape(-1, 2)
         components["virtual"] = fields.repulsive_force(obs.position, points, p.vobs_gain, p.vobs_influence_m)
-        decision.force = sum(components.values(), np.zeros(2))
-        if not self.governor.idle:
-            decision.force = self.governor.govern(decision.force, obs.position, obs.yaw, obs.echo_points())
+        steering = self.governor.steer(sum(components.values(), np.zeros(2)), obs, obs.echo_points())
+        decision.force, decision.command = steering.force, steering.command
         decision.mode = "escaping" if len(self.virtual) else "normal"
         decision.planes = []
         return decision

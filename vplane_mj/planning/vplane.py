@@ -35,6 +35,7 @@ from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.groups import DetectorParams, FieldParams, MotionParams, SonarMapParams
 from vplane_mj.planning.localmap import angular_extremes
+from vplane_mj.planning.motion import Steering
 from vplane_mj.planning.params import param
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.planning.vectors import unit
@@ -165,18 +166,19 @@ class VPlanePlanner(Planner):
                 )
         components["virtual"] = self._planes_force(obs.position)
         decision.components = components
-        decision.force = self._governed(sum(components.values(), np.zeros(2)), obs)
+        steering = self._governed(sum(components.values(), np.zeros(2)), obs)
+        decision.force, decision.command = steering.force, steering.command
         decision.objective = self.temp_goal
         decision.planes = [(plane.e1, plane.e2) for plane in self.planes]
         return decision
 
-    def _governed(self, force: np.ndarray, obs: Observation) -> np.ndarray:
-        """The force fitted to the robot's body (motion.py) among the echoes and the mapped
+    def _governed(self, force: np.ndarray, obs: Observation) -> Steering:
+        """The command for the force (motion.py) among the echoes and the mapped
         cells around it, which remember what the sensor sees between its beams or behind."""
         if self.governor.idle:
-            return force
+            return Steering(force)
         cells, _ = self.map.cells(self.params.map_threshold, obs.position, self.governor.reach_m)
-        return self.governor.govern(force, obs.position, obs.yaw, np.vstack((obs.echo_points(), cells)))
+        return self.governor.steer(force, obs, np.vstack((obs.echo_points(), cells)))
 
     # -- Algorithm 2: escaping ---------------------------------------------------------------
     def _start_escape(self, obs: Observation, decision: Decision) -> bool:

@@ -22,8 +22,12 @@ unknown counted as free):
   map holds no way to the goal at all for `no_way_patience_s`. A dense scan (a laser: scan.py)
   maps the obstacles it sees as they are from the first scan, so with one the robot follows
   the map's way from the start;
-- the governor (motion.py) fits the force to the robot's body: no turn in place into an
-  obstacle, and no faster than the robot can brake within the room ahead.
+- the governor (motion.py) drives a robot that is not a small disc for the force: its
+  commands keep the footprint off the echoes and the mapped cells over the motion they start
+  (the drive's ramp and the coast of a turn included), and back the robot off where it is shut
+  in. On a way of the map such a robot is not repelled by the echoes: the way keeps it off the
+  mapped obstacles and the governor off everything else, and the repulsion would only turn
+  it off the way where it passes close to an obstacle.
 
 Every decision is an event (`/events`), and objectives and planes appear in `/virtual`.
 """
@@ -40,6 +44,7 @@ from vplane_mj.planning import fields, gridsearch, scan
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.localmap import LocalMap, angular_extremes
+from vplane_mj.planning.motion import Steering
 from vplane_mj.planning.params import param, with_default
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.planning.vectors import unit, wrap_angle
@@ -222,7 +227,8 @@ class VPlanePlusPlanner(VPlanePlanner):
         components["virtual"] = np.zeros(2) if self.following else self._planes_force(obs.position)
         components["map"] = self._nearest_cell_force(obs.position)
         decision.components = components
-        decision.force = self._governed(sum(components.values(), np.zeros(2)), obs)
+        steering = self._governed(sum(components.values(), np.zeros(2)), obs)
+        decision.force, decision.command = steering.force, steering.command
         decision.objective = self.temp_goal
         decision.planes = [(plane.e1, plane.e2) for plane in self.planes]
         return decision
@@ -256,11 +262,14 @@ class VPlanePlusPlanner(VPlanePlanner):
         every narrow gap, since an echo is placed on its sonar's axis, up to half a beam away
         from the obstacle that returned it. Echoes closer than the robot radius plus
         CLOSE_ECHO_MARGIN_M, and without a way (the map shows none) all echoes, repel in full,
-        as in normal mode."""
+        as in normal mode. A governed robot on a way is not repelled (module docstring)."""
         p = self.params
         heading = unit(waypoint - obs.position)
         components["attractive"] = pull * heading
         if not on_a_way:
+            return
+        if not self.governor.idle:
+            components["repulsive"] = np.zeros(2)
             return
         echoes = obs.echo_points()
         close = np.hypot(*(echoes - obs.position).T) < self.radius + CLOSE_ECHO_MARGIN_M
@@ -270,13 +279,13 @@ class VPlanePlusPlanner(VPlanePlanner):
         near = fade * fields.repulsive_force(obs.position, echoes[close], gain, influence)
         components["repulsive"] = near + farther - min(float(farther @ heading), 0.0) * heading
 
-    def _governed(self, force: np.ndarray, obs: Observation) -> np.ndarray:
-        """The force fitted to the robot's body (motion.py) among the echoes and the mapped
+    def _governed(self, force: np.ndarray, obs: Observation) -> Steering:
+        """The command for the force (motion.py) among the echoes and the mapped
         cells around it (not swept), which remember what the sensor sees between its beams or
         behind; on a way, no faster than lets the robot turn along the way's next
         `BEND_HORIZON_M`."""
         if self.governor.idle:
-            return force
+            return Steering(force)
         cells = self._mapped_cells_near(obs.position, self.governor.reach_m)
         way = self.escape_way if self.temp_goal is not None else self.follow_way if self.following else []
         speed = math.inf
@@ -285,7 +294,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             travelled = np.cumsum(np.hypot(*np.diff(np.vstack((obs.position, ahead)), axis=0).T))
             speed = self.governor.policy.bend_speed(obs.position, obs.yaw, ahead[travelled <= BEND_HORIZON_M])
         points = np.vstack((obs.echo_points(), cells))
-        return self.governor.govern(force, obs.position, obs.yaw, points, speed)
+        return self.governor.steer(force, obs, points, speed)
 
     def _mapped_cells_near(self, position: np.ndarray, reach_m: float) -> np.ndarray:
         """Centres (N, 2) of the mapped obstacle cells (not swept) within a square of half side
@@ -615,24 +624,11 @@ class VPlanePlusPlanner(VPlanePlanner):
     def _way(self, window: gridsearch.Window, start: np.ndarray, end: np.ndarray) -> list[np.ndarray] | None:
         """Waypoints (m) of the map's shortest way from `start` to `end` (beyond the window:
         toward it in a straight line from the window's edge); None when there is none."""
-        shape = window.cost.shape
-        end_cell = window.cell_of(end)
-        if end_cell is not None:
-            window.clear_disc(end, self.radius)
-            targets, target_costs = np.array([np.ravel_multi_index(end_cell, shape)]), np.zeros(1)
-        else:
-            edge = np.zeros(shape, dtype=bool)
-            edge[[0, -1], :] = edge[:, [0, -1]] = True
-            targets = np.flatnonzero(edge)
-            centres = window.centres().reshape(-1, 2)[targets]
-            target_costs = np.hypot(*(centres - end).T)
-        costs = gridsearch.cost_to_go(window.cost, targets, target_costs, window.cell_m)
-        start_cell = window.free_cell_near(start, 2 * self.radius)
-        if start_cell is None or not np.isfinite(costs[start_cell]):
+        cells = gridsearch.way_to(window, start, end, self.radius)
+        if cells is None:
             return None
-        cells = gridsearch.descend(costs, start_cell, shape[0] * shape[1])
         way = [window.centre(c) for c in cells[1:]]
-        if end_cell is not None:
+        if window.cell_of(end) is not None:
             way.append(np.asarray(end, float))
         self.sight = window
         return way

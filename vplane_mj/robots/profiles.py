@@ -144,7 +144,11 @@ JACKAL = RobotProfile(
     track_scale=1.9,
     wheel_friction=0.5,
     limits=DriveLimits(
-        max_speed_mps=2.0, max_turn_rate_radps=4.0, max_accel_mps2=2.0, max_turn_accel_radps2=4.0
+        max_speed_mps=2.0,
+        max_turn_rate_radps=4.0,
+        max_accel_mps2=2.0,
+        max_turn_accel_radps2=4.0,
+        turn_lag_s=0.06,
     ),
     ramped=True,
     gains=ControllerGains(
@@ -192,7 +196,13 @@ JACKAL = RobotProfile(
             "jackal_control/config/control.yaml)",
             "accelerations": "chosen: top speed and top turn rate in 1 s (control.yaml's limits of "
             "20 m/s^2 and 25 rad/s^2 do not bind); the 4 N m per side motors deliver 3.9 m/s^2 "
-            "straight without spin-out, and turn in place at 4 rad/s against the tyres' skid",
+            "straight without spin-out, and turn in place at 4 rad/s against the tyres' skid; "
+            "ramped at 6 rad/s^2 the model turns up at only 4.6 rad/s^2 (the limit must hold "
+            "within 15 %), so 4 rad/s^2 stays",
+            "turn lag": "measured (tests/test_profiles.py): stopped from turning in place at 2 and "
+            "4 rad/s, the model turns 0.06-0.08 s x its turn rate beyond its ramp's "
+            "omega^2 / 2 alpha (the tyres slip before they turn it; 0.01 s and less for the "
+            "differential drives)",
             "gains": "chosen: speed_gain = top speed per unit force and turn_gain 3.0, as the default "
             "robot; wheel PI of the default's bandwidth (kp over the side's inertia about 24 /s, "
             "ki = 10 kp); max_wheel_speed 1.2 x the faster wheel speed of the top speed and the top "
