@@ -10,7 +10,8 @@ import pytest
 
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.synthetic import BEAM, BEARINGS, LAYOUTS, scan
-from vplane_mj.planning import beams, localmap
+from vplane_mj.planning import beams
+from vplane_mj.planning.kernels.map_update import nearest_by_search, nearest_in_ring
 from vplane_mj.planning.localmap import LocalMap, angular_extremes
 
 WALL = shapes.Footprints(shapes.Wall((2.0, -1.0), (2.0, 1.0), 0.1).footprint())
@@ -171,14 +172,6 @@ def dense_update(
     np.clip(window, 0, top, out=window)
 
 
-@pytest.fixture(params=["table", "walk"])
-def path(request, monkeypatch):
-    """How the map finds the cells a scan may change: the cone table (a sonar's few beams) or
-    the compiled walk through each cone (a laser's many, or a far echo). The grid is the same."""
-    monkeypatch.setattr(localmap, "TABLE_MAX_BEAMS", 10**6 if request.param == "table" else 0)
-    return request.param
-
-
 @pytest.mark.parametrize(
     "count, beam_deg, cell, size, range_max, yaw_scale",
     [
@@ -190,7 +183,7 @@ def path(request, monkeypatch):
     ],
 )
 def test_the_update_equals_a_pass_over_every_cell_within_reach(
-    count, beam_deg, cell, size, range_max, yaw_scale, path
+    count, beam_deg, cell, size, range_max, yaw_scale
 ):
     rng = np.random.default_rng(count)
     bearings = np.arange(count) * (2 * math.pi / count)
@@ -298,7 +291,7 @@ def ring_sequence(options: dict) -> str:
 
 @pytest.mark.parametrize("nearest", ["ring arithmetic", "search"])
 @pytest.mark.parametrize("name", RING_MAPS)
-def test_the_ring_gives_the_grid_it_gave_before_any_other_scan_was_possible(name, path, nearest, monkeypatch):
+def test_the_ring_gives_the_grid_it_gave_before_any_other_scan_was_possible(name, nearest, monkeypatch):
     if nearest == "search":  # no ring is even enough for the arithmetic: every cell's beam is searched
         monkeypatch.setattr(beams, "RING_TOLERANCE_RAD", -1.0)
     assert ring_sequence(RING_MAPS[name]) == RING_DIGESTS[name]
@@ -318,8 +311,9 @@ def test_the_ring_arithmetic_and_the_search_give_every_angle_the_same_beam(count
     world = np.concatenate(
         [rng.uniform(-math.pi, math.pi, 50_000), wrapped(np.r_[on_axes, near_bounds] + axis)]
     )
-    ring_beam, ring_offset = fan.nearest_in_ring(world - axis, axis)
-    search_beam, search_offset = fan.nearest_by_search(world - axis)
+    ring = [nearest_in_ring(angle, axis, fan.spacing, fan.count) for angle in world - axis]
+    search = [nearest_by_search(angle, fan.bounds, fan.directions) for angle in world - axis]
+    (ring_beam, ring_offset), (search_beam, search_offset) = (np.array(pairs).T for pairs in (ring, search))
     np.testing.assert_array_equal(ring_beam, search_beam)
     np.testing.assert_allclose(ring_offset, search_offset, rtol=0, atol=1e-9)
     assert np.abs(ring_offset).max() <= math.pi / count + 1e-9  # the nearest: at most half the spacing
@@ -396,7 +390,7 @@ RULES = {
 
 @pytest.mark.parametrize("rule", RULES)
 @pytest.mark.parametrize("name", SCANS)
-def test_any_scan_updates_the_grid_as_the_rule_says_cell_by_cell(name, rule, path):
+def test_any_scan_updates_the_grid_as_the_rule_says_cell_by_cell(name, rule):
     bearings, beam, range_max = SCANS[name]
     options = RULES[rule]
     rng = np.random.default_rng(len(bearings))
@@ -491,7 +485,7 @@ def test_the_synthetic_scan_sees_posts_and_walls_where_they_are():
 
 
 @pytest.mark.parametrize("name", LAYOUTS)
-def test_a_scan_of_known_obstacles_marks_them_clears_the_way_and_leaves_unseen_cells(name, path):
+def test_a_scan_of_known_obstacles_marks_them_clears_the_way_and_leaves_unseen_cells(name):
     layout = LAYOUTS[name]
     rays = 5 if len(layout.bearings) < 100 else 1  # a sonar's echo: the nearest anywhere in its beam
     ranges, source = exact_ranges(ROBOT, HEADING, layout.bearings, layout.beam, layout.range_max, rays)
@@ -535,7 +529,7 @@ def test_a_scan_of_known_obstacles_marks_them_clears_the_way_and_leaves_unseen_c
 
 
 @pytest.mark.parametrize("name", ["jackal_laser", "sonar_ring"])
-def test_a_return_far_beyond_the_grid_clears_its_cone_to_the_edge_and_allocates_little(name, path):
+def test_a_return_far_beyond_the_grid_clears_its_cone_to_the_edge_and_allocates_little(name):
     layout = LAYOUTS[name]
     warm_up = LocalMap(cell_m=0.1, size_m=8.0)  # numba's kernel loads outside the measurement
     warm_up.update(ROBOT, 0.0, layout.bearings, np.full(len(layout.bearings), 30.0), layout.beam)
@@ -561,7 +555,7 @@ def test_a_return_far_beyond_the_grid_clears_its_cone_to_the_edge_and_allocates_
     np.testing.assert_array_equal(grid.grid, np.where(cleared, 4, 5))  # one miss each; no hit
 
 
-def test_beams_that_share_a_bearing_act_as_one_with_the_shortest_echo(path):
+def test_beams_that_share_a_bearing_act_as_one_with_the_shortest_echo():
     layout = LAYOUTS["pioneer_sonars"]
     ranges, _ = exact_ranges(ROBOT, HEADING, layout.bearings, layout.beam, layout.range_max, 5)
     ranges[[0, 15]] = (1.2, 0.9)  # the front and the rear sonar looking along +90 degrees
@@ -580,7 +574,7 @@ def test_beams_that_share_a_bearing_act_as_one_with_the_shortest_echo(path):
     assert grids[0][0].max() > 0
 
 
-def test_the_order_of_the_beams_does_not_matter(path):
+def test_the_order_of_the_beams_does_not_matter():
     layout = LAYOUTS["jackal_laser"]
     ranges, _ = exact_ranges(ROBOT, HEADING, layout.bearings, layout.beam, layout.range_max, 1)
     order = np.random.default_rng(3).permutation(len(ranges))
@@ -592,7 +586,7 @@ def test_the_order_of_the_beams_does_not_matter(path):
     np.testing.assert_array_equal(*grids)
 
 
-def test_an_arc_no_wider_than_a_cell_marks_beyond_the_hit_range(path):
+def test_an_arc_no_wider_than_a_cell_marks_beyond_the_hit_range():
     # A wall 3 m ahead, 0.6 m wide: a laser's 0.375 degree arc there is 2 cm wide and places
     # its echo; a 20 degree sonar arc is a metre wide, and past the hit range it only clears.
     marked = {}

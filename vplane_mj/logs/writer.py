@@ -122,6 +122,19 @@ METRICS_JSON_SCHEMA: dict[str, Any] = {
     "required": ["time_s", "mode"],
 }
 """Every value optional but `time_s` and `mode`: a missing or non-finite one is omitted."""
+_METRIC_KEYS = (
+    "time_s",
+    "speed_mps",
+    "distance_to_goal_m",
+    "force_attractive",
+    "force_repulsive",
+    "force_virtual",
+    "force_total",
+    "command_v_mps",
+    "command_omega_radps",
+    "odometry_error_m",
+)
+"""The numbers of /metrics, in the order of its messages (then `mode`)."""
 
 EVENTS_JSON_SCHEMA: dict[str, Any] = {
     "title": "vplane_mj.Event",
@@ -137,6 +150,8 @@ EVENTS_JSON_SCHEMA: dict[str, Any] = {
     "required": ["kind", "text"],
 }
 """An event as data; its points are present only when the event has them."""
+_FORCE_ARROWS = tuple((name, FORCE_COLOURS[name], dz) for name, (_, dz) in FORCE_STYLE.items())
+"""Each force arrow's name, colour and extra height, in the order they are drawn."""
 WARNING_EVENTS = {EventKind.COLLISION, EventKind.GAVE_UP, EventKind.ERROR, EventKind.BELIEVED_ARRIVED}
 """Events logged at the Warning level."""
 
@@ -196,13 +211,15 @@ class McapLog:
         start = np.asarray(scenario.robot.start, dtype=float)
         self._last_pose = (float(start[0]), float(start[1]), float(scenario.robot.start_yaw))
         self._last_ns = 0
-        self._shown_forces: set[str] = set()
+        self._shown_forces: list[str] = []  # in FORCE_STYLE's order
         self._virtual_state: tuple[tuple[float, ...] | None, tuple[tuple[float, ...], ...]] = (None, ())
         self._shown_planes = 0
+        self._virtual_shown: tuple[np.ndarray | None, list[tuple[np.ndarray, np.ndarray]]] = (None, [])
         self._path = PathSimplifier(PATH_TOLERANCE_M)
         self._scan_pose = scene.pose(0.0, 0.0, PROFILES[scenario.robot.profile].sensor_height_m)
         self._scan_slots, self._scan_angles = scan_slots(self.bearings)
         self._path_dirty = False
+        self._modes: dict[str, str] = {}  # mode -> its JSON string
         self._next_flush_s = 0.0  # the first tick flushes, so /path starts with the run
 
     # -- metadata and the static world -------------------------------------------------------
@@ -295,21 +312,25 @@ class McapLog:
 
     # -- per-tick topics ---------------------------------------------------------------------
     def _log_pose(self, ns: int, stamp: fm.Timestamp, x: float, y: float, yaw: float) -> None:
-        turn = scene.yaw_quaternion(yaw)
+        turn = fm.Quaternion(x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))  # scene.yaw_quaternion
         where = fm.Vector3(x=x, y=y, z=0.0)
         here = fm.Pose(position=where, orientation=turn)
         self._pose_ch.log(fm.PoseInFrame(timestamp=stamp, frame_id=WORLD_FRAME, pose=here), log_time=ns)
-        transforms = [
-            fm.FrameTransform(
-                timestamp=stamp,
-                parent_frame_id=WORLD_FRAME,
-                child_frame_id=child,
-                translation=where,
-                rotation=rotation,
-            )
-            for child, rotation in ((ROBOT_FRAME, turn), (FOLLOW_FRAME, scene.IDENTITY))
-        ]
-        self._tf_ch.log(fm.FrameTransforms(transforms=transforms), log_time=ns)
+        robot = fm.FrameTransform(
+            timestamp=stamp,
+            parent_frame_id=WORLD_FRAME,
+            child_frame_id=ROBOT_FRAME,
+            translation=where,
+            rotation=turn,
+        )
+        follow = fm.FrameTransform(
+            timestamp=stamp,
+            parent_frame_id=WORLD_FRAME,
+            child_frame_id=FOLLOW_FRAME,
+            translation=where,
+            rotation=scene.IDENTITY,
+        )
+        self._tf_ch.log(fm.FrameTransforms(transforms=[robot, follow]), log_time=ns)
 
     def _log_belief(self, ns: int, stamp: fm.Timestamp, belief: tuple[float, float, float] | None) -> None:
         if self._odometry_ch is None or belief is None or not all(map(math.isfinite, belief)):
@@ -322,7 +343,7 @@ class McapLog:
     def _log_scan(self, ns: int, stamp: fm.Timestamp, ranges: np.ndarray) -> None:
         if self._scan_slots is not None:
             ranges = on_slots(ranges, self._scan_slots)
-        ranges = np.round(ranges / RANGE_STEP_M) * RANGE_STEP_M
+        ranges = np.rint(ranges * (1.0 / RANGE_STEP_M)) * RANGE_STEP_M  # a step of 2^-10: exact
         scan = fm.LaserScan(
             timestamp=stamp,
             frame_id=ROBOT_FRAME,
@@ -334,23 +355,33 @@ class McapLog:
         self._scan_ch.log(scan, log_time=ns)
 
     def _log_forces(self, ns: int, stamp: fm.Timestamp, x: float, y: float, tick: Tick) -> None:
-        components = tick.decision.components
+        decision = tick.decision
+        components = decision.components
         entities = []
-        shown = set()
-        for name, (_, dz) in FORCE_STYLE.items():
-            vector = tick.decision.force if name == "total" else components.get(name)
+        shown = []
+        for name, colour, dz in _FORCE_ARROWS:
+            vector = decision.force if name == "total" else components.get(name)
             if vector is None:
                 continue
-            arrow = scene.force_arrow(x, y, float(vector[0]), float(vector[1]), FORCE_COLOURS[name], dz)
+            arrow = scene.force_arrow(x, y, float(vector[0]), float(vector[1]), colour, dz)
             if arrow is None:
                 continue
-            shown.add(name)
+            shown.append(name)
             entities.append(fm.SceneEntity(timestamp=stamp, frame_id=WORLD_FRAME, id=name, arrows=[arrow]))
-        deletions = [scene.deletion(stamp, name) for name in sorted(self._shown_forces - shown)]
+        deletions = [scene.deletion(stamp, name) for name in self._shown_forces if name not in shown]
         self._shown_forces = shown
         self._forces_ch.log(fm.SceneUpdate(deletions=deletions, entities=entities), log_time=ns)
 
     def _log_virtual(self, ns: int, stamp: fm.Timestamp, tick: Tick) -> None:
+        decision = tick.decision
+        last_objective, last_planes = self._virtual_shown
+        if (
+            decision.objective is last_objective
+            and len(decision.planes) == len(last_planes)
+            and all(a is c and b is d for (a, b), (c, d) in zip(decision.planes, last_planes, strict=True))
+        ):
+            return  # the very objects of the last tick (held here): a planner keeps them while they stand
+        self._virtual_shown = (decision.objective, list(decision.planes))
         objective = _finite_tuple(tick.decision.objective)
         planes = tuple(
             plane
@@ -376,28 +407,30 @@ class McapLog:
 
     def _log_metrics(self, ns: int, tick: Tick) -> None:
         components = tick.decision.components
-        distance = math.hypot(
-            self._goal[0] - float(tick.position[0]), self._goal[1] - float(tick.position[1])
+        x, y = float(tick.position[0]), float(tick.position[1])
+        values = (
+            tick.time_s,
+            tick.speed,
+            math.hypot(self._goal[0] - x, self._goal[1] - y),
+            _magnitude(components.get("attractive")),
+            _magnitude(components.get("repulsive")),
+            _magnitude(components.get("virtual")),
+            _magnitude(tick.decision.force),
+            tick.command[0],
+            tick.command[1],
+            None if tick.believed_pose is None else math.dist(tick.believed_pose[:2], (x, y)),
         )
-        values = {
-            "time_s": tick.time_s,
-            "speed_mps": tick.speed,
-            "distance_to_goal_m": distance,
-            "force_attractive": _magnitude(components.get("attractive")),
-            "force_repulsive": _magnitude(components.get("repulsive")),
-            "force_virtual": _magnitude(components.get("virtual")),
-            "force_total": _magnitude(tick.decision.force),
-            "command_v_mps": tick.command[0],
-            "command_omega_radps": tick.command[1],
-        }
-        if tick.believed_pose is not None:
-            position = (float(tick.position[0]), float(tick.position[1]))
-            values["odometry_error_m"] = math.dist(tick.believed_pose[:2], position)
-        record: dict[str, float | str] = {
-            key: float(value) for key, value in values.items() if value is not None and math.isfinite(value)
-        }
-        record["mode"] = tick.decision.mode
-        self._metrics_ch.log(record, log_time=ns)
+        # JSON text as json.dumps writes it (a float's repr); a missing or non-finite value is left out.
+        fields = [
+            f'"{key}": {float(value)!r}'
+            for key, value in zip(_METRIC_KEYS, values, strict=True)
+            if value is not None and math.isfinite(value)
+        ]
+        mode = self._modes.get(tick.decision.mode)
+        if mode is None:
+            mode = self._modes[tick.decision.mode] = json.dumps(tick.decision.mode)
+        fields.append(f'"mode": {mode}')
+        self._metrics_ch.log(("{" + ", ".join(fields) + "}").encode(), log_time=ns)
 
     # -- the path ----------------------------------------------------------------------------
     def _log_path(self, ns: int) -> None:

@@ -1,12 +1,11 @@
-"""The directions of a scan's beams, and which beam speaks for a point (the local map's rule).
+"""The directions of a scan's beams, as the local map judges cells by them.
 
 A scan's bearings come in any order, unevenly spaced, over any field of view, and several
 beams may share a bearing (they then act as one, with the shortest of their echoes). A
 point's beam is the one whose bearing is nearest to the point's; the map then asks whether
 the point lies within half a beam width of it. For an evenly spaced ring the nearest beam
-follows by arithmetic (`nearest_in_ring`), for any directions by a search among the bounds
-half-way between neighbouring directions (`nearest_by_search`): one rule, two ways, and they
-agree wherever rounding does not decide (a tie exactly half-way between two beams).
+follows by arithmetic, for any directions by a search among the bounds half-way between
+neighbouring directions (`kernels.map_update.nearest_in_ring` and `nearest_by_search`).
 """
 
 from __future__ import annotations
@@ -22,8 +21,8 @@ RING_TOLERANCE_RAD = 1e-12
 
 
 class BeamFan:
-    """The directions of a scan's beams: sorted, those that share a bearing merged, and the rule
-    that gives a cell its beam (the nearest direction) and its angle from that beam's axis.
+    """The directions of a scan's beams: sorted, those that share a bearing merged, with what
+    the rule that gives a cell its beam (the nearest direction) needs.
 
     Directions are angles in [0, 2 pi) (one slightly below 0 when a bearing lies within
     SAME_DIRECTION_RAD below a full turn); `relative` are them less the first. Each beam's
@@ -33,6 +32,8 @@ class BeamFan:
 
     def __init__(self, bearings: np.ndarray, beam: float):
         turn = 2 * math.pi
+        self.source = bearings
+        """The bearings as given (a sensor gives the same array at every scan)."""
         self.bearings = np.array(bearings, dtype=float)
         self.beam = beam
         wrapped = np.mod(self.bearings, turn)
@@ -60,33 +61,3 @@ class BeamFan:
             return ranges
         ordered = ranges[self._order]
         return ordered if self.count == len(ordered) else np.fmin.reduceat(ordered, self._first)
-
-    def nearest(self, angle: np.ndarray, axis: float) -> tuple[np.ndarray, np.ndarray]:
-        """The nearest direction (index) of each angle (rad from the first direction's world
-        axis, `axis`), and the angle from its axis, in [-pi, pi)."""
-        if self.spacing is not None:
-            return self.nearest_in_ring(angle, axis)
-        return self.nearest_by_search(angle)
-
-    def nearest_in_ring(self, angle: np.ndarray, axis: float) -> tuple[np.ndarray, np.ndarray]:
-        """`nearest` by arithmetic, for an evenly spaced ring."""
-        spacing = self.spacing
-        assert spacing is not None, "the arithmetic holds for an evenly spaced ring only"
-        beam = np.rint(angle / spacing).astype(int)  # halves to even, as np.round
-        beam %= self.count
-        offset = angle - beam * spacing + math.pi  # wrapped below: the angle from its axis
-        if abs(axis) <= math.pi:  # offset in (-2 pi, 4 pi): the modulo is one conditional turn
-            turn = 2 * math.pi
-            offset = np.where(offset < 0.0, offset + turn, np.where(offset >= turn, offset - turn, offset))
-            offset -= math.pi
-        else:
-            offset = offset % (2 * math.pi) - math.pi
-        return beam, offset
-
-    def nearest_by_search(self, angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """`nearest` by a search among the directions' bounds, for any directions."""
-        turn = 2 * math.pi
-        angle = angle % turn
-        beam = np.searchsorted(self.bounds, angle, side="right")
-        beam %= self.count
-        return beam, (angle - self.relative[beam] + math.pi) % turn - math.pi

@@ -30,7 +30,7 @@ control tick:
      the disc does not already cover: its dist is L.
    - A polygon robot: its footprint at poses along the arc, no point of it moving more than
      half a cell between two, and the signed distance from the footprint to the obstacle
-     cells' centres there (footprint_clearance.py); with a dense scan (a laser's), also from
+     cells' centres there (kernels/footprint_clearance.py); with a dense scan (a laser's), also from
      this scan's echoes, where they are, in the cells the map does not hold (it judges a cell
      by the beam nearest its centre, which along a wall seen at a grazing angle passes the
      wall and clears it). dist is the length the centre travels before that
@@ -268,7 +268,7 @@ class DwaPlanner(Planner):
             # between two: a corner passing a cell centre at d comes at most
             # sqrt(d^2 + (cell / 4)^2) - d closer between them (6 mm at d = 5 cm).
             self.step_m = p.map_cell_m / 2
-            from vplane_mj.planning.footprint_clearance import footprint_clearance  # imports numba
+            from vplane_mj.planning.kernels.footprint_clearance import footprint_clearance  # imports numba
 
             self.footprint_clearance = footprint_clearance
         self.smooth_speeds = smoothing_matrix(p.speed_samples, p.smoothing)

@@ -22,11 +22,11 @@ def attractive_potential(position: np.ndarray, goal: np.ndarray, gain: float, ra
 
 def attractive_force(position: np.ndarray, goal: np.ndarray, gain: float, radius: float) -> np.ndarray:
     """Eq. 3: -grad of eq. 2: -2w d inside r, -2wr d/|d| beyond; zero at the goal."""
-    d = np.asarray(position, float) - np.asarray(goal, float)
-    dist = float(np.hypot(d[0], d[1]))
-    if dist <= radius:
-        return -2.0 * gain * d
-    return -2.0 * gain * radius * d / dist
+    from vplane_mj.planning.kernels import fields  # numba: loaded by the first call
+
+    return fields.attractive_force(
+        float(position[0]), float(position[1]), float(goal[0]), float(goal[1]), float(gain), float(radius)
+    )
 
 
 def repulsive_potential(position: np.ndarray, points: np.ndarray, gain: float, influence: float) -> float:
@@ -44,15 +44,17 @@ def repulsive_force(position: np.ndarray, points: np.ndarray, gain: float, influ
 
     Each sonar echo is one obstacle point, so the force is the negative gradient of
     `repulsive_potential`; it points away from every point within the influence distance.
+    At a clamped distance the direction (x - x_obs)/f is still a unit vector or zero.
     """
-    rel, f = _offsets(position, points)
-    near = f <= influence
-    if not near.any():
-        return np.zeros(2)
-    f, rel = f[near], rel[near]
-    magnitude = gain * (1.0 / f - 1.0 / influence) / (f * f)
-    # At a clamped distance the direction (x - x_obs)/f is still a unit vector or zero.
-    return (magnitude[:, None] * rel / f[:, None]).sum(axis=0)
+    from vplane_mj.planning.kernels import fields  # numba: loaded by the first call
+
+    return fields.repulsive_force(
+        np.asarray(position, float),
+        np.asarray(points, float).reshape(-1, 2),
+        float(gain),
+        float(influence),
+        MIN_DISTANCE_M,
+    )
 
 
 def _offsets(position: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

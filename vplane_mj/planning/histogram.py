@@ -4,7 +4,7 @@ Angles in radians, world frame; sector k covers [k, k+1) * sector width from +x.
 cell within `window_m` adds c^2 (window_m - d) to the sectors it blocks (Borenstein and
 Koren's VFH magnitude); as in VFH+ a cell is enlarged by the robot radius plus a clearance,
 so it blocks every sector within asin(enlarge / d) of its bearing, and any free sector is a
-direction the robot's disc fits through.
+direction the robot's disc fits through. The sum is compiled (`kernels.histogram`).
 """
 
 from __future__ import annotations
@@ -13,6 +13,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from vplane_mj.planning.localmap import LocalMap
 
 
 @dataclass(frozen=True)
@@ -33,30 +35,42 @@ def polar_histogram(
     enlarge_m: float,
 ) -> np.ndarray:
     """Obstacle density per sector (n_sectors,) around `origin` from map cells (N, 2)."""
-    if len(cells) == 0:
-        return np.zeros(n_sectors)
-    rel = np.asarray(cells, float) - origin
-    d = np.hypot(rel[:, 0], rel[:, 1])
-    inside = d < window_m
-    if not inside.any():
-        return np.zeros(n_sectors)
-    rel, d, c = rel[inside], d[inside], np.asarray(certainty)[inside]
-    sector = 2 * math.pi / n_sectors
-    bearing = np.arctan2(rel[:, 1], rel[:, 0])
-    bearing = np.where(bearing < 0.0, bearing + 2 * math.pi, bearing)  # [0, 2 pi), as % would
-    half = np.arcsin(np.minimum(1.0, enlarge_m / np.maximum(d, 1e-6)))
-    magnitude = c * c * (window_m - d)
-    # Each cell adds its magnitude to the run of sectors [first, last] (indices may wrap):
-    # a difference array over two laps of the circle (every start, then every end, each in
-    # cell order), folded back onto one.
-    first = np.floor((bearing - half) / sector).astype(int) + n_sectors
-    last = np.floor((bearing + half) / sector).astype(int) + n_sectors
-    last = np.minimum(last, first + (n_sectors - 1))
-    steps = np.bincount(
-        np.concatenate((first, last + 1)), np.concatenate((magnitude, -magnitude)), 3 * n_sectors + 1
+    from vplane_mj.planning.kernels import histogram  # numba: loaded by the first call
+
+    return histogram.polar_histogram(
+        np.asarray(origin, float),
+        np.asarray(cells, float).reshape(-1, 2),
+        np.asarray(certainty, float),
+        int(n_sectors),
+        float(window_m),
+        float(enlarge_m),
     )
-    laps = np.cumsum(steps)[: 3 * n_sectors].reshape(3, n_sectors)
-    return laps.sum(axis=0)
+
+
+def map_histogram(
+    local_map: LocalMap,
+    min_certainty: int,
+    origin: np.ndarray,
+    n_sectors: int,
+    window_m: float,
+    enlarge_m: float,
+) -> tuple[np.ndarray, int]:
+    """`polar_histogram` of the map cells at or above `min_certainty` in the square around `origin`
+    that holds the window (`LocalMap.cells`), and how many such cells the square holds."""
+    from vplane_mj.planning.kernels import histogram  # numba: loaded by the first call
+
+    if local_map.origin is None:
+        return np.zeros(n_sectors), 0
+    return histogram.grid_histogram(
+        local_map.grid,
+        local_map.origin,
+        local_map.cell_m,
+        int(min_certainty),
+        np.asarray(origin, float),
+        int(n_sectors),
+        float(window_m),
+        float(enlarge_m),
+    )
 
 
 def sector_of(bearing: float, n_sectors: int) -> int:

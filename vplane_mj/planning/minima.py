@@ -12,7 +12,6 @@ is one detection.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections import deque
 from dataclasses import dataclass
@@ -44,12 +43,14 @@ class LocalMinimumDetector:
         self.speed_mps = speed_mps
         self.startup_s = startup_s
         self._samples: deque[tuple[float, float, float, float]] = deque()  # t, x, y, speed
+        self._fast = 0  # samples in the window faster than speed_mps
         self._trap_position: np.ndarray | None = None
         self._trap_time = 0.0
 
     def reset(self) -> None:
         """Forget the history (after an escape manoeuvre starts, for instance)."""
         self._samples.clear()
+        self._fast = 0
         self._trap_position = None
 
     def update(self, time_s: float, position: np.ndarray, near_goal: bool) -> MinimumState:
@@ -60,8 +61,9 @@ class LocalMinimumDetector:
             if time_s > t0:
                 speed = math.hypot(x - x0, y - y0) / (time_s - t0)
         self._samples.append((time_s, x, y, speed))
+        self._fast += not speed <= self.speed_mps
         while self._samples[0][0] < time_s - self.window_s - 1e-9:
-            self._samples.popleft()
+            self._fast -= not self._samples.popleft()[3] <= self.speed_mps
 
         if self._trap_position is not None:
             trap_x, trap_y = self._trap_position
@@ -95,7 +97,7 @@ class LocalMinimumDetector:
         if len(self._samples) < 2:
             return False
         # The oldest sample's speed belongs to the step before the window.
-        return all(s[3] <= self.speed_mps for s in itertools.islice(self._samples, 1, None))
+        return self._fast == (not self._samples[0][3] <= self.speed_mps)
 
 
 def report_trap(

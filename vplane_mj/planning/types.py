@@ -39,10 +39,14 @@ class Observation:
         """
         points = self.__dict__.get("_echo_points")
         if points is None:
-            hit = np.isfinite(self.ranges)
-            angles = self.yaw + self.bearings[hit]
-            r = self.ranges[hit]
-            points = self.position + np.array((r * np.cos(angles), r * np.sin(angles))).T
+            from vplane_mj.planning.kernels import points as compiled  # numba: loaded by the first call
+
+            points = compiled.echo_points(
+                np.asarray(self.position, float),
+                float(self.yaw),
+                np.asarray(self.bearings, float),
+                np.asarray(self.ranges, float),
+            )
             points.flags.writeable = False
             self.__dict__["_echo_points"] = points  # a frozen dataclass: cache outside its fields
         return points

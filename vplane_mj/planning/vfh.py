@@ -72,8 +72,9 @@ class VfhPlanner(Planner):
         self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
         enlarge = self.robot.half_width_m + p.clearance_m
         window = min(p.window_m, obs.distance_to_goal() + enlarge)  # nothing beyond the goal blocks it
-        cells, certainty = self.map.cells(p.map_threshold, obs.position, window)
-        h = histogram.polar_histogram(obs.position, cells, certainty, self.n_sectors, window, enlarge)
+        h, _ = histogram.map_histogram(
+            self.map, p.map_threshold, obs.position, self.n_sectors, window, enlarge
+        )
         to_goal = obs.goal - obs.position
         goal_bearing = math.atan2(to_goal[1], to_goal[0])
         direction = self._choose(histogram.find_valleys(h > p.histogram_threshold), goal_bearing, obs.yaw)

@@ -280,22 +280,21 @@ class VPlanePlanner(Planner):
     def _update_avoidance(self, obs: Observation, decision: Decision) -> None:
         """Enter, keep or leave the avoiding mode (steering past a concave obstacle's edge)."""
         p = self.params
-        # Only cells within the histogram's window count: those of the square around the robot.
-        cells, certainty = self.map.cells(p.map_threshold, obs.position, p.window_m)
-        goal_bearing = math.atan2(*(obs.goal - obs.position)[::-1])
-        if len(cells) == 0 and not self.map.any_cells(p.map_threshold):
-            self.avoid_waypoint = None
-            return
         # A valley is a direction the robot drives along, aligned with it: cells enlarged by
-        # its half width (VFH+'s robot radius for a round robot).
-        h = histogram.polar_histogram(
+        # its half width (VFH+'s robot radius for a round robot). Only cells within the
+        # histogram's window count: those of the square around the robot.
+        h, count = histogram.map_histogram(
+            self.map,
+            p.map_threshold,
             obs.position,
-            cells,
-            certainty,
             self.n_sectors,
             p.window_m,
             self.robot.half_width_m + p.clearance_m,
         )
+        if count == 0 and not self.map.any_cells(p.map_threshold):
+            self.avoid_waypoint = None
+            return
+        goal_bearing = math.atan2(obs.goal[1] - obs.position[1], obs.goal[0] - obs.position[0])
         blocked = h > p.histogram_threshold
         goal_free = not blocked[histogram.sector_of(goal_bearing, self.n_sectors)]
         if goal_free:

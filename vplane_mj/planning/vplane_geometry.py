@@ -7,7 +7,6 @@ away from the trap), never with fixed x/y comparisons, so it holds for any orien
 from __future__ import annotations
 
 import functools
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,8 +38,17 @@ class VirtualPlane:
 
     def frame_coordinates(self, point: np.ndarray) -> tuple[float, float]:
         """(along, out): position along e1 -> e2 (m from e1) and signed distance outward (m)."""
-        rel = np.asarray(point, float) - self.e1
-        return float(rel @ self.tangent), float(rel @ self.normal)
+        x, y = float(point[0]) - float(self.e1[0]), float(point[1]) - float(self.e1[1])
+        (tx, ty), (nx, ny) = self._axes
+        return x * tx + y * ty, x * nx + y * ny
+
+    @functools.cached_property
+    def _axes(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """The tangent and the normal as floats."""
+        return (float(self.tangent[0]), float(self.tangent[1])), (
+            float(self.normal[0]),
+            float(self.normal[1]),
+        )
 
     def in_corridor(self, point: np.ndarray, influence: float, margin: float) -> bool:
         """Inside the activation corridor: along the segment (+- margin), at most `influence` out."""
@@ -137,23 +145,19 @@ def plane_force(
     hardest. A tangential part `slide_gain` times as large moves the robot along the plane
     toward the end with the shorter way to the goal, so a head-on approach cannot stall.
     """
+    from vplane_mj.planning.kernels import fields  # numba: loaded by the first call
+
     along, out = plane.frame_coordinates(robot)
-    positions = _plane_points(plane.length, step)
-    weight = plane.length / (len(positions) - 1)
-    normal_distance = max(out, MIN_DISTANCE_M)
-    f = np.hypot(along - positions, normal_distance)
-    near = f <= influence
-    if not near.any():
-        return np.zeros(2)
-    f = f[near]
-    magnitude = gain * (1.0 / f - 1.0 / influence) / (f * f) * weight
-    outward = float(np.sum(magnitude * normal_distance / f))
-    return outward * plane.normal + slide_gain * outward * plane.slide * plane.tangent
-
-
-@functools.lru_cache(maxsize=64)
-def _plane_points(length: float, step: float) -> np.ndarray:
-    """Positions (m from e1) of the points p_i: at most `step` apart, both ends included."""
-    points = np.linspace(0.0, length, max(2, math.ceil(length / step) + 1))
-    points.flags.writeable = False
-    return points
+    return fields.plane_force(
+        along,
+        out,
+        plane.length,
+        plane.normal,
+        plane.tangent,
+        float(plane.slide),
+        float(gain),
+        float(influence),
+        float(step),
+        float(slide_gain),
+        MIN_DISTANCE_M,
+    )

@@ -67,7 +67,7 @@ class Drive:
         self.torques: list[tuple[float, float]] = []
         self.steps = 0
         self._warnings = data.warning.number  # counts per warning kind, a view into mjData
-        self._fatal = [int(kind) for kind in FATAL_WARNINGS]
+        self._no_warnings = bytes(self._warnings.nbytes)
 
     def yaw(self) -> float:
         return math.atan2(self.xmat[3], self.xmat[0])
@@ -95,16 +95,19 @@ class Drive:
         """The wheels' encoder angles (rad), left and right."""
         return float(self.data.qpos[self.wheel_qpos[0]]), float(self.data.qpos[self.wheel_qpos[1]])
 
-    def run_tick(self, command: tuple[float, float], after_step) -> np.ndarray:
+    def run_tick(self, command: tuple[float, float], after_step) -> tuple[np.ndarray, float]:
         """Drive one control tick; return base_link's x, y (m) and yaw (rad) after every motor
-        period (chunks, 3)."""
+        period (chunks, 3), and the length (m) of the path through them from the pose before
+        the tick (each step's straight length, added in order)."""
         target_left, target_right = self._wheel_targets(command)
         (left_pi, right_pi), (left_dof, right_dof) = self.wheels, self.wheel_dofs
         left_motor, right_motor = self.motors
         model, data, steps, dt = self.model, self.data, self.motor_steps, self.motor_dt
         qvel, ctrl, xpos, xmat, torques = data.qvel, data.ctrl, self.xpos, self.xmat, self.torques
-        trace = np.empty((self.chunks_per_tick, 3))
-        for chunk in range(self.chunks_per_tick):
+        trace = []
+        x0, y0 = float(xpos[0]), float(xpos[1])
+        length = 0.0
+        for _ in range(self.chunks_per_tick):
             if self.ramp is not None:
                 target_left, target_right = self._wheel_targets(self.ramp.toward(command, dt))
             left = left_pi.torque(target_left, float(qvel[left_dof]), dt)
@@ -113,11 +116,13 @@ class Drive:
             ctrl[right_motor] = right
             torques.append((left, right))
             mujoco.mj_step(model, data, steps)
-            trace[chunk, :2] = xpos[:2]
-            trace[chunk, 2] = math.atan2(xmat[3], xmat[0])
+            x, y = float(xpos[0]), float(xpos[1])
+            trace.append((x, y, math.atan2(xmat[3], xmat[0])))
+            length += math.hypot(x - x0, y - y0)
+            x0, y0 = x, y
             after_step()
         self.steps += self.motor_steps * self.chunks_per_tick
-        return trace
+        return np.array(trace), length
 
     def _wheel_targets(self, command: tuple[float, float]) -> tuple[float, float]:
         """Left and right wheel speeds (rad/s) for a body speed (m/s) and turn rate (rad/s)."""
@@ -128,11 +133,12 @@ class Drive:
     def fatal_warning(self) -> str | None:
         """Why the simulation cannot go on (a fatal MuJoCo warning, a non-finite state), or None."""
         data = self.data
-        if any(self._warnings[kind] for kind in self._fatal):
+        if self._warnings.tobytes() != self._no_warnings:  # some warning: is it a fatal one?
             for warning, meaning in FATAL_WARNINGS.items():
                 if data.warning[warning].number:
                     return f"MuJoCo warning at t = {data.time:.3f} s: {meaning}"
-        if not np.isfinite(data.qpos).all():
+        qpos = data.qpos
+        if not math.isfinite(qpos.dot(qpos)):  # a non-finite coordinate (or one beyond 1e154)
             return f"the simulation diverged (non-finite state) at t = {data.time:.3f} s"
         return None
 

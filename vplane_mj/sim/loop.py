@@ -34,7 +34,7 @@ from vplane_mj.scenario import Scenario
 from vplane_mj.sim.control import heading_command, within_limits
 from vplane_mj.sim.drive import BELIEF_PATIENCE_S, CollisionCounter, Drive, Localiser
 from vplane_mj.sim.failure import RunFailure, failure_of
-from vplane_mj.sim.metrics import Clearance, motion_quality, path_quality, trajectory_digest, travelled
+from vplane_mj.sim.metrics import Clearance, motion_quality, path_quality, trajectory_digest
 from vplane_mj.sim.sensors import range_sensor
 from vplane_mj.sim.summary import Outcome, RunSummary
 from vplane_mj.sim.world import build_model
@@ -379,12 +379,10 @@ class Run:
 
     def _act(self) -> None:
         """Drive the wheels for one control tick; measure the path, clearance and collisions."""
-        trace = self.drive.run_tick(self.command, self._check_contacts)
+        trace, length = self.drive.run_tick(self.command, self._check_contacts)
         self.clearance.add(trace)
-        first, rest = travelled(self.position, trace)
-        self.path_length += first
-        self.path_length += rest
-        self.position = trace[-1, :2].copy()
+        self.path_length += length
+        self.position = trace[-1, :2]
 
     def _check_contacts(self) -> None:
         if self.collisions.found[0] > 0 or self.collisions.touching:

@@ -59,14 +59,6 @@ class Clearance:
         self._pending_count = 0
 
 
-def travelled(start: np.ndarray, trace: np.ndarray) -> tuple[float, float]:
-    """Lengths (m) of the step from `start` to the first point of `trace` (N, 2) and of the rest
-    (added to a running total one after the other, as they always were)."""
-    steps = trace[1:] - trace[:-1]
-    first = math.hypot(trace[0, 0] - start[0], trace[0, 1] - start[1])
-    return first, float(np.hypot(steps[:, 0], steps[:, 1]).sum())
-
-
 class MotionQuality(TypedDict):
     """The summary's keys for how the robot moved (`motion_quality`)."""
 

@@ -1,0 +1,111 @@
+"""Reading the local map's grid, compiled: its obstacle cells near a point, its clusters."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def square(first_cell: np.ndarray, n: int, cell_m: float, x: float, y: float, within_m: float) -> tuple:
+    """The rows and columns [lo, hi) of an n x n grid (cell (0, 0) the world cell `first_cell`,
+    cells of `cell_m`) in the square around the point (x, y) (m) that holds the disc of radius
+    `within_m`: every cell closer than `within_m`, and some farther ones. The whole grid when
+    `within_m` is not finite."""
+    if not math.isfinite(within_m):
+        return 0, 0, n, n
+    reach = math.ceil(within_m / cell_m) + 1
+    row = math.floor(x / cell_m) - first_cell[0]
+    col = math.floor(y / cell_m) - first_cell[1]
+    return (
+        max(0, row - reach),
+        max(0, col - reach),
+        min(n, max(0, row + reach + 1)),
+        min(n, max(0, col + reach + 1)),
+    )
+
+
+@njit(cache=True)
+def cells_near(
+    grid: np.ndarray,
+    first_cell: np.ndarray,
+    cell_m: float,
+    min_certainty: int,
+    x: float,
+    y: float,
+    within_m: float,
+    skip: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Centres (N, 2; m) and certainties (N,) of the cells at or above `min_certainty`, and not in
+    `skip` (a mask like `grid`, or an empty one: none skipped), of the `square` around (x, y)
+    (m) that holds the disc of radius `within_m`; row-major. Grid cell (i, j) is the world cell
+    `first_cell` + (i, j), its centre ((first_cell + (i, j)) + 1/2) cell_m."""
+    lo_i, lo_j, hi_i, hi_j = square(first_cell, grid.shape[0], cell_m, x, y, within_m)
+    skipping = skip.size > 0
+    count = 0
+    for i in range(lo_i, hi_i):
+        for j in range(lo_j, hi_j):
+            if grid[i, j] >= min_certainty and not (skipping and skip[i, j]):
+                count += 1
+    centres = np.empty((count, 2))
+    certainty = np.empty(count, dtype=np.int64)
+    k = 0
+    for i in range(lo_i, hi_i):
+        for j in range(lo_j, hi_j):
+            if grid[i, j] >= min_certainty and not (skipping and skip[i, j]):
+                centres[k, 0] = ((i + first_cell[0]) + 0.5) * cell_m
+                centres[k, 1] = ((j + first_cell[1]) + 0.5) * cell_m
+                certainty[k] = grid[i, j]
+                k += 1
+    return centres, certainty
+
+
+@njit(cache=True)
+def dilate(mask: np.ndarray, disk: np.ndarray) -> np.ndarray:
+    """Binary dilation of `mask` by the centred structuring element `disk` (cells beyond the edge
+    are off)."""
+    rows, cols = mask.shape
+    reach_i, reach_j = disk.shape[0] // 2, disk.shape[1] // 2
+    out = np.zeros_like(mask)
+    for i in range(rows):
+        for j in range(cols):
+            if not mask[i, j]:
+                continue
+            for di in range(disk.shape[0]):
+                a = i + di - reach_i
+                if a < 0 or a >= rows:
+                    continue
+                for dj in range(disk.shape[1]):
+                    b = j + dj - reach_j
+                    if disk[di, dj] and 0 <= b < cols:
+                        out[a, b] = True
+    return out
+
+
+@njit(cache=True)
+def label_regions(mask: np.ndarray) -> np.ndarray:
+    """Labels (1, 2, ...) of the 4-connected regions of `mask`, 0 elsewhere, numbered in row-major
+    order of their first cell (as scipy.ndimage.label numbers them)."""
+    rows, cols = mask.shape
+    labels = np.zeros((rows, cols), dtype=np.int32)
+    stack = np.empty(rows * cols, dtype=np.int64)
+    count = 0
+    for i in range(rows):
+        for j in range(cols):
+            if not mask[i, j] or labels[i, j]:
+                continue
+            count += 1
+            labels[i, j] = count
+            stack[0] = i * cols + j
+            top = 1
+            while top:
+                top -= 1
+                a, b = divmod(stack[top], cols)
+                for na, nb in ((a - 1, b), (a + 1, b), (a, b - 1), (a, b + 1)):
+                    if 0 <= na < rows and 0 <= nb < cols and mask[na, nb] and not labels[na, nb]:
+                        labels[na, nb] = count
+                        stack[top] = na * cols + nb
+                        top += 1
+    return labels

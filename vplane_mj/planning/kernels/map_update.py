@@ -1,0 +1,277 @@
+"""The local map's update, compiled: each beam's cone walked, and the cells it may change judged.
+
+A scan changes only the cells near its echo arcs (hits), the marked cells inside its cones
+(misses: an empty cell stays empty) and, with `seen`, the cells of its cones not yet seen. The
+walk visits the cells of each cone: a cone is split into pieces at most a quarter turn wide; a
+piece is held by the quadrilateral of the robot, the arc's two ends and the point where the
+tangents at those ends meet, so the cells of one grid line (a row or a column, whichever
+crosses fewer lines) that lie inside it form one run, computed from the four edges. Only cells
+of the grid are visited, so an echo beyond the grid costs no more than one at its edge.
+
+Of the cells of a cone, a cell is taken when it lies in the beam's arc band, or nearer than the
+band and marked (an echo clears it), or nearer and not yet seen (with `seen`); the bounds are
+wider than the rule by a margin, so rounding never drops a cell. Each cell taken is then judged
+once (a stamp per cell), as it is found, by the map's rule (`vplane_mj.planning.localmap`): its beam is the
+nearest direction (`nearest_in_ring` for an evenly spaced ring, `nearest_by_search` for any
+directions: one rule, two ways, which agree wherever rounding does not decide), and it must lie
+within half a beam width of that direction's axis; a cell within ARC_HALF_WIDTH cell of the
+range, along its beam, is on the arc and gains `hit`; a cell nearer than the range less one
+cell is in the free cone and loses `miss`. So the grid is what a pass over every cell would
+make of it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+ARC_HALF_WIDTH = 0.75
+"""An echo's arc holds the cells within this many cells of its range (along the beam)."""
+ANGLE_MARGIN_RAD = 1e-9
+DISTANCE_MARGIN_M = 1e-6
+"""How much wider than the map's rule the walk looks (rad, m), so that rounding drops no cell."""
+QUARTER_TURN = math.pi / 2
+TURN = 2 * math.pi
+
+
+@njit(cache=True)
+def fold_scan(
+    x: float,
+    y: float,
+    yaw: float,
+    first_cell: np.ndarray,
+    cell_m: float,
+    beam: float,
+    directions: np.ndarray,
+    half_before: np.ndarray,
+    half_after: np.ndarray,
+    spacing: float,
+    bounds: np.ndarray,
+    ranges: np.ndarray,
+    mark_range_m: float,
+    silent_free_m: float,
+    rule: np.ndarray,
+    track_seen: bool,
+    grid: np.ndarray,
+    seen: np.ndarray,
+    stamps: np.ndarray,
+    stamp: int,
+) -> None:
+    """Fold one scan into `grid` (n, n certainties) and `seen` (n, n), in place.
+
+    The robot at `x`, `y` (m) heading `yaw` (rad); `first_cell` the world cell index (i, j) of
+    grid cell (0, 0), cells of `cell_m`. The scan's distinct directions (rad, robot frame,
+    ascending) are `directions`, each beam `beam` wide (rad) and its cone clipped to
+    `half_before` and `half_after` of its axis; `spacing` (rad) is the even ring's, 0 for any
+    directions, then searched among `bounds`. `ranges[k]` (m, NaN: no echo) is direction k's;
+    an echo marks its arc when it is at most `mark_range_m` away. When some direction has no
+    echo, its cone shows free for `silent_free_m` (m, with `track_seen`). `rule` is (hit,
+    miss, max_certainty). `stamps` (n * n) remembers the cells judged: a cell is judged once,
+    and its stamp becomes `stamp`.
+    """
+    n = grid.shape[0]
+    marks = np.empty(directions.shape[0], dtype=np.bool_)
+    silent_m = 0.0
+    for c in range(directions.shape[0]):
+        marks[c] = ranges[c] <= mark_range_m
+        if ranges[c] != ranges[c]:
+            silent_m = silent_free_m
+    # No cone needs to reach past the grid's farthest corner (with a cell to spare).
+    far_x = max(abs(x - first_cell[0] * cell_m), abs((first_cell[0] + n) * cell_m - x))
+    far_y = max(abs(y - first_cell[1] * cell_m), abs((first_cell[1] + n) * cell_m - y))
+    extent2 = far_x * far_x + far_y * far_y + cell_m * cell_m
+    arc_m = ARC_HALF_WIDTH * cell_m
+    scan = (x, y, yaw + directions[0], cell_m, beam, arc_m, spacing, silent_m)
+    fan = (directions, bounds, ranges, marks, rule, track_seen)
+    cells = (first_cell, grid.reshape(-1), seen.reshape(-1), stamps, stamp)
+    for c in range(directions.shape[0]):
+        if ranges[c] != ranges[c] and silent_m <= 0.0:
+            continue  # a silent beam: no information here
+        band_lo2, band_hi2, clear, show = _cone_reach(
+            ranges[c], marks[c], arc_m, cell_m, silent_m, track_seen
+        )
+        reach2 = min(max(band_hi2, clear * clear, show * show), extent2)
+        if reach2 <= 0.0:
+            continue
+        reach = (reach2, band_lo2, band_hi2, clear * clear, show * show)
+        axis = yaw + directions[c]
+        start = axis - half_before[c] - ANGLE_MARGIN_RAD
+        span = half_before[c] + half_after[c] + 2 * ANGLE_MARGIN_RAD
+        pieces = max(1, math.ceil(span / QUARTER_TURN))
+        width = span / pieces
+        for k in range(pieces):  # overlapping a little: rounding drops no cell
+            low = start + k * width - ANGLE_MARGIN_RAD
+            high = low + width + 2 * ANGLE_MARGIN_RAD
+            sight = (math.cos(low), math.sin(low), math.cos(high), math.sin(high))
+            _walk_piece(n, sight, reach, scan, fan, cells)
+
+
+@njit(cache=True)
+def _judge(index, n, scan, fan, cells):
+    """Apply the map's rule to the cell `index` (flat, row-major in the n x n grid)."""
+    px, py, axis, cell_m, beam, arc_m, spacing, silent_m = scan
+    directions, bounds, ranges, marks, rule, track_seen = fan
+    first_cell, flat, seen_flat, _, _ = cells
+    rel_x = (first_cell[0] + index // n + 0.5) * cell_m - px
+    rel_y = (first_cell[1] + index % n + 0.5) * cell_m - py
+    distance = math.hypot(rel_x, rel_y)
+    angle = math.atan2(rel_y, rel_x) - axis
+    if spacing > 0.0:
+        nearest, offset = nearest_in_ring(angle, axis, spacing, directions.shape[0])
+    else:
+        nearest, offset = nearest_by_search(angle, bounds, directions)
+    in_beam = abs(offset) <= beam / 2
+    echo = ranges[nearest] == ranges[nearest]  # not NaN
+    reading = ranges[nearest] if echo and in_beam else -1.0
+    shown_free = distance < reading - cell_m
+    delta = 0
+    if abs(distance - reading) <= arc_m and marks[nearest]:
+        delta += rule[0]
+    if shown_free:
+        delta -= rule[1]
+    flat[index] = min(max(flat[index] + delta, 0), rule[2])
+    if track_seen:
+        if silent_m > 0.0 and in_beam and not echo and distance < silent_m:
+            shown_free = True
+        if shown_free:
+            seen_flat[index] = True
+
+
+@njit(cache=True)
+def nearest_in_ring(angle: float, axis: float, spacing: float, count: int) -> tuple[int, float]:
+    """The nearest direction (index) of an angle (rad from the first direction's world axis,
+    `axis`) on an evenly spaced ring of `count` directions `spacing` apart, and the angle from
+    its axis, in [-pi, pi), by arithmetic."""
+    beam = int(np.rint(angle / spacing)) % count  # halves to even, as np.round
+    offset = angle - beam * spacing + math.pi  # wrapped below: the angle from its axis
+    if abs(axis) <= math.pi:  # offset in (-2 pi, 4 pi): the modulo is one conditional turn
+        if offset < 0.0:
+            offset += TURN
+        elif offset >= TURN:
+            offset -= TURN
+        return beam, offset - math.pi
+    return beam, offset % TURN - math.pi
+
+
+@njit(cache=True)
+def nearest_by_search(angle: float, bounds: np.ndarray, directions: np.ndarray) -> tuple[int, float]:
+    """`nearest_in_ring` for any directions (rad, ascending): a search among the `bounds` half-way
+    between neighbouring directions (each relative to the first direction)."""
+    angle = angle % TURN
+    beam = np.searchsorted(bounds, angle, side="right") % directions.shape[0]
+    return beam, (angle - (directions[beam] - directions[0]) + math.pi) % TURN - math.pi
+
+
+@njit(cache=True)
+def _cone_reach(
+    r: float, marks: bool, arc_m: float, cell_m: float, silent_m: float, track_seen: bool
+) -> tuple[float, float, float, float]:
+    """For a cone with the range `r` (m, NaN: no echo): the squared bounds (m^2) of the arc band
+    it marks (inf and -1 when it marks none), and how far (m) it clears marked cells and shows
+    unseen ones (0 without `track_seen`)."""
+    band_lo2, band_hi2, clear, show = math.inf, -1.0, 0.0, 0.0
+    if r == r:  # an echo
+        band_hi = r + arc_m + DISTANCE_MARGIN_M
+        if marks and band_hi > 0.0:
+            band_lo = max(r - arc_m - DISTANCE_MARGIN_M, 0.0)
+            band_lo2, band_hi2 = band_lo * band_lo, band_hi * band_hi
+            clear = max(r - arc_m + DISTANCE_MARGIN_M, 0.0)
+        else:
+            clear = max(r - cell_m + DISTANCE_MARGIN_M, 0.0)
+        show = clear
+    elif silent_m > 0.0:
+        show = silent_m + DISTANCE_MARGIN_M
+    if not track_seen:
+        show = 0.0
+    return band_lo2, band_hi2, clear, show
+
+
+@njit(cache=True)
+def _walk_piece(n, sight, reach, scan, fan, cells):
+    """Judge the cells of one piece of a cone that the scan may change (each once: its stamp):
+    from the direction (ax, ay) of `sight` counter-clockwise to (bx, by), at most a quarter
+    turn. `reach` holds the squared distances (m^2): how far the piece reaches, the arc band's
+    bounds, and how far it clears marked cells and shows unseen ones."""
+    first_cell, flat, seen_flat, stamps, stamp = cells
+    _, band_lo2, band_hi2, clear2, show2 = reach
+    track_seen = fan[5]
+    cell_m = scan[3]
+    us, vs, edges, lines, first_v, step_u, step_v = _piece_lines(n, sight, reach[0], scan, first_cell)
+    for line in range(lines[0], lines[1] + 1):
+        u = (lines[2] + line + 0.5) * cell_m
+        lo, hi = -math.inf, math.inf
+        for k in range(4):
+            lo, hi = _bound(lo, hi, u, edges[k][0], edges[k][1], us[k], vs[k])
+        if lo > hi:
+            continue
+        run_first = max(0, math.ceil((lo - 1e-9) / cell_m - first_v - 0.5))
+        run_last = min(n - 1, math.floor((hi + 1e-9) / cell_m - first_v - 0.5))
+        du2 = (u - us[0]) * (u - us[0])
+        for along in range(run_first, run_last + 1):
+            dv = (first_v + along + 0.5) * cell_m - vs[0]
+            d2 = du2 + dv * dv
+            index = line * step_u + along * step_v
+            if (
+                band_lo2 <= d2 <= band_hi2
+                or (d2 < clear2 and flat[index] > 0)
+                or (track_seen and d2 < show2 and not seen_flat[index])
+            ) and stamps[index] != stamp:
+                stamps[index] = stamp
+                _judge(index, n, scan, fan, cells)
+
+
+@njit(cache=True)
+def _piece_lines(n, sight, reach2, scan, first_cell):
+    """How to walk one piece of a cone (see `_walk_piece`): the corners (u, v) of the
+    quadrilateral that holds it (the robot, the arc's start, the corner where the tangents at
+    the arc's ends meet, the arc's end), its four edges (`_edge`), the first and last grid
+    line it crosses and the first line's world cell, the first cell along a line, and the flat
+    index steps between lines and along one. Lines are rows (u = x) or columns (u = y),
+    whichever are fewer."""
+    ax, ay, bx, by = sight
+    x0, y0, cell_m = scan[0], scan[1], scan[3]
+    far_m = math.sqrt(reach2)
+    sx, sy = ax + bx, ay + by
+    far = 2.0 * far_m / (sx * sx + sy * sy)
+    xs = (x0, x0 + far_m * ax, x0 + far * sx, x0 + far_m * bx)
+    ys = (y0, y0 + far_m * ay, y0 + far * sy, y0 + far_m * by)
+    if max(xs) - min(xs) <= max(ys) - min(ys):
+        us, vs, first_u, first_v, step_u, step_v, orient = xs, ys, first_cell[0], first_cell[1], n, 1, 1.0
+    else:
+        us, vs, first_u, first_v, step_u, step_v, orient = ys, xs, first_cell[1], first_cell[0], 1, n, -1.0
+    # Each edge bounds a line's run from below or above (or, parallel to the lines, keeps or
+    # drops whole lines); its inner side is the left one in x, y.
+    edges = (
+        _edge(us[0], vs[0], us[1], vs[1], orient),
+        _edge(us[1], vs[1], us[2], vs[2], orient),
+        _edge(us[2], vs[2], us[3], vs[3], orient),
+        _edge(us[3], vs[3], us[0], vs[0], orient),
+    )
+    line_first = max(0, math.ceil((min(us) - 1e-9) / cell_m - first_u - 0.5))
+    line_last = min(n - 1, math.floor((max(us) + 1e-9) / cell_m - first_u - 0.5))
+    return us, vs, edges, (line_first, line_last, first_u), first_v, step_u, step_v
+
+
+@njit(cache=True)
+def _edge(ua, va, ub, vb, orient):
+    """How the edge a -> b bounds the run of a line of constant u: (1, slope) from below,
+    (-1, slope) from above, (0, s) parallel to the lines (a line at u is outside when
+    s (u - ua) > 0). Its inner side is the left one when `orient` is 1, the right when -1."""
+    du, dv = ub - ua, vb - va
+    if du == 0.0:
+        return 0, orient * dv
+    return (1 if orient * du > 0.0 else -1), dv / du
+
+
+@njit(cache=True)
+def _bound(lo, hi, u, kind, slope, ua, va):
+    """The run [lo, hi] of the line at `u` cut by one edge (see `_edge`) through (ua, va)."""
+    if kind > 0:
+        return max(lo, va + slope * (u - ua)), hi
+    if kind < 0:
+        return lo, min(hi, va + slope * (u - ua))
+    if slope * (u - ua) > 0.0:
+        return math.inf, -math.inf
+    return lo, hi
