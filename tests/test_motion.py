@@ -62,6 +62,33 @@ def _driving(governor: motion.Governor, command: tuple[float, float], seconds: f
     return time_s
 
 
+def brute_force_distance(footprint: np.ndarray, point: np.ndarray) -> float:
+    """Distance (m) from `point` to the convex polygon `footprint` (0 inside): the nearest of
+    a thousand points along each edge, or 0 where the point is on the inner side of every edge."""
+    edges = np.roll(footprint, -1, axis=0) - footprint
+    rel = point - footprint
+    if (edges[:, 0] * rel[:, 1] - edges[:, 1] * rel[:, 0] >= 0.0).all():  # left of every edge
+        return 0.0
+    t = np.linspace(0.0, 1.0, 1001)[:, None, None]
+    along = footprint[None] + t * edges[None]
+    return float(np.hypot(*(along - point).transpose(2, 0, 1)).min())
+
+
+@pytest.mark.parametrize("profile", ["jackal", "pioneer3dx", "turtlebot3_burger"])
+def test_the_footprints_distance_at_any_pose_is_that_of_the_moved_polygon(profile):
+    body = robot_body(profile)
+    rng = np.random.default_rng(3)
+    local = rng.uniform(-0.8, 0.8, (40, 2))
+    poses = np.column_stack((rng.uniform(-0.3, 0.3, (25, 2)), rng.uniform(-math.pi, math.pi, 25)))
+    got = motion.pose_distances(body, local, poses)
+    assert got.shape == (25, 40) and (got == 0.0).any() and (got > 0.0).any()
+    for m, (x, y, yaw) in enumerate(poses):
+        turn = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
+        moved = body.footprint @ turn.T + (x, y)
+        for n, point in enumerate(local):
+            assert got[m, n] == pytest.approx(brute_force_distance(moved, point), abs=2e-4)
+
+
 def test_the_drive_model_ramps_the_commands_and_turns_its_lag_late():
     model = motion.DriveModel(JACKAL.limits)
     model.advance(0.0, (0.3, -0.5))  # the first tick: the measured velocity

@@ -91,22 +91,20 @@ def outline_distances(body: RobotBody, local: np.ndarray, angles: np.ndarray) ->
 
 def pose_distances(body: RobotBody, local: np.ndarray, poses: np.ndarray) -> np.ndarray:
     """Distance (m) from each point of `local` (N, 2; robot frame) to the footprint at each of
-    `poses` (M, 3: x, y in m and yaw in rad, in the robot frame): (M, N), 0 inside the footprint."""
-    c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
-    # The points in the frame of each pose: the footprint moved there, seen from the footprint.
-    dx, dy = local[None, :, 0] - poses[:, 0, None], local[None, :, 1] - poses[:, 1, None]
-    x, y = c * dx + s * dy, -s * dx + c * dy
+    `poses` (M, 3: x, y in m and yaw in rad, in the robot frame): (M, N), 0 inside the footprint
+    (a point is inside when it lies behind every edge; `kernels.outline`)."""
+    from vplane_mj.planning.kernels import outline  # numba: loaded by the first call
+
     a = body.footprint
-    b = np.roll(a, -1, axis=0)
-    edge = b - a
-    # Each edge's outward normal (the polygon is counter-clockwise): a point is inside when it
-    # lies behind every edge.
+    edge = np.roll(a, -1, axis=0) - a
+    # Each edge's outward normal (the polygon is counter-clockwise).
     normal = np.column_stack((edge[:, 1], -edge[:, 0])) / np.hypot(edge[:, 0], edge[:, 1])[:, None]
-    px, py = x[..., None] - a[:, 0], y[..., None] - a[:, 1]  # (M, N, k)
-    outside = (px * normal[:, 0] + py * normal[:, 1]).max(axis=-1) > 0.0
-    t = np.clip((px * edge[:, 0] + py * edge[:, 1]) / (edge**2).sum(axis=1), 0.0, 1.0)
-    gap = np.hypot(px - t * edge[:, 0], py - t * edge[:, 1]).min(axis=-1)
-    return np.where(outside, gap, 0.0)
+    return outline.pose_distances(
+        np.ascontiguousarray(a, float),
+        normal,
+        np.ascontiguousarray(local, float).reshape(-1, 2),
+        np.ascontiguousarray(poses, float).reshape(-1, 3),
+    )
 
 
 def free_turn(body: RobotBody, local: np.ndarray, side: float, limit_rad: float, margin_m: float) -> float:
