@@ -26,13 +26,13 @@ import time
 from collections import deque
 
 import numpy as np
-from vplane_mj.families import BARN_CELL_M, BARN_COLUMNS, BARN_FIELD_Y_M, barn_cells
-from vplane_mj.robot import robot_radius_m
 
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.synthetic import LAYOUTS
 from vplane_mj.planning.localmap import LocalMap
 from vplane_mj.planning.registry import make_planner
+from vplane_mj.robots.facts import robot_radius_m
+from vplane_mj.worlds.families import BARN_CELL_M, BARN_COLUMNS, BARN_FIELD_Y_M, barn_cells
 
 MAPS = ("vplane_plus", "vplane", "dwa")
 POST_RADIUS_M = 0.075

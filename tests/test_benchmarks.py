@@ -147,6 +147,17 @@ def test_barn_protocol_sweeps_the_planners_beside_barns_published_figures(tmp_pa
     assert (tmp_path / "barn" / "barn_protocol.png").stat().st_size > 1000
 
 
+def test_sweep_rate_counts_runs_per_core_minute_of_each_planners_sweep(tmp_path):
+    out = run_benchmark(
+        "sweep_rate.py", *("--worlds", "2", "--planners", "apf,vplane", "--out", "rate"), cwd=tmp_path
+    )
+    rows = {row["planner"]: row for row in csv.DictReader((tmp_path / "rate" / "sweep_rate.csv").open())}
+    assert set(rows) == {"apf", "vplane"} and all(row["runs"] == "2" for row in rows.values())
+    assert all(float(row["cpu_s"]) > 0 and float(row["runs_per_core_minute"]) > 0 for row in rows.values())
+    assert len(table_rows(out, "barn, default robot")) == 2
+    assert (tmp_path / "rate" / "sweep_rate.png").stat().st_size > 1000
+
+
 def run_peer_irsim(cwd: Path) -> subprocess.CompletedProcess:
     """benchmarks/peer_irsim.py with its smallest arguments."""
     arguments = ("--count", "1", "--time-limit", "0.1", "--repeat", "1", "--planners", "dwa")

@@ -1,5 +1,5 @@
-"""Planning: numpy (numba for a laser's map update), no MuJoCo. What a planner receives each
-control tick and what it answers.
+"""Planning: numpy, with its inner loops compiled (`kernels`, numba), no MuJoCo. What a
+planner receives each control tick and what it answers.
 
 The names for writing a planner of one's own (docs/own-planner.md):
 

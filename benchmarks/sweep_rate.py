@@ -1,0 +1,129 @@
+"""Runs per core-minute: what a sweep of many BARN worlds costs, planner by planner.
+
+Generates `--worlds` worlds of `vplane-mj generate barn` (seed `--seed`, the default robot and
+its sonar), and with `--protocol` those of `generate barn --protocol` (the Jackal and its
+laser), then sweeps each planner of `--planners` over them (run seed 0, 2 cm range noise, no
+log, no render; on protocol worlds `dwa` follows its map's way, as in `barn_protocol.py`)
+through `vplane_mj.bench.sweep.run_sweep` with `--jobs` workers. Reported per
+planner: runs, success, the sweep's wall time, the CPU time of its workers (their own
+accounting, so other processes on a shared machine do not inflate it), and runs per
+core-minute: runs over that CPU time in minutes. Writes `OUT/sweep_rate.csv` and a bar chart,
+`OUT/sweep_rate.png`.
+
+    python benchmarks/sweep_rate.py [--worlds 300] [--planners vplane,vplane_plus,dwa] [--protocol] [--jobs 2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import resource
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from barn_protocol import PLANNER_SETTINGS
+
+from vplane_mj.bench.sweep import plan_jobs, run_sweep
+from vplane_mj.files import prepare_out_dir, write_atomically
+from vplane_mj.worlds.barn_protocol import generate_protocol
+from vplane_mj.worlds.families import generate
+
+COLUMNS = ("worlds", "planner", "runs", "success_rate", "wall_s", "cpu_s", "runs_per_core_minute")
+
+
+def write_worlds(out: Path, cases) -> list[str]:
+    """The cases' scenario files under `out`, their paths."""
+    out.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for case in cases:
+        path = out / f"{case.name}.toml"
+        path.write_text(case.toml(), encoding="utf-8")
+        paths.append(str(path))
+    return paths
+
+
+def children_cpu_s() -> float:
+    """CPU time (s, user and system) of this process's finished children."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def sweep_row(label: str, scenarios: list[str], planner: str, jobs: int, settings: tuple[str, ...]) -> dict:
+    """One planner's sweep over `scenarios` with `settings` (`--set` style): its rows' success
+    and what it cost."""
+    planned = plan_jobs(scenarios, [planner], [0], ["sensors.noise_std=0.02", *settings])
+    with tempfile.TemporaryDirectory() as tmp:
+        cpu, wall = children_cpu_s(), time.perf_counter()
+        rows = run_sweep(planned, Path(tmp), jobs)
+        wall, cpu = time.perf_counter() - wall, children_cpu_s() - cpu
+    reached = sum(row["outcome"] == "reached" and row["collisions"] == 0 for row in rows)
+    return {
+        "worlds": label,
+        "planner": planner,
+        "runs": len(rows),
+        "success_rate": reached / len(rows),
+        "wall_s": wall,
+        "cpu_s": cpu,
+        "runs_per_core_minute": len(rows) / (cpu / 60.0),
+    }
+
+
+def plot(table: list[dict], path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    labels = [f"{row['planner']}\n{row['worlds']}" for row in table]
+    figure, ax = plt.subplots(figsize=(2 + 1.2 * len(table), 3.6), layout="constrained")
+    bars = ax.bar(range(len(table)), [row["runs_per_core_minute"] for row in table], color="tab:blue")
+    ax.bar_label(bars, fmt="%.0f")
+    ax.set_xticks(range(len(table)), labels, fontsize=8)
+    ax.set_ylabel("runs per core-minute")
+    ax.margins(y=0.12)
+    ax.set_title(f"A sweep of {table[0]['runs']} BARN worlds\n(one run each, no log, no render)", fontsize=10)
+    write_atomically(path, lambda tmp: figure.savefig(tmp, format="png", dpi=100))
+    plt.close(figure)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--worlds", type=int, default=300)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--planners", default="vplane,vplane_plus,dwa")
+    parser.add_argument("--protocol", action="store_true", help="also the protocol worlds (the Jackal)")
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--out", type=Path, default=Path("logs/sweep_rate"))
+    args = parser.parse_args(argv)
+    out = prepare_out_dir(args.out)
+    sets = {"barn, default robot": write_worlds(out / "barn", generate("barn", args.worlds, args.seed))}
+    if args.protocol:
+        sets["protocol, Jackal"] = write_worlds(out / "protocol", generate_protocol(args.worlds, args.seed))
+    table = []
+    print("| worlds | planner | runs | success | wall s | CPU s | runs per core-minute |")
+    print("|---|---|---:|---:|---:|---:|---:|")
+    for label, scenarios in sets.items():
+        for planner in (name.strip() for name in args.planners.split(",")):
+            settings = PLANNER_SETTINGS.get(planner, ()) if label.startswith("protocol") else ()
+            row = sweep_row(label, scenarios, planner, args.jobs, settings)
+            table.append(row)
+            print(
+                f"| {label} | `{planner}` | {row['runs']} | {row['success_rate']:.1%} | {row['wall_s']:.0f} "
+                f"| {row['cpu_s']:.0f} | {row['runs_per_core_minute']:.0f} |"
+            )
+            sys.stdout.flush()
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=COLUMNS)
+    writer.writeheader()
+    writer.writerows(table)
+    write_atomically(out / "sweep_rate.csv", lambda tmp: tmp.write_text(buffer.getvalue(), encoding="utf-8"))
+    plot(table, out / "sweep_rate.png")
+    print(f"wrote {out / 'sweep_rate.csv'}\nwrote {out / 'sweep_rate.png'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
