@@ -77,10 +77,22 @@ def test_overhead_times_runs_and_the_run_loop_alone_against_the_floor(tmp_path):
     assert number(row[4]) > 0  # floor us/step
     for ratio in row[5:10]:  # run, run with log, as built, run / as built, wall clock
         assert RATIO_BOUNDS[0] < number(ratio) < RATIO_BOUNDS[1], row
-    assert number(row[10]) > 0 and number(row[11]) > 0  # planner ms/tick, log MB/min
+    assert row[10] == "-"  # the laser's share: the default robot has sonars
+    assert number(row[11]) > 0 and number(row[12]) > 0  # planner ms/tick, log MB/min
     loop_alone = re.search(r"The run loop alone: .* reached on open_field at ([0-9.]+) times the floor", text)
     assert loop_alone is not None, text
     assert RATIO_BOUNDS[0] < float(loop_alone.group(1)) < RATIO_BOUNDS[1]
+
+
+def test_overhead_reports_the_lasers_share_of_the_floor_on_a_protocol_world(tmp_path):
+    from vplane_mj.worlds.barn_protocol import generate_protocol
+
+    (case,) = generate_protocol(1, 0)
+    (tmp_path / "world.toml").write_text(case.toml(), encoding="utf-8")
+    arguments = ("world.toml", "--planners", "apf", "--repeat", "1", "--no-log")
+    text = run_benchmark("overhead.py", *arguments, cwd=tmp_path)
+    (row,) = table_rows(text, case.name)
+    assert 0 < number(row[10]) < number(row[5])  # the laser's scans: a part of the run
 
 
 def test_startup_times_runs_against_their_loop_and_the_main_job_with_its_log_and_render(tmp_path):
