@@ -203,15 +203,16 @@ def arc_poses(
     position: np.ndarray, yaw: float, travel: np.ndarray, turn: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """Points (..., 2) and headings (...) after travelling `travel` (m) along a circle while
-    turning by `turn` (rad), from `position` at `yaw` (a straight line when turn = 0)."""
-    half = np.asarray(turn, float) / 2
-    sin_half, cos_half = np.sin(half), np.cos(half)
-    bent = np.abs(half) > 1e-12
-    chord = travel * np.where(bent, sin_half / np.where(bent, half, 1.0), 1.0)  # 2 sin(turn/2) / curvature
-    cos_yaw, sin_yaw = math.cos(yaw), math.sin(yaw)
-    x = position[0] + chord * (cos_yaw * cos_half - sin_yaw * sin_half)
-    y = position[1] + chord * (sin_yaw * cos_half + cos_yaw * sin_half)
-    return np.stack((x, y), axis=-1), yaw + turn
+    turning by `turn` (rad), from `position` at `yaw` (a straight line when turn = 0;
+    `kernels.arcs`)."""
+    from vplane_mj.planning.kernels import arcs  # numba: loaded by the first call
+
+    shape = np.broadcast_shapes(np.shape(travel), np.shape(turn))
+    travels, turns = np.empty(shape), np.empty(shape)
+    travels[...], turns[...] = travel, turn
+    x, y = float(position[0]), float(position[1])
+    points = arcs.arc_points(x, y, float(yaw), travels.ravel(), turns.ravel())
+    return points.reshape(*shape, 2), yaw + turns
 
 
 def force_for_command(speed: float, turn: float, yaw: float, gains: HeadingGains) -> np.ndarray:

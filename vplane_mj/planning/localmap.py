@@ -284,18 +284,12 @@ class ClearanceField:
 
     def at(self, points: np.ndarray) -> np.ndarray:
         """The distance at world points (N, 2), bilinear between the cell centres; points beyond
-        the outermost centres take the border's values."""
-        rows, cols = self.values.shape
-        u = np.asarray(points, float) / self.cell_m - self.first_cell - 0.5
-        i = np.minimum(np.maximum(np.floor(u[:, 0]).astype(int), 0), rows - 2)
-        j = np.minimum(np.maximum(np.floor(u[:, 1]).astype(int), 0), cols - 2)
-        fx = np.minimum(np.maximum(u[:, 0] - i, 0.0), 1.0)
-        fy = np.minimum(np.maximum(u[:, 1] - j, 0.0), 1.0)
-        flat = self.values.ravel()
-        index = i * cols + j
-        below = flat[index] + (flat[index + cols] - flat[index]) * fx
-        above = flat[index + 1] + (flat[index + cols + 1] - flat[index + 1]) * fx
-        return below + (above - below) * fy
+        the outermost centres take the border's values (`kernels.arcs`)."""
+        from vplane_mj.planning.kernels import arcs  # numba: loaded by the first call
+
+        points = np.ascontiguousarray(points, float).reshape(-1, 2)
+        first_i, first_j = float(self.first_cell[0]), float(self.first_cell[1])
+        return arcs.bilinear(np.ascontiguousarray(self.values, float), first_i, first_j, self.cell_m, points)
 
 
 @functools.cache
