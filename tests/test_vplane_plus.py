@@ -157,6 +157,51 @@ def test_costs_block_the_disc_and_charge_for_closeness():
     assert np.isfinite(soft).all() and soft[20, 5] > 20  # doubtful: passable at a price
 
 
+def scipy_cost_to_go(cost: np.ndarray, targets: np.ndarray, target_costs: np.ndarray, cell_m: float):
+    """`gridsearch.cost_to_go` by scipy's Dijkstra over the explicit grid graph: every move
+    between free cells, a diagonal only across a free 2 x 2 square, weighted by its length times
+    the mean step cost of its cells, and a source joined to each free target at its cost."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    nx, ny = cost.shape
+    free, index = np.isfinite(cost), np.arange(nx * ny).reshape(nx, ny)
+    rows, cols, weights = [], [], []
+    every, head, tail = slice(None), slice(None, -1), slice(1, None)
+    square = free[:-1, :-1] & free[:-1, 1:] & free[1:, :-1] & free[1:, 1:]
+    for a, b, mask, length in (
+        ((every, head), (every, tail), free[:, :-1] & free[:, 1:], cell_m),
+        ((head, every), (tail, every), free[:-1, :] & free[1:, :], cell_m),
+        ((head, head), (tail, tail), square, cell_m * math.sqrt(2)),
+        ((head, tail), (tail, head), square, cell_m * math.sqrt(2)),
+    ):
+        rows.append(index[a][mask])
+        cols.append(index[b][mask])
+        weights.append(length * 0.5 * (cost[a][mask] + cost[b][mask]))
+    keep = free.ravel()[targets]
+    rows.append(np.full(keep.sum(), nx * ny))
+    cols.append(targets[keep])
+    weights.append(np.maximum(target_costs[keep], 1e-9))
+    graph = coo_matrix(
+        (np.concatenate(weights), (np.concatenate(rows), np.concatenate(cols))), shape=(nx * ny + 1,) * 2
+    ).tocsr()
+    return dijkstra(graph, directed=False, indices=nx * ny)[:-1].reshape(nx, ny)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_compiled_search_equals_scipys_dijkstra_bit_for_bit(seed):
+    rng = np.random.default_rng(seed)
+    cost = 1.0 + 4.0 * rng.random((37, 53)) ** 3
+    cost[rng.random(cost.shape) < 0.3] = np.inf  # walls and islands, some cells cut off
+    edge = np.flatnonzero(np.pad(np.zeros((35, 51), bool), 1, constant_values=True))
+    targets = edge if seed % 2 else rng.choice(np.flatnonzero(np.isfinite(cost)), 1)
+    starts = rng.uniform(0.0, 3.0, len(targets)) if seed % 2 else np.zeros(1)
+    got = gridsearch.cost_to_go(cost, targets, starts, 0.05)
+    expected = scipy_cost_to_go(cost, targets, starts, 0.05)
+    assert np.isfinite(got).sum() > 100 and np.isinf(got).any()
+    np.testing.assert_array_equal(got, expected)
+
+
 def test_the_way_goes_round_a_wall_through_its_gap():
     cost = np.ones((60, 60))
     cost[30, :] = np.inf

@@ -1,14 +1,15 @@
 """Shortest ways over the sonar map: where the robot's disc fits, and the cost to go to a target.
 
-Pure numpy and scipy. Each cell gets a step cost from its distance to the nearest obstacle
-cell (`step_costs`): infinite (blocked) closer than the robot's radius plus a clearance, 1 far
-from obstacles, and rising in between, so ways keep their distance where there is room and
-still pass a narrow gap when it is the only one (a costmap's inflation layer). An 8-connected
-grid graph over the finite cells (diagonal moves only between two free orthogonal neighbours,
-so no corner is cut; each move costs its length times the mean of its two cells' costs) gives,
-by Dijkstra, each cell's cost to go to a set of target cells (`cost_to_go`). Cells the sonar
-has never seen count as free: the search is optimistic about the unknown, so a way that is
-not known to be blocked is worth trying, and the map corrects it when the sonar sees more.
+numpy, scipy's distance transform and a compiled Dijkstra. Each cell gets a step cost from its
+distance to the nearest obstacle cell (`step_costs`): infinite (blocked) closer than the
+robot's radius plus a clearance, 1 far from obstacles, and rising in between, so ways keep
+their distance where there is room and still pass a narrow gap when it is the only one (a
+costmap's inflation layer). An 8-connected grid graph over the finite cells (diagonal moves
+only between two free orthogonal neighbours, so no corner is cut; each move costs its length
+times the mean of its two cells' costs) gives, by Dijkstra, each cell's cost to go to a set of
+target cells (`cost_to_go`). Cells the sonar has never seen count as free: the search is
+optimistic about the unknown, so a way that is not known to be blocked is worth trying, and
+the map corrects it when the sonar sees more.
 Steepest descent of the cost gives the way itself (`descend`).
 
 Grids are indexed [i, j] with i along world x and j along world y, like the sonar map.
@@ -21,8 +22,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import ndimage
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import dijkstra
 
 INFLATED_STEP_COST = 10.0
 """Step cost of blocked cells made passable (under the robot's own disc, at the goal)."""
@@ -165,43 +164,22 @@ class Window:
 
 def cost_to_go(cost: np.ndarray, targets: np.ndarray, target_costs: np.ndarray, cell_m: float) -> np.ndarray:
     """Least cost (m, weighted by the step costs) from every cell to the targets; inf where no
-    target is reachable.
+    target is reachable (Dijkstra over the 8-connected grid, `kernels.grid_dijkstra`).
 
     `targets` are flat indices of cells, each starting at its `target_costs` (m): a target
     outside the grid is represented by the border cells with their straight distance to it.
     Targets on blocked cells are dropped.
     """
-    nx, ny = cost.shape
-    n = nx * ny
-    free = np.isfinite(cost)
-    index = np.arange(n).reshape(nx, ny)
-    rows, cols, weights = [], [], []
+    from vplane_mj.planning.kernels import grid_dijkstra  # numba: loaded by the first call
 
-    def link(a: tuple[slice, slice], b: tuple[slice, slice], mask: np.ndarray, length: float) -> None:
-        rows.append(index[a][mask])
-        cols.append(index[b][mask])
-        weights.append(length * 0.5 * (cost[a][mask] + cost[b][mask]))
-
-    all_, head, tail = slice(None), slice(None, -1), slice(1, None)
-    link((all_, head), (all_, tail), free[:, :-1] & free[:, 1:], cell_m)
-    link((head, all_), (tail, all_), free[:-1, :] & free[1:, :], cell_m)
-    square = free[:-1, :-1] & free[:-1, 1:] & free[1:, :-1] & free[1:, 1:]
-    link((head, head), (tail, tail), square, cell_m * math.sqrt(2))
-    link((head, tail), (tail, head), square, cell_m * math.sqrt(2))
-    keep = free.ravel()[targets]
-    targets, target_costs = targets[keep], target_costs[keep]
-    if not len(targets):
-        return np.full((nx, ny), np.inf)
-    # One extra node, the source, joins every target at its starting cost (a tiny positive
-    # weight stands for zero: the sparse graph drops explicit zeros).
-    rows.append(np.full(len(targets), n))
-    cols.append(targets)
-    weights.append(np.maximum(target_costs, 1e-9))
-    graph = coo_matrix(
-        (np.concatenate(weights), (np.concatenate(rows), np.concatenate(cols))), shape=(n + 1, n + 1)
-    ).tocsr()
-    costs = dijkstra(graph, directed=False, indices=n)
-    return costs[:n].reshape(nx, ny)
+    targets = np.asarray(targets, dtype=np.int64).ravel()
+    keep = np.isfinite(cost).ravel()[targets]
+    return grid_dijkstra.cost_to_go(
+        np.ascontiguousarray(cost, float),
+        targets[keep],
+        np.asarray(target_costs, float).ravel()[keep],
+        float(cell_m),
+    )
 
 
 def way_to(
