@@ -16,6 +16,7 @@ planner, where a run's time goes. Last, the run loop's own share: a run of `open
 planner costs next to nothing (`straight_to_goal`, a unit force toward the goal), over its floor.
 
     python benchmarks/overhead.py [SCENARIO ...] [--planners vplane,apf] [--repeat 3] [--no-log] [--profile]
+        [--plot overhead.png]
 
 SCENARIO is a built-in name or a scenario file (e.g. one of `vplane-mj generate`).
 """
@@ -177,10 +178,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--no-log", action="store_true", help="do not time runs that write their log")
     parser.add_argument("--profile", action="store_true", help="profile one run of the first combination")
+    parser.add_argument("--plot", type=Path, help="also draw the ratios into this PNG")
     args = parser.parse_args(argv)
     planners = [name.strip() for name in args.planners.split(",")]
     with tempfile.TemporaryDirectory() as tmp:
-        report(args.scenarios, planners, args.repeat, None if args.no_log else Path(tmp))
+        rows = report(args.scenarios, planners, args.repeat, None if args.no_log else Path(tmp))
+    if args.plot:
+        plot(rows, args.plot)
+        print(f"wrote {args.plot}")
     if args.profile:
         profile(args.scenarios[0], planners[0])
     register_planner(StraightToGoal)
@@ -192,7 +197,29 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def report(scenarios: list[str], planners: list[str], repeat: int, log_dir: Path | None) -> None:
+def plot(rows: list[dict], path: Path) -> None:
+    """Each row's run over floor, without and with its log, as bars."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    x = np.arange(len(rows))
+    figure, ax = plt.subplots(figsize=(2 + 0.9 * len(rows), 3.8), layout="constrained")
+    ax.bar(x - 0.2, [row["run"] for row in rows], 0.4, label="run / floor", color="tab:blue")
+    logged = [row["log"] if row["log"] is not None else 0.0 for row in rows]
+    ax.bar(x + 0.2, logged, 0.4, label="run with its log / floor", color="tab:orange")
+    ax.axhline(1.0, color="black", linewidth=0.8)
+    ax.set_xticks(x, [f"{row['planner']}\n{row['scenario']}" for row in rows], fontsize=7)
+    ax.set_ylabel("CPU time over the physics floor")
+    ax.set_title("A run against MuJoCo's bare physics of the same world and steps", fontsize=10)
+    ax.legend(fontsize=8)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    figure.savefig(path, dpi=100)
+    plt.close(figure)
+
+
+def report(scenarios: list[str], planners: list[str], repeat: int, log_dir: Path | None) -> list[dict]:
     print(f"median of {repeat} interleaved repeats, CPU time; mujoco {mujoco.__version__}\n")
     print(
         "| scenario | planner | outcome | physics steps | floor us/step | run / floor | run with log / floor "
@@ -200,6 +227,7 @@ def report(scenarios: list[str], planners: list[str], repeat: int, log_dir: Path
         "| log MB/min |"
     )
     print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    rows = []
     for planner in planners:
         for ref in scenarios:
             row = measure(ref, planner, repeat, log_dir)
@@ -213,6 +241,8 @@ def report(scenarios: list[str], planners: list[str], repeat: int, log_dir: Path
                 f"| {size} |"
             )
             sys.stdout.flush()
+            rows.append(row)
+    return rows
 
 
 if __name__ == "__main__":

@@ -69,7 +69,9 @@ RATIO_BOUNDS = (0.2, 50.0)
 
 
 def test_overhead_times_runs_and_the_run_loop_alone_against_the_floor(tmp_path):
-    text = run_benchmark("overhead.py", "open_field", "--planners", "apf", "--repeat", "1", cwd=tmp_path)
+    arguments = ("open_field", "--planners", "apf", "--repeat", "1", "--plot", "ratios.png")
+    text = run_benchmark("overhead.py", *arguments, cwd=tmp_path)
+    assert (tmp_path / "ratios.png").stat().st_size > 1000
     (row,) = table_rows(text, "open_field")
     assert row[1:3] == ["`apf`", "reached"]
     steps = run_scenario(load_scenario("open_field", ["planner.name=apf"])).summary.steps
