@@ -23,8 +23,6 @@ published figures as lines, to `OUT/barn_protocol.png`.
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 import statistics
 import sys
 from pathlib import Path
@@ -33,7 +31,7 @@ import numpy as np
 
 from vplane_mj.bench.sweep import parse_seeds, plan_jobs, run_sweep
 from vplane_mj.errors import VPlaneError
-from vplane_mj.files import prepare_out_dir, write_atomically
+from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
 from vplane_mj.planning.registry import PLANNERS
 from vplane_mj.worlds.barn_protocol import generate_protocol
 
@@ -167,13 +165,7 @@ def main(argv: list[str] | None = None) -> int:
     ]
     rows = run_sweep(jobs, out, args.jobs)
     table = planner_table(rows)
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=COLUMNS)
-    writer.writeheader()
-    writer.writerows(table)
-    write_atomically(
-        out / "barn_protocol.csv", lambda tmp: tmp.write_text(buffer.getvalue(), encoding="utf-8")
-    )
+    write_csv(out / "barn_protocol.csv", table, COLUMNS)
     plot(table, out / "barn_protocol.png")
     print(markdown([*table, *PUBLISHED]))
     print(f"wrote {out / 'barn_protocol.csv'}\nwrote {out / 'barn_protocol.png'}")

@@ -20,8 +20,6 @@ and prints the table as Markdown.
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 import statistics
 import sys
 from pathlib import Path
@@ -30,7 +28,7 @@ import numpy as np
 
 from vplane_mj.bench.sweep import plan_jobs, run_sweep
 from vplane_mj.errors import VPlaneError
-from vplane_mj.files import prepare_out_dir, write_atomically
+from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
 from vplane_mj.planning.registry import PLANNERS
 from vplane_mj.worlds.families import generate, trap_suite
 
@@ -184,11 +182,7 @@ def main(argv: list[str] | None = None) -> int:
             family_of[job.scenario] = "barn" + NOISY_SUFFIX
     rows = run_sweep(jobs + noisy, out, args.jobs)
     table = family_table(rows, family_of)
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=COLUMNS)
-    writer.writeheader()
-    writer.writerows(table)
-    write_atomically(out / "clutter.csv", lambda tmp: tmp.write_text(buffer.getvalue(), encoding="utf-8"))
+    write_csv(out / "clutter.csv", table, COLUMNS)
     plot(table, out / "clutter.png")
     print(markdown(table))
     print(f"wrote {out / 'clutter.csv'}\nwrote {out / 'clutter.png'}")

@@ -23,14 +23,12 @@ the success table.
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 import sys
 from pathlib import Path
 
 from vplane_mj.bench.sweep import parse_seeds, plan_jobs, run_sweep
 from vplane_mj.errors import VPlaneError
-from vplane_mj.files import prepare_out_dir, write_atomically
+from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
 from vplane_mj.planning.registry import PLANNERS
 from vplane_mj.worlds.families import trap_suite
 
@@ -181,11 +179,7 @@ def sweep(args: argparse.Namespace) -> int:
 
     rows = run_sweep(jobs, args.out, args.jobs)
     table = tally(jobs_levels, rows)
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=COLUMNS)
-    writer.writeheader()
-    writer.writerows(table)
-    csv_path = write_atomically(args.out / "degradation.csv", lambda tmp: tmp.write_text(buffer.getvalue()))
+    csv_path = write_csv(args.out / "degradation.csv", table, COLUMNS)
     png_path = plot(table, args.reference, args.out / "degradation.png")
     runs_per_cell = len(paths) * len(seeds)
     print(f"success per planner and sensor level (noise_std m / dropout), {runs_per_cell} runs each")

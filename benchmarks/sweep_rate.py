@@ -16,8 +16,6 @@ core-minute: runs over that CPU time in minutes. Writes `OUT/sweep_rate.csv` and
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 import resource
 import sys
 import tempfile
@@ -27,7 +25,7 @@ from pathlib import Path
 from barn_protocol import PLANNER_SETTINGS
 
 from vplane_mj.bench.sweep import plan_jobs, run_sweep
-from vplane_mj.files import prepare_out_dir, write_atomically
+from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
 from vplane_mj.worlds.barn_protocol import generate_protocol
 from vplane_mj.worlds.families import generate
 
@@ -115,11 +113,7 @@ def main(argv: list[str] | None = None) -> int:
                 f"| {row['cpu_s']:.0f} | {row['runs_per_core_minute']:.0f} |"
             )
             sys.stdout.flush()
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=COLUMNS)
-    writer.writeheader()
-    writer.writerows(table)
-    write_atomically(out / "sweep_rate.csv", lambda tmp: tmp.write_text(buffer.getvalue(), encoding="utf-8"))
+    write_csv(out / "sweep_rate.csv", table, COLUMNS)
     plot(table, out / "sweep_rate.png")
     print(f"wrote {out / 'sweep_rate.csv'}\nwrote {out / 'sweep_rate.png'}")
     return 0

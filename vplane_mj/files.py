@@ -4,6 +4,8 @@ that every file appears complete under its name, or not at all."""
 from __future__ import annotations
 
 import contextlib
+import csv
+import io
 import json
 import os
 import tempfile
@@ -72,6 +74,15 @@ def write_json(path: Path, document: dict) -> Path:
     """A JSON document, indented, written atomically."""
     text = json.dumps(document, indent=2, allow_nan=False) + "\n"
     return write_atomically(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+
+
+def write_csv(path: Path, rows: list[dict], columns: list[str] | tuple[str, ...]) -> Path:
+    """`rows` as CSV with a header of `columns` (other keys left out), written atomically."""
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=list(columns), extrasaction="ignore")
+    writer.writeheader()
+    writer.writerows(rows)
+    return write_atomically(path, lambda tmp: tmp.write_text(buffer.getvalue(), encoding="utf-8"))
 
 
 def data_dir(name: str) -> Path:

@@ -11,7 +11,6 @@ data URIs and the page loads nothing, so it works offline and can be mailed arou
 from __future__ import annotations
 
 import base64
-import csv
 import html
 import io
 import json
@@ -28,7 +27,7 @@ import numpy as np
 
 from vplane_mj.bench.job import Job
 from vplane_mj.bench.sweep import PATH_KEY, family_of
-from vplane_mj.files import write_atomically, write_json
+from vplane_mj.files import write_atomically, write_csv, write_json
 from vplane_mj.geometry import shapes
 from vplane_mj.scenario import parse_scenario
 
@@ -385,14 +384,8 @@ svg.defs { position: absolute; width: 0; height: 0; }
 def write_outputs(rows: list[dict], table: list[dict], out_dir: Path, jobs: list[Job]) -> list[Path]:
     """bench.csv (one row per run), bench.json (rows and table), the figures and bench.html."""
     columns = sorted({key for row in rows for key in row if not isinstance(row[key], dict | list)})
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=columns, extrasaction="ignore")
-    writer.writeheader()
-    writer.writerows(rows)
     written = [
-        write_atomically(
-            out_dir / "bench.csv", lambda tmp: tmp.write_text(buffer.getvalue(), encoding="utf-8")
-        ),
+        write_csv(out_dir / "bench.csv", rows, columns),
         write_json(out_dir / "bench.json", {"format": 1, "rows": rows, "table": table}),
     ]
     figures = {
