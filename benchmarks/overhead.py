@@ -1,19 +1,21 @@
 """Overhead of whole runs over the physics floor, measured side by side in one process.
 
-For each scenario and planner: a full run (sonar, planner, controller, metrics; no log, no
+For each scenario and planner: a full run (sensor, planner, controller, metrics; no log, no
 render) takes N physics steps. The floor is MuJoCo alone on the same world with the sensor
-stage disabled (no rays), replaying the run's own wheel torques (one `mj_step` of k steps
-per motor period: the same N steps, the same motion and contacts). The same replay on the
-world as exported, whose rangefinders cast every sonar ray at every physics step, is the
-physics "as built" before the sonar cast its rays only when it pings. Reported: run over
-floor, run writing its MCAP log (into a temporary directory) over floor, as built over
-floor, and run over as built. Times are the process's CPU time, which other processes on a
-shared machine do not inflate; from a run's is subtracted that of a run of one control tick
-of the same scenario (building its models: what the loop's wall time in the summary leaves
-out too). Run over floor in wall-clock time (the summary's `wall_time_s`) is shown beside. Each measurement is
-repeated, interleaved, and the median kept. `--profile` prints, for the first scenario and
-planner, where a run's time goes. Last, the run loop's own share: a run of `open_field` whose
-planner costs next to nothing (`straight_to_goal`, a unit force toward the goal), over its floor.
+stage disabled (no rays), replaying the run's own wheel torques (one `mj_step` of k steps per
+motor period: the same N steps, the same motion and contacts). The same replay on the world as
+exported, whose rangefinders cast every sonar ray at every physics step, is the physics "as
+built" before the sonar cast its rays only when it pings. Reported: run over floor, run
+writing its MCAP log (into a temporary directory) over floor, as built over floor, and run
+over as built. Times are the process's CPU time, which other processes on a shared machine do
+not inflate; from a run's is subtracted that of a run of one control tick of the same scenario
+(building its models: what the loop's wall time in the summary leaves out too). Run over floor
+in wall-clock time (the summary's `wall_time_s`) is shown beside, and for a robot with a
+laser, the CPU time of its scans over the floor. Each measurement is repeated, interleaved,
+and the median kept. `--profile` prints, for the first scenario and planner, where a run's
+time goes; `--plot PNG` draws the ratios. Last, the run loop's own share: a run of
+`open_field` whose planner costs next to nothing (`straight_to_goal`, a unit force toward the
+goal), over its floor.
 
     python benchmarks/overhead.py [SCENARIO ...] [--planners vplane,apf] [--repeat 3] [--no-log] [--profile]
         [--plot overhead.png]
