@@ -32,6 +32,10 @@ def run_logged(tmp_path, capsys, *argv):
             ],
             "single_box-apf-0",
         ),
+        (  # a rectangular robot: the clearance of its footprint, not of its circumscribed disc
+            ["paper_c_avoid", "--set", "robot.profile=jackal", "--set", "run.time_limit_s=15"],
+            "paper_c_avoid-vplane-0",
+        ),
     ],
 )
 def test_summary_from_the_log_agrees_with_the_run(tmp_path, capsys, argv, base):

@@ -16,6 +16,7 @@ from vplane_mj.geometry import shapes
 from vplane_mj.logs.reader import LogContents, iter_messages, read_log
 from vplane_mj.logs.writer import METADATA_NAME
 from vplane_mj.planning.events import EventKind
+from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario import Scenario, parse_scenario
 from vplane_mj.sim.loop import Track
 from vplane_mj.sim.summary import Outcome
@@ -81,7 +82,7 @@ def summarize(contents: LogContents, scenario: Scenario) -> dict:
     footprints = shapes.scene_footprints(
         scenario.world.obstacles, scenario.world.size if scenario.world.border else None
     )
-    clearance = float(footprints.distance(contents.positions).min()) if len(footprints) else math.inf
+    clearance = pose_clearance(footprints, scenario, contents, radius)
     reached = outcome == Outcome.REACHED
     return {
         "scenario": scenario.name,
@@ -94,12 +95,27 @@ def summarize(contents: LogContents, scenario: Scenario) -> dict:
         "sim_time_s": contents.times_ns[-1] / 1e9,
         "path_length_m": float(np.sum(np.hypot(steps[:, 0], steps[:, 1]))),
         "collisions": collisions,
-        "min_clearance_m": None if math.isinf(clearance) else clearance - radius,
+        "min_clearance_m": None if math.isinf(clearance) else clearance,
         "local_minima": sum(event.kind is EventKind.LOCAL_MINIMUM for event in events),
         "escapes": sum(event.kind is EventKind.ESCAPE_FINISHED for event in events),
         "message": "" if ending is None or outcome in (Outcome.REACHED, Outcome.TIMEOUT) else ending.text,
         "events": [f"{event.time_s:8.2f} s  {event.text}" for event in events],
     }
+
+
+def pose_clearance(
+    footprints: shapes.Footprints, scenario: Scenario, contents: LogContents, radius_m: float
+) -> float:
+    """The smallest distance (m) from the robot to any obstacle over the logged poses, as the run
+    measures it: from its footprint polygon (negative: overlapping), or for a round robot from its
+    disc of `radius_m`; inf without obstacles."""
+    if not len(footprints):
+        return math.inf
+    body = robot_body(scenario.robot.profile, scenario.sensors.kind)
+    if body.disc:
+        return float(footprints.distance(contents.positions).min()) - radius_m
+    poses = np.column_stack((contents.positions, contents.yaws))
+    return float(footprints.outline_distance(body.footprint, poses).min())
 
 
 def disagreements(recomputed: dict, stored: dict, tolerance_m: float = 0.01) -> list[str]:
