@@ -6,7 +6,8 @@ in the world frame, metres:
 
 - The drive as the governor's commands move it (`DriveModel`): a ramped drive moves the
   command it drives toward the one asked for at its accelerations; the robot's speed follows
-  that ramp, its turn rate follows it `turn_lag_s` late (a skid-steer robot's tyres slip).
+  that ramp (or, measured faster, as a skid-steer braking in a hard turn, slows from where it
+  is), its turn rate follows it `turn_lag_s` late (a skid-steer robot's tyres slip).
   So the robot goes on turning after its turn command changes: a turn at omega coasts
   omega |omega| / 2 alpha (and the lag's turn) before it stops, as a speed v brakes in v^2 / 2a.
 - The check of a command (`intrusion`): the footprint along the motion it predicts (the
@@ -153,9 +154,10 @@ def ramped(start: float, phases: list[tuple[float, float]], rate: float, time_s:
 class DriveModel:
     """The drive as a planner's commands move it: a ramped drive moves the command it drives
     toward the one asked for at its accelerations (m/s^2, rad/s^2), the robot's speed follows
-    that ramp, and its turn rate follows it `turn_lag_s` late. `advance` keeps the ramp (and
-    the ramp's turn rates over the last lag) up to each control tick, `commanded` notes each
-    command given, `poses` predicts the motion of the next one."""
+    that ramp (a robot measured faster than its ramp, as a skid-steer braking in a hard turn,
+    slows from its measured speed), and its turn rate follows it `turn_lag_s` late. `advance`
+    keeps the ramp (and the ramp's turn rates over the last lag) up to each control tick,
+    `commanded` notes each command given, `poses` predicts the motion of the next one."""
 
     limits: DriveLimits
     ramp: tuple[float, float] = (0.0, 0.0)
@@ -168,6 +170,8 @@ class DriveModel:
     before the second)."""
     past: list[tuple[float, float]] = field(default_factory=list)
     """(time in s, ramped turn rate in rad/s) at the ticks within the lag, oldest first."""
+    speed: float = 0.0
+    """The robot's measured speed (m/s) at the last tick."""
 
     def advance(self, time_s: float, measured: tuple[float, float]) -> None:
         """The ramp at `time_s` (s): moved toward the last command since the last tick; at the
@@ -185,6 +189,7 @@ class DriveModel:
                 w + min(dw, max(-dw, self.command[1] - w)),
             )
         self.time_s = time_s
+        self.speed = float(measured[0])
         self.past = [(t, w) for t, w in self.past if t >= time_s - 2 * limits.turn_lag_s - 1e-9]
         self.past.append((time_s, self.ramp[1]))
 
@@ -202,14 +207,16 @@ class DriveModel:
         limits = self.limits
         a, alpha, lag = limits.max_accel_mps2, limits.max_turn_accel_radps2, limits.turn_lag_s
         speeds, turns = [(command[0], hold_s), (0.0, math.inf)], [(command[1], hold_s), (0.0, math.inf)]
+        # A robot faster than its ramp (a skid-steer braking in a hard turn) slows from its speed.
+        start = self.speed if abs(self.speed) > abs(self.ramp[0]) else self.ramp[0]
         end_of_hold = np.array([hold_s])
         v1, w1 = (
-            ramped(self.ramp[0], speeds, a, end_of_hold)[0],
+            ramped(start, speeds, a, end_of_hold)[0],
             ramped(self.ramp[1], turns, alpha, end_of_hold)[0],
         )
         end = lag + hold_s + max(abs(v1) / a, abs(w1) / alpha)
         t = np.arange(0.0, end + MOTION_STEP_S, MOTION_STEP_S)
-        v = ramped(self.ramp[0], speeds, a, t)
+        v = ramped(start, speeds, a, t)
         w = ramped(self.ramp[1], turns, alpha, t - lag)
         if lag > 0 and self.time_s is not None:
             times, rates = np.array(self.past).T
