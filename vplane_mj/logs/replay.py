@@ -12,13 +12,13 @@ from pathlib import Path
 import numpy as np
 
 from vplane_mj.errors import VPlaneError
-from vplane_mj.geometry import shapes
 from vplane_mj.logs.reader import LogContents, iter_messages, read_log
 from vplane_mj.logs.writer import METADATA_NAME
 from vplane_mj.planning.events import EventKind
 from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario import Scenario, parse_scenario
 from vplane_mj.sim.loop import Track
+from vplane_mj.sim.metrics import robot_clearance
 from vplane_mj.sim.summary import Outcome
 
 ENDINGS: dict[EventKind, Outcome] = {
@@ -79,10 +79,7 @@ def summarize(contents: LogContents, scenario: Scenario) -> dict:
     outcome = INTERRUPTED if ending is None else str(ENDINGS[ending.kind])
     collisions = sum(event.kind is EventKind.COLLISION for event in events)
     steps = np.diff(contents.positions, axis=0)
-    footprints = shapes.scene_footprints(
-        scenario.world.obstacles, scenario.world.size if scenario.world.border else None
-    )
-    clearance = pose_clearance(footprints, scenario, contents, radius)
+    clearance = pose_clearance(scenario, contents, radius)
     reached = outcome == Outcome.REACHED
     return {
         "scenario": scenario.name,
@@ -103,19 +100,13 @@ def summarize(contents: LogContents, scenario: Scenario) -> dict:
     }
 
 
-def pose_clearance(
-    footprints: shapes.Footprints, scenario: Scenario, contents: LogContents, radius_m: float
-) -> float:
-    """The smallest distance (m) from the robot to any obstacle over the logged poses, as the run
-    measures it: from its footprint polygon (negative: overlapping), or for a round robot from its
-    disc of `radius_m`; inf without obstacles."""
-    if not len(footprints):
-        return math.inf
-    body = robot_body(scenario.robot.profile, scenario.sensors.kind)
-    if body.disc:
-        return float(footprints.distance(contents.positions).min()) - radius_m
-    poses = np.column_stack((contents.positions, contents.yaws))
-    return float(footprints.outline_distance(body.footprint, poses).min())
+def pose_clearance(scenario: Scenario, contents: LogContents, radius_m: float) -> float:
+    """The robot's smallest clearance (m) over the logged poses, measured as the run measures it
+    (`robot_clearance`); inf without obstacles."""
+    clearance = robot_clearance(scenario, robot_body(scenario.robot.profile, scenario.sensors.kind), radius_m)
+    clearance.add(np.column_stack((contents.positions, contents.yaws)))
+    clearance.flush()
+    return clearance.robot_minimum
 
 
 def disagreements(recomputed: dict, stored: dict, tolerance_m: float = 0.01) -> list[str]:

@@ -25,7 +25,6 @@ import numpy as np
 
 from vplane_mj import __version__
 from vplane_mj.errors import VPlaneError
-from vplane_mj.geometry import shapes
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Decision, Observation
@@ -34,7 +33,7 @@ from vplane_mj.scenario import Scenario
 from vplane_mj.sim.control import heading_command, within_limits
 from vplane_mj.sim.drive import BELIEF_PATIENCE_S, CollisionCounter, Drive, Localiser
 from vplane_mj.sim.failure import RunFailure, failure_of
-from vplane_mj.sim.metrics import Clearance, motion_quality, path_quality, trajectory_digest
+from vplane_mj.sim.metrics import motion_quality, path_quality, robot_clearance, trajectory_digest
 from vplane_mj.sim.sensors import range_sensor
 from vplane_mj.sim.summary import Outcome, RunSummary
 from vplane_mj.sim.world import build_model
@@ -163,11 +162,7 @@ class Run:
             raise
         except Exception as exc:  # the planner's constructor: the run ends at once as `error`
             self.planner, failed = None, exc
-        world = scenario.world
-        self.clearance = Clearance(
-            shapes.scene_footprints(world.obstacles, world.size if world.border else None),
-            None if self.body.disc else self.body.footprint,
-        )
+        self.clearance = robot_clearance(scenario, self.body, self.radius)
         self.collisions = CollisionCounter(self.model, self.data)
         self.goal = np.asarray(scenario.robot.goal, float)
         self.tolerance = scenario.robot.goal_tolerance
@@ -435,12 +430,6 @@ class Run:
             planes=self.planes,
         )
 
-    @property
-    def _from_centre(self) -> float:
-        """What the clearance measured from the robot's centre loses to its footprint (m): the
-        radius of a round robot; 0 for an outline, measured from the outline itself."""
-        return self.radius if self.body.disc else 0.0
-
     def summary(self) -> RunSummary:
         """The run's summary (call once it has ended)."""
         scenario, ending, clearance = self.scenario, self.ending, self.clearance
@@ -464,8 +453,8 @@ class Run:
             wall_time_s=self.wall_time_s,
             path_length_m=self.path_length,
             collisions=len(self.collisions.points),
-            min_clearance_m=None if math.isinf(clearance.minimum) else clearance.minimum - self._from_centre,
-            mean_clearance_m=None if math.isinf(clearance.mean) else clearance.mean - self._from_centre,
+            min_clearance_m=None if math.isinf(clearance.robot_minimum) else clearance.robot_minimum,
+            mean_clearance_m=None if math.isinf(clearance.robot_mean) else clearance.robot_mean,
             **motion_quality(np.array(self.yaws), self.path_length),
             planner_cpu_ms_mean=1e3 * float(np.mean(cpu)) if cpu else None,
             planner_cpu_ms_max=1e3 * float(np.max(cpu)) if cpu else None,

@@ -11,6 +11,7 @@ import numpy as np
 
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.reference import shortest_path_length
+from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.vectors import wrap_angle
 from vplane_mj.scenario import Scenario
 
@@ -23,11 +24,15 @@ TURN_NOISE_RAD = 1e-3
 class Clearance:
     """Smallest and mean distance (m) to any obstacle or border, batched over poses (x, y in m,
     yaw in rad): from base_link's centre, or with `outline` (the robot's footprint polygon in
-    base_link, m) from the outline (negative: it overlaps)."""
+    base_link, m) from the outline (negative: it overlaps). The robot's own clearance
+    (`robot_minimum`, `robot_mean`) is that less `from_centre_m`, a round robot's radius."""
 
-    def __init__(self, footprints: shapes.Footprints, outline: np.ndarray | None = None):
+    def __init__(
+        self, footprints: shapes.Footprints, outline: np.ndarray | None = None, from_centre_m: float = 0.0
+    ):
         self._footprints = footprints
         self._outline = outline
+        self._from_centre = from_centre_m
         self._pending: list[np.ndarray] = []
         self._pending_count = 0
         self.minimum = math.inf
@@ -37,6 +42,16 @@ class Clearance:
     @property
     def mean(self) -> float:
         return self._total / self._count if self._count else math.inf
+
+    @property
+    def robot_minimum(self) -> float:
+        """The robot's smallest clearance (m; inf before any pose or without obstacles)."""
+        return self.minimum - self._from_centre
+
+    @property
+    def robot_mean(self) -> float:
+        """The robot's mean clearance (m; inf before any pose or without obstacles)."""
+        return self.mean - self._from_centre
 
     def add(self, poses: np.ndarray) -> None:
         """Poses (N, 3) of the robot, or positions (N, 2) of a robot measured from its centre."""
@@ -57,6 +72,16 @@ class Clearance:
             self._count += len(distances)
         self._pending.clear()
         self._pending_count = 0
+
+
+def robot_clearance(scenario: Scenario, body: RobotBody, radius_m: float) -> Clearance:
+    """The clearance of the scenario's robot among its obstacles and border: from its footprint
+    polygon, or for a round robot from its centre less `radius_m` (m)."""
+    world = scenario.world
+    footprints = shapes.scene_footprints(world.obstacles, world.size if world.border else None)
+    if body.disc:
+        return Clearance(footprints, None, radius_m)
+    return Clearance(footprints, body.footprint)
 
 
 class MotionQuality(TypedDict):
