@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vplane_mj.bench.report import markdown_table
 from vplane_mj.bench.sweep import parse_seeds, plan_jobs, run_sweep
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
@@ -56,16 +57,20 @@ PUBLISHED = (
 """BARN's published figures: the benchmark paper's DWA and the challenges' best mean scores."""
 
 
-def write_cases(out: Path, count: int, seed: int) -> list[str]:
-    """The protocol worlds' scenario files under `out/cases/`, their paths."""
-    cases_dir = out / "cases"
-    cases_dir.mkdir(parents=True, exist_ok=True)
+def write_scenarios(directory: Path, cases) -> list[str]:
+    """The generated `cases` as scenario files under `directory`, their paths."""
+    directory.mkdir(parents=True, exist_ok=True)
     paths = []
-    for case in generate_protocol(count, seed):
-        path = cases_dir / f"{case.name}.toml"
+    for case in cases:
+        path = directory / f"{case.name}.toml"
         path.write_text(case.toml(), encoding="utf-8")
         paths.append(str(path))
     return paths
+
+
+def write_cases(out: Path, count: int, seed: int) -> list[str]:
+    """The protocol worlds' scenario files under `out/cases/`, their paths."""
+    return write_scenarios(out / "cases", generate_protocol(count, seed))
 
 
 def planner_table(rows: list[dict]) -> list[dict]:
@@ -101,9 +106,7 @@ def markdown(rows: list[dict]) -> str:
             return f"{value:.3f}"
         return f"{value:.2f}" if isinstance(value, float) else str(value)
 
-    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
-    lines += ["| " + " | ".join(cell(k, row.get(k)) for k in COLUMNS) + " |" for row in rows]
-    return "\n".join(lines)
+    return markdown_table(rows, COLUMNS, cell)
 
 
 def plot(table: list[dict], path: Path) -> None:

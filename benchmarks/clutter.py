@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vplane_mj.bench.report import markdown_table
 from vplane_mj.bench.sweep import plan_jobs, run_sweep
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
@@ -106,9 +107,7 @@ def markdown(table: list[dict]) -> str:
             return f"{100 * value:.0f}%"
         return f"{value:.2f}" if isinstance(value, float) else str(value)
 
-    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
-    lines += ["| " + " | ".join(cell(k, row[k]) for k in COLUMNS) + " |" for row in table]
-    return "\n".join(lines)
+    return markdown_table(table, COLUMNS, cell)
 
 
 def plot(table: list[dict], path: Path) -> None:

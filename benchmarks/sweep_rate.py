@@ -22,7 +22,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from barn_protocol import PLANNER_SETTINGS
+from barn_protocol import PLANNER_SETTINGS, write_scenarios
 
 from vplane_mj.bench.sweep import plan_jobs, run_sweep
 from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
@@ -30,17 +30,6 @@ from vplane_mj.worlds.barn_protocol import generate_protocol
 from vplane_mj.worlds.families import generate
 
 COLUMNS = ("worlds", "planner", "runs", "success_rate", "wall_s", "cpu_s", "runs_per_core_minute")
-
-
-def write_worlds(out: Path, cases) -> list[str]:
-    """The cases' scenario files under `out`, their paths."""
-    out.mkdir(parents=True, exist_ok=True)
-    paths = []
-    for case in cases:
-        path = out / f"{case.name}.toml"
-        path.write_text(case.toml(), encoding="utf-8")
-        paths.append(str(path))
-    return paths
 
 
 def children_cpu_s() -> float:
@@ -97,9 +86,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=Path("logs/sweep_rate"))
     args = parser.parse_args(argv)
     out = prepare_out_dir(args.out)
-    sets = {"barn, default robot": write_worlds(out / "barn", generate("barn", args.worlds, args.seed))}
+    sets = {"barn, default robot": write_scenarios(out / "barn", generate("barn", args.worlds, args.seed))}
     if args.protocol:
-        sets["protocol, Jackal"] = write_worlds(out / "protocol", generate_protocol(args.worlds, args.seed))
+        sets["protocol, Jackal"] = write_scenarios(
+            out / "protocol", generate_protocol(args.worlds, args.seed)
+        )
     table = []
     print("| worlds | planner | runs | success | wall s | CPU s | runs per core-minute |")
     print("|---|---|---:|---:|---:|---:|---:|")

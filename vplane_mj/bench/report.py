@@ -381,6 +381,14 @@ svg.defs { position: absolute; width: 0; height: 0; }
 """
 
 
+def markdown_table(rows: list[dict], columns: tuple[str, ...], cell: Callable[[str, object], str]) -> str:
+    """`rows` as a Markdown table of `columns`, each value written by `cell(column, value)` (a
+    missing value is None)."""
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(cell(key, row.get(key)) for key in columns) + " |" for row in rows]
+    return "\n".join(lines)
+
+
 def write_outputs(rows: list[dict], table: list[dict], out_dir: Path, jobs: list[Job]) -> list[Path]:
     """bench.csv (one row per run), bench.json (rows and table), the figures and bench.html."""
     columns = sorted({key for row in rows for key in row if not isinstance(row[key], dict | list)})
