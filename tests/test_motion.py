@@ -4,6 +4,7 @@ observations; the drive model against the Jackal in MuJoCo; and real runs of the
 protocol worlds and of the Pioneer and the TurtleBot3 in the paper's four scenarios."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -108,6 +109,26 @@ def test_the_drive_model_ramps_the_commands_and_turns_its_lag_late():
     assert straight.drive.poses((0.0, 0.0), 0.05)[-1] == pytest.approx(
         [1.0**2 / (2 * 2.0), 0.0, 0.0], abs=0.01
     )
+
+
+def test_the_drive_model_brakes_slower_in_a_hard_turn_and_lets_a_slide_fade():
+    limits = JACKAL.limits
+    model = motion.DriveModel(limits)
+    assert model.braking((1.0, 0.0)) == limits.max_accel_mps2
+    assert model.braking((0.0, limits.max_turn_rate_radps / 4)) == pytest.approx(1.4)  # half way
+    assert model.braking((0.0, -limits.max_turn_rate_radps)) == limits.turning_brake_mps2
+    # The poses show the robot going 0.6 m/s along its heading (+y) and 0.3 m/s to its right,
+    # while its wheels measure 0.2 m/s: told to stop and turn hard, it slows from 0.6 m/s at
+    # the turning brake, and its slide fades at it.
+    model.advance(0.0, (0.2, 0.0), (0.0, 0.0, math.pi / 2))
+    model.advance(0.05, (0.2, 0.0), (0.015, 0.03, math.pi / 2))
+    assert (model.speed, model.slide) == pytest.approx((0.6, -0.3))
+    brake = limits.turning_brake_mps2
+    end = model.poses((0.0, limits.max_turn_rate_radps), 0.05)[-1]
+    assert end[0] == pytest.approx(0.6**2 / (2 * brake), abs=0.01)
+    assert end[1] == pytest.approx(-(0.3**2) / (2 * brake), abs=0.01)
+    # A robot that does not say how it brakes in a turn brakes at its top acceleration.
+    assert motion.DriveModel(DriveLimits(max_accel_mps2=3.0)).braking((0.0, 9.0)) == 3.0
 
 
 def test_a_predicted_motion_keeps_a_growing_margin_and_nears_no_close_point():
@@ -223,18 +244,19 @@ def _run(scenario_text_or_name: str, overrides: list[str]):
     return run_scenario(load_scenario(scenario_text_or_name, overrides)).summary
 
 
-@pytest.fixture(scope="module")
-def protocol_worlds(tmp_path_factory):
-    """The first 27 BARN protocol worlds of seed 0 as scenario files."""
+PROTOCOL_WORLDS = Path(__file__).parent / "data" / "barn_protocol"
+"""Worlds of `vplane-mj generate barn --protocol --count 43 --seed 0` that once troubled the Jackal."""
+
+
+@pytest.mark.slow
+def test_the_stored_protocol_worlds_are_the_generators():
     from vplane_mj.worlds.barn_protocol import generate_protocol
 
-    out = tmp_path_factory.mktemp("barn")
-    paths = []
-    for case in generate_protocol(27, 0):
-        path = out / f"{case.name}.toml"
-        path.write_text(case.toml(), encoding="utf-8")
-        paths.append(str(path))
-    return paths
+    cases = generate_protocol(43, 0)
+    stored = sorted(PROTOCOL_WORLDS.glob("*.toml"))
+    assert len(stored) == 4
+    for path in stored:
+        assert path.read_text(encoding="utf-8") == cases[int(path.stem[-3:])].toml()
 
 
 @pytest.mark.parametrize(
@@ -243,11 +265,12 @@ def protocol_worlds(tmp_path_factory):
         (1, 0, 0.4),  # measured 0.50: within twice the reference path's time at 2 m/s
         (16, 0, 0.3),  # the robot's turn coasted it into a post on every seed before the turn lag
         (26, 2, 0.3),  # the robot wedged itself between posts before it could back off
+        (42, 1, 0.3),  # spinning hard, the robot slid on into the wall behind the start
     ],
 )
-def test_a_jackal_crosses_barn_protocol_worlds_without_a_collision(protocol_worlds, world, seed, least_score):
+def test_a_jackal_crosses_barn_protocol_worlds_without_a_collision(world, seed, least_score):
     overrides = ["planner.name=vplane_plus", f"run.seed={seed}", "sensors.noise_std=0.01"]
-    summary = _run(protocol_worlds[world], overrides)
+    summary = _run(str(PROTOCOL_WORLDS / f"barn_protocol_0_{world:03d}.toml"), overrides)
     assert summary.outcome == "reached" and summary.collisions == 0
     assert summary.score > least_score
 

@@ -185,12 +185,14 @@ def test_the_pioneer_outline_is_the_hull_of_its_top_plate_and_wheels_and_its_son
 @dataclass(frozen=True)
 class Run:
     """A drive from standing: times (s), body speed (m/s), yaw rate (rad/s), left wheel rate
-    (rad/s), and the physics time per step (s)."""
+    (rad/s), position (x, y in m), and the physics time per step (s)."""
 
     time: np.ndarray
     speed: np.ndarray
     yaw_rate: np.ndarray
     wheel_rate: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
     step_cost_s: float
 
     def rise(self, signal: np.ndarray, target: float) -> tuple[float, float]:
@@ -205,12 +207,18 @@ class Run:
 
 
 def drive_from_standing(
-    profile: RobotProfile, speed: float, turn: float, ramp: bool, seconds: float, stop_s: float = math.inf
+    profile: RobotProfile,
+    speed: float,
+    turn: float,
+    ramp: bool,
+    seconds: float,
+    stop_s: float = math.inf,
+    then: tuple[float, float] = (0.0, 0.0),
 ) -> Run:
     """Command (speed m/s, turn rad/s) from standing, ramped at the profile's accelerations or
     stepped (as today's drive does), through a wheel-speed PI loop per side at the motor rate
     (as vplane_mj.sim.drive runs it), the wheel targets from the track times the track_scale;
-    from `stop_s` (s) on, command a stop."""
+    from `stop_s` (s) on, command `then` (a stop by default)."""
     model = attached_model(profile)
     data = mujoco.MjData(model)
     gains, limits = profile.gains, profile.limits
@@ -225,7 +233,7 @@ def drive_from_standing(
     trace = []
     started = time.perf_counter()
     for _ in range(round(seconds / dt)):
-        wanted = (speed, turn) if data.time < stop_s else (0.0, 0.0)
+        wanted = (speed, turn) if data.time < stop_s else then
         if ramp:
             dv, dw = limits.max_accel_mps2 * dt, limits.max_turn_accel_radps2 * dt
             commanded = (
@@ -242,7 +250,7 @@ def drive_from_standing(
         mujoco.mj_step(model, data, steps)
         yaw = math.atan2(data.xmat[base][3], data.xmat[base][0])
         forward = data.qvel[0] * math.cos(yaw) + data.qvel[1] * math.sin(yaw)
-        trace.append((data.time, forward, data.qvel[5], data.qvel[dofs[0]]))
+        trace.append((data.time, forward, data.qvel[5], data.qvel[dofs[0]], data.qpos[0], data.qpos[1]))
     cost = (time.perf_counter() - started) / (len(trace) * steps)
     columns = np.array(trace).T
     return Run(*columns, step_cost_s=cost)
@@ -293,9 +301,95 @@ def test_each_robot_stops_turning_its_turn_lag_after_its_ramp(name):
         assert beyond == pytest.approx(limits.turn_lag_s, abs=0.03)
 
 
+@pytest.mark.parametrize("name", [name for name in NAMES if PROFILES[name].limits.turning_brake_mps2])
+def test_a_robot_told_to_stop_and_turn_hard_slides_within_its_turning_brake(name):
+    # At 1 m/s, then a stop with a turn in place: the body slides on, farther than a straight
+    # stop (v^2 / 2a) on the Jackal, whose tyres drag sideways, but within v^2 / 2 b, b its
+    # turning brake (the governor's prediction).
+    profile = PROFILES[name]
+    limits = profile.limits
+    speed = min(1.0, limits.max_speed_mps)
+    straight = drive_from_standing(profile, speed, 0.0, ramp=True, seconds=4.0, stop_s=2.5)
+    assert _slid(straight, 2.5) == pytest.approx(speed**2 / (2 * limits.max_accel_mps2), rel=0.1)
+    for share in (0.5, 0.75, 1.0):
+        turning = (0.0, share * limits.max_turn_rate_radps)
+        run = drive_from_standing(profile, speed, 0.0, ramp=True, seconds=5.0, stop_s=2.5, then=turning)
+        assert _slid(straight, 2.5) < _slid(run, 2.5) <= speed**2 / (2 * limits.turning_brake_mps2)
+    if name == "jackal":
+        assert _slid(run, 2.5) > 2 * _slid(straight, 2.5)
+
+
+def _slid(run: Run, stop_s: float) -> float:
+    """How far (m) the robot got from where it was at `stop_s` (s), by the end of `run`."""
+    at = int(np.searchsorted(run.time, stop_s))
+    return float(np.hypot(run.x[-1] - run.x[at], run.y[-1] - run.y[at]))
+
+
 def test_a_profile_is_frozen_data():
     profile = PROFILES["jackal"]
     with pytest.raises(dataclasses.FrozenInstanceError):
         profile.track_scale = 1.0  # type: ignore[misc]
     with pytest.raises(TypeError):
         profile.sensors["beams"] = 10  # type: ignore[index]
+
+
+def measured_table() -> str:
+    """The docs' "Measured in MuJoCo" table (docs/robots.md), as Markdown, for every profile."""
+    rows: dict[str, list[str]] = {key: [] for key in MEASURED_ROWS}
+    for name in NAMES:
+        profile = PROFILES[name]
+        limits = profile.limits
+        top, rate = limits.max_speed_mps, limits.max_turn_rate_radps
+        run = drive_from_standing(profile, top, 0.0, ramp=profile.ramped, seconds=3.0)
+        accel, rise_s = run.rise(run.speed, top)
+        stepped = drive_from_standing(profile, top, 0.0, ramp=False, seconds=3.0)
+        turning = drive_from_standing(profile, 0.0, rate, ramp=profile.ramped, seconds=4.0)
+        rows["reached"].append(f"{run.steady(run.speed) / top:.3f}")
+        rows["accel"].append(f"{accel:.2f}")
+        rows["rise"].append(f"{rise_s:.2f}")
+        rows["stepped"].append(f"{stepped.rise(stepped.speed, top)[0]:.2f}")
+        rows["turn"].append(f"{turning.steady(turning.yaw_rate) / rate:.2f}")
+        lags, slides = [], []
+        for share in (0.5, 1.0) if profile.ramped else ():
+            stop = drive_from_standing(profile, 0.0, share * rate, ramp=True, seconds=5.0, stop_s=3.0)
+            after = stop.time > 3.0
+            coast = float(np.sum(stop.yaw_rate[after] * np.diff(stop.time, prepend=0.0)[after]))
+            lags.append(
+                f"{(coast - (share * rate) ** 2 / (2 * limits.max_turn_accel_radps2)) / (share * rate):.3f}"
+            )
+        speed = min(1.0, top)
+        for then in (
+            [(0.0, 0.0)] + [(0.0, share * rate) for share in (0.5, 0.75, 1.0)] if profile.ramped else []
+        ):
+            slide = drive_from_standing(profile, speed, 0.0, ramp=True, seconds=5.0, stop_s=2.5, then=then)
+            slides.append(_slid(slide, 2.5))
+        rows["lag"].append(", ".join(lags) or "-")
+        rows["slide"].append(
+            f"{slides[0]:.3f}; " + ", ".join(f"{s:.3f}" for s in slides[1:]) if slides else "-"
+        )
+        braking = [speed * speed / (2 * s) for s in slides]
+        rows["braking"].append(
+            f"{braking[0]:.2f}; " + ", ".join(f"{b:.2f}" for b in braking[1:]) if slides else "-"
+        )
+        rows["step"].append(f"{run.step_cost_s * 1e6:.1f}")
+    lines = ["| | " + " | ".join(f"`{name}`" for name in NAMES) + " |", "|---|" + "---|" * len(NAMES)]
+    lines += [f"| {title} | " + " | ".join(rows[key]) + " |" for key, title in MEASURED_ROWS.items()]
+    return "\n".join(lines)
+
+
+MEASURED_ROWS = {
+    "reached": "Top speed reached (of the profile's)",
+    "accel": "Acceleration, 10-90 % (m/s^2)",
+    "rise": "Time to 95 % of top speed (s)",
+    "stepped": "Acceleration with the commands stepped (m/s^2)",
+    "turn": "Turning in place: yaw rate / commanded",
+    "lag": "Turn after a stop beyond omega^2 / 2 alpha, per rad/s of turn (s), at half and full turn rate",
+    "slide": "Slide (m) from 1 m/s (the Burger: its top speed) told to stop straight, or to stop and turn "
+    "at half, three quarters and all of the top turn rate",
+    "braking": "Braking those slides show (m/s^2)",
+    "step": "Physics step (microseconds, the robot alone)",
+}
+
+
+if __name__ == "__main__":  # python -m tests.test_profiles: the table of docs/robots.md
+    print(measured_table())

@@ -154,6 +154,10 @@ def summary_figure(rows: list[dict]) -> plt.Figure:
     data = [[r["path_ratio"] for r in rows if r["planner"] == p and r.get("path_ratio")] for p in planners]
     ratios.boxplot([d if d else [float("nan")] for d in data], tick_labels=planners)
     ratios.set(ylabel="path length / shortest path", title="path ratio of the runs that reached the goal")
+    for axes in (times, ratios):  # long planner names stay apart
+        axes.tick_params(axis="x", labelrotation=30)
+        for label in axes.get_xticklabels():
+            label.set_horizontalalignment("right")
     return figure
 
 

@@ -21,15 +21,18 @@ DISC_SIDES = 32
 @dataclass(frozen=True)
 class DriveLimits:
     """What the drive can do: top speed (m/s), top turn rate (rad/s), forward acceleration and
-    braking (m/s^2), turn-rate acceleration (rad/s^2), and how long (s) the robot's turn rate
+    braking (m/s^2), turn-rate acceleration (rad/s^2), how long (s) the robot's turn rate
     trails its drive's turn command (`turn_lag_s`: a skid-steer robot's tyres slip before they
-    turn it). The defaults are the default robot's."""
+    turn it), and the braking (m/s^2) the body still gets while it turns at half its top turn
+    rate or faster (`turning_brake_mps2`: a skid-steer's tyres spend their grip dragging
+    sideways; None: `max_accel_mps2`). The defaults are the default robot's."""
 
     max_speed_mps: float = 0.5
     max_turn_rate_radps: float = 2.5
     max_accel_mps2: float = 4.0
     max_turn_accel_radps2: float = 30.0
     turn_lag_s: float = 0.0
+    turning_brake_mps2: float | None = None
 
 
 @dataclass(frozen=True)

@@ -6,10 +6,13 @@ in the world frame, metres:
 
 - The drive as the governor's commands move it (`DriveModel`): a ramped drive moves the
   command it drives toward the one asked for at its accelerations; the robot's speed follows
-  that ramp (or, measured faster, as a skid-steer braking in a hard turn, slows from where it
-  is), its turn rate follows it `turn_lag_s` late (a skid-steer robot's tyres slip).
-  So the robot goes on turning after its turn command changes: a turn at omega coasts
-  omega |omega| / 2 alpha (and the lag's turn) before it stops, as a speed v brakes in v^2 / 2a.
+  that ramp (or, measured faster by its wheels or its poses, as a skid-steer braking in a hard
+  turn, slows from where it is), its turn rate follows it `turn_lag_s` late (a skid-steer
+  robot's tyres slip). So the robot goes on turning after its turn command changes: a turn at
+  omega coasts omega |omega| / 2 alpha (and the lag's turn) before it stops, as a speed v
+  brakes in v^2 / 2a. A robot turning hard brakes slower (`braking`: a skid-steer's tyres
+  spend their grip dragging sideways), and the sideways slide its poses show fades at that
+  braking too.
 - The check of a command (`intrusion`): the footprint along the motion it predicts (the
   command for one control period, then braking to rest) must keep a margin from every point,
   the margin growing with the way the outline sweeps (`PREDICTION_ERROR`: the prediction is
@@ -135,13 +138,13 @@ def brake_speed(distance: float, accel: float, delay_s: float) -> float:
     return accel * (math.sqrt(delay_s * delay_s + 2 * max(0.0, distance) / accel) - delay_s)
 
 
-def ramped(start: float, phases: list[tuple[float, float]], rate: float, time_s: np.ndarray) -> np.ndarray:
+def ramped(start: float, phases: list[tuple[float, float, float]], time_s: np.ndarray) -> np.ndarray:
     """A ramped drive's speed (or turn rate) at each of `time_s` (s from now): from `start` it
-    moves toward each phase's target at `rate` (per s) for the phase's duration (s), in turn;
-    after the last phase it holds."""
+    moves toward each phase's target at the phase's rate (per s) for its duration (s), in
+    turn; after the last phase it holds."""
     value = np.full(len(time_s), float(start))
     begin = 0.0
-    for target, duration in phases:
+    for target, duration, rate in phases:
         inside = time_s > begin
         step = np.clip(time_s[inside] - begin, 0.0, duration) * rate
         value[inside] = start + np.clip(target - start, -step, step)
@@ -150,14 +153,23 @@ def ramped(start: float, phases: list[tuple[float, float]], rate: float, time_s:
     return value
 
 
+def faded(speed: float, rate: float, time_s: np.ndarray) -> np.ndarray:
+    """How far (m, signed as `speed`) a slide at `speed` (m/s) goes by each of `time_s` (s from
+    now) while it fades at `rate` (m/s^2): v t - a t^2 / 2 up to v / a, v^2 / 2a after."""
+    t = np.minimum(np.asarray(time_s, float), abs(speed) / rate)
+    return speed * t - math.copysign(rate, speed) * t * t / 2
+
+
 @dataclass
 class DriveModel:
     """The drive as a planner's commands move it: a ramped drive moves the command it drives
     toward the one asked for at its accelerations (m/s^2, rad/s^2), the robot's speed follows
-    that ramp (a robot measured faster than its ramp, as a skid-steer braking in a hard turn,
-    slows from its measured speed), and its turn rate follows it `turn_lag_s` late. `advance`
-    keeps the ramp (and the ramp's turn rates over the last lag) up to each control tick,
-    `commanded` notes each command given, `poses` predicts the motion of the next one."""
+    that ramp (a robot measured faster than its ramp, by its wheels or its poses, as a
+    skid-steer braking in a hard turn, slows from its measured speed), its turn rate follows it
+    `turn_lag_s` late, and a robot turning hard brakes slower (`braking`). `advance` keeps the
+    ramp (and the ramp's turn rates over the last lag) and the robot's motion up to each
+    control tick, `commanded` notes each command given, `poses` predicts the motion of the
+    next one."""
 
     limits: DriveLimits
     ramp: tuple[float, float] = (0.0, 0.0)
@@ -171,12 +183,30 @@ class DriveModel:
     past: list[tuple[float, float]] = field(default_factory=list)
     """(time in s, ramped turn rate in rad/s) at the ticks within the lag, oldest first."""
     speed: float = 0.0
-    """The robot's measured speed (m/s) at the last tick."""
+    """The robot's measured speed (m/s) at the last tick: its wheels' or, when faster along its
+    heading, its poses' over the last tick."""
+    turn: float = 0.0
+    """The robot's turn rate (rad/s) its wheels measured at the last tick."""
+    slide: float = 0.0
+    """The robot's speed (m/s) to its left, across its heading, over the last tick (its poses')."""
+    pose: tuple[float, float, float] | None = None
+    """The robot's pose (x, y in m; yaw in rad; world) at the last tick, when given."""
 
-    def advance(self, time_s: float, measured: tuple[float, float]) -> None:
+    def advance(
+        self, time_s: float, measured: tuple[float, float], pose: tuple[float, float, float] | None = None
+    ) -> None:
         """The ramp at `time_s` (s): moved toward the last command since the last tick; at the
-        first tick, the `measured` speed (m/s) and turn rate (rad/s)."""
+        first tick, the `measured` speed (m/s) and turn rate (rad/s). With the robot's `pose`
+        (x, y in m, yaw in rad; world), its motion since the last tick's: how fast it went
+        along its heading and across it."""
         limits = self.limits
+        moved = None
+        if pose is not None and self.pose is not None and self.time_s is not None and time_s > self.time_s:
+            elapsed = time_s - self.time_s
+            vx, vy = (pose[0] - self.pose[0]) / elapsed, (pose[1] - self.pose[1]) / elapsed
+            c, s = math.cos(pose[2]), math.sin(pose[2])
+            moved = (c * vx + s * vy, -s * vx + c * vy)
+        self.pose = pose
         if self.time_s is None:
             self.ramp = (float(measured[0]), float(measured[1]))
         else:
@@ -189,7 +219,11 @@ class DriveModel:
                 w + min(dw, max(-dw, self.command[1] - w)),
             )
         self.time_s = time_s
-        self.speed = float(measured[0])
+        self.speed, self.turn, self.slide = float(measured[0]), float(measured[1]), 0.0
+        if moved is not None:
+            self.slide = moved[1]
+            if abs(moved[0]) > abs(self.speed):
+                self.speed = moved[0]
         self.past = [(t, w) for t, w in self.past if t >= time_s - 2 * limits.turn_lag_s - 1e-9]
         self.past.append((time_s, self.ramp[1]))
 
@@ -197,44 +231,58 @@ class DriveModel:
         """Note the command given at this tick."""
         self.command = command
 
+    def braking(self, command: tuple[float, float]) -> float:
+        """The braking (m/s^2) of the motion `command` starts: the top acceleration, less as the
+        robot turns harder (the fastest of the command's, the ramp's and the measured turn
+        rate), down to `turning_brake_mps2` at half the top turn rate and beyond."""
+        limits = self.limits
+        full, turning = limits.max_accel_mps2, limits.turning_brake_mps2
+        if turning is None:
+            return full
+        turn = max(abs(command[1]), abs(self.ramp[1]), abs(self.turn))
+        return full - (full - turning) * min(1.0, turn / (limits.max_turn_rate_radps / 2))
+
     def poses(self, command: tuple[float, float], hold_s: float) -> np.ndarray:
         """The poses (K, 3: x, y in m, yaw in rad; in the robot's frame now) the robot passes
         through when it is given `command` (m/s, rad/s) for `hold_s` (s) and then stops: its
-        speed ramps toward `command` for `hold_s` and then to rest; its turn rate is first the
-        ramp's of the last `turn_lag_s`, then the same ramp late (its coast: the lag's turn and
-        omega^2 / 2 alpha). Poses are kept where the robot has moved about SWEEP_STEP_M (m of
-        travel plus rad of turn) since the last kept one; the first and last are always kept."""
+        speed ramps toward `command` for `hold_s` (at the top acceleration speeding up, at
+        `braking` slowing) and then to rest at `braking`; its turn rate is first the ramp's of
+        the last `turn_lag_s`, then the same ramp late (its coast: the lag's turn and
+        omega^2 / 2 alpha); its slide across its heading fades at `braking`. Poses are kept
+        where the robot has moved about SWEEP_STEP_M (m of travel plus rad of turn) since the
+        last kept one; the first and last are always kept."""
         limits = self.limits
-        a, alpha, lag = limits.max_accel_mps2, limits.max_turn_accel_radps2, limits.turn_lag_s
-        speeds, turns = [(command[0], hold_s), (0.0, math.inf)], [(command[1], hold_s), (0.0, math.inf)]
+        alpha, lag = limits.max_turn_accel_radps2, limits.turn_lag_s
+        brake = self.braking(command)
         # A robot faster than its ramp (a skid-steer braking in a hard turn) slows from its speed.
         start = self.speed if abs(self.speed) > abs(self.ramp[0]) else self.ramp[0]
+        faster = abs(command[0]) > abs(start) and command[0] * start >= 0
+        speeds = [(command[0], hold_s, limits.max_accel_mps2 if faster else brake), (0.0, math.inf, brake)]
+        turns = [(command[1], hold_s, alpha), (0.0, math.inf, alpha)]
         end_of_hold = np.array([hold_s])
-        v1, w1 = (
-            ramped(start, speeds, a, end_of_hold)[0],
-            ramped(self.ramp[1], turns, alpha, end_of_hold)[0],
-        )
-        end = lag + hold_s + max(abs(v1) / a, abs(w1) / alpha)
+        v1, w1 = ramped(start, speeds, end_of_hold)[0], ramped(self.ramp[1], turns, end_of_hold)[0]
+        end = lag + hold_s + max(abs(v1) / brake, abs(w1) / alpha, abs(self.slide) / brake)
         t = np.arange(0.0, end + MOTION_STEP_S, MOTION_STEP_S)
-        v = ramped(start, speeds, a, t)
-        w = ramped(self.ramp[1], turns, alpha, t - lag)
+        v = ramped(start, speeds, t)
+        w = ramped(self.ramp[1], turns, t - lag)
         if lag > 0 and self.time_s is not None:
             times, rates = np.array(self.past).T
             late = t < lag
             w[late] = np.interp(self.time_s + t[late] - lag, times, rates)
-        return _integrated(t, v, w)
+        return _integrated(t, v, w, faded(self.slide, brake, t))
 
 
-def _integrated(t: np.ndarray, v: np.ndarray, w: np.ndarray) -> np.ndarray:
+def _integrated(t: np.ndarray, v: np.ndarray, w: np.ndarray, slid: np.ndarray) -> np.ndarray:
     """The poses (K, 3) of a robot starting at the origin with speeds `v` (m/s) and turn rates
-    `w` (rad/s) at times `t` (s), kept about SWEEP_STEP_M apart (see `DriveModel.poses`)."""
+    `w` (rad/s) at times `t` (s), slid `slid` (m) to its left of now besides, kept about
+    SWEEP_STEP_M apart (see `DriveModel.poses`)."""
     dt = np.diff(t)
     yaw = np.concatenate(([0.0], np.cumsum(0.5 * (w[1:] + w[:-1]) * dt)))
     mid = 0.5 * (yaw[1:] + yaw[:-1])
     ds = 0.5 * (v[1:] + v[:-1]) * dt
     x = np.concatenate(([0.0], np.cumsum(ds * np.cos(mid))))
-    y = np.concatenate(([0.0], np.cumsum(ds * np.sin(mid))))
-    moved = np.concatenate(([0.0], np.cumsum(np.abs(ds) + np.abs(np.diff(yaw)))))
+    y = np.concatenate(([0.0], np.cumsum(ds * np.sin(mid)))) + slid
+    moved = np.concatenate(([0.0], np.cumsum(np.abs(ds) + np.abs(np.diff(slid)) + np.abs(np.diff(yaw)))))
     keep = np.flatnonzero(np.diff(np.floor(moved / SWEEP_STEP_M), prepend=-1.0) > 0)
     keep = np.union1d(keep, [len(t) - 1])
     return np.column_stack((x[keep], y[keep], yaw[keep]))
@@ -369,11 +417,12 @@ class Governor:
     def reach_m(self) -> float:
         """How far (m) from base_link's origin obstacles matter to the governor: the
         circumscribed radius, the longest motion it predicts (one control period at the top
-        speed and the braking from it), the larger margin and the margin's growth along that
-        motion and the longest coast of a turn."""
+        speed and the braking from it, turning hard), the larger margin and the margin's growth
+        along that motion and the longest coast of a turn."""
         limits, period = self.body.limits, self.drive.period_s
         top, rate = limits.max_speed_mps, limits.max_turn_rate_radps
-        travel = top * (period + top / (2 * limits.max_accel_mps2))
+        brake = min(limits.max_accel_mps2, limits.turning_brake_mps2 or math.inf)
+        travel = top * (period + top / (2 * brake))
         turn = rate * (period + limits.turn_lag_s) + rate * rate / (2 * limits.max_turn_accel_radps2)
         swept = travel + self.body.radius_m * turn
         return (
@@ -398,7 +447,8 @@ class Governor:
         length = float(np.hypot(force[0], force[1]))
         if self.idle:
             return Steering(force)
-        self.drive.advance(obs.time_s, obs.velocity)
+        pose = (float(obs.position[0]), float(obs.position[1]), float(obs.yaw))
+        self.drive.advance(obs.time_s, obs.velocity, pose)
         if length < 1e-9 or not math.isfinite(length):
             self.maneuver = None
             self.drive.commanded((0.0, 0.0))

@@ -149,6 +149,7 @@ JACKAL = RobotProfile(
         max_accel_mps2=2.0,
         max_turn_accel_radps2=4.0,
         turn_lag_s=0.06,
+        turning_brake_mps2=0.8,
     ),
     ramped=True,
     gains=ControllerGains(
@@ -258,7 +259,11 @@ PIONEER_3DX = RobotProfile(
     track_scale=1.0,
     wheel_friction=1.0,
     limits=DriveLimits(
-        max_speed_mps=1.2, max_turn_rate_radps=5.236, max_accel_mps2=1.2, max_turn_accel_radps2=5.236
+        max_speed_mps=1.2,
+        max_turn_rate_radps=5.236,
+        max_accel_mps2=1.2,
+        max_turn_accel_radps2=5.236,
+        turning_brake_mps2=1.0,
     ),
     ramped=True,
     gains=ControllerGains(
