@@ -202,6 +202,25 @@ def test_the_compiled_search_equals_scipys_dijkstra_bit_for_bit(seed):
     np.testing.assert_array_equal(got, expected)
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_a_search_stopped_at_the_start_gives_the_same_costs_below_it_and_the_same_way(seed):
+    rng = np.random.default_rng(seed)
+    cost = 1.0 + 4.0 * rng.random((41, 47)) ** 3
+    cost[rng.random(cost.shape) < 0.25] = np.inf
+    free = np.flatnonzero(np.isfinite(cost))
+    target, start = rng.choice(free, 2, replace=False)
+    full = gridsearch.cost_to_go(cost, np.array([target]), np.zeros(1), 0.05)
+    start_cell = np.unravel_index(start, cost.shape)
+    stopped = gridsearch.cost_to_go(cost, np.array([target]), np.zeros(1), 0.05, stop=start_cell)
+    below = full < full[start_cell]
+    np.testing.assert_array_equal(stopped[below], full[below])
+    assert stopped[start_cell] == full[start_cell]
+    assert (stopped[~below] >= full[~below]).all()
+    if np.isfinite(full[start_cell]):
+        assert np.isinf(stopped).sum() > np.isinf(full).sum()  # it stopped early
+    assert gridsearch.descend(stopped, start_cell, 10_000) == gridsearch.descend(full, start_cell, 10_000)
+
+
 def test_the_way_goes_round_a_wall_through_its_gap():
     cost = np.ones((60, 60))
     cost[30, :] = np.inf

@@ -162,13 +162,21 @@ class Window:
         return bool(np.all(np.isfinite(self.cost[i[inside], j[inside]])))
 
 
-def cost_to_go(cost: np.ndarray, targets: np.ndarray, target_costs: np.ndarray, cell_m: float) -> np.ndarray:
+def cost_to_go(
+    cost: np.ndarray,
+    targets: np.ndarray,
+    target_costs: np.ndarray,
+    cell_m: float,
+    stop: tuple[int, int] | None = None,
+) -> np.ndarray:
     """Least cost (m, weighted by the step costs) from every cell to the targets; inf where no
     target is reachable (Dijkstra over the 8-connected grid, `kernels.grid_dijkstra`).
 
     `targets` are flat indices of cells, each starting at its `target_costs` (m): a target
     outside the grid is represented by the border cells with their straight distance to it.
-    Targets on blocked cells are dropped.
+    Targets on blocked cells are dropped. With a `stop` cell, the search ends once it has that
+    cell's cost: the cells cheaper than it have theirs (all that a descent from it reads),
+    the others an upper bound or inf.
     """
     from vplane_mj.planning.kernels import grid_dijkstra  # numba: loaded by the first call
 
@@ -179,6 +187,7 @@ def cost_to_go(cost: np.ndarray, targets: np.ndarray, target_costs: np.ndarray, 
         targets[keep],
         np.asarray(target_costs, float).ravel()[keep],
         float(cell_m),
+        -1 if stop is None else int(np.ravel_multi_index(stop, np.shape(cost))),
     )
 
 
@@ -201,9 +210,11 @@ def way_to(
         targets = np.flatnonzero(edge)
         centres = window.centres().reshape(-1, 2)[targets]
         target_costs = np.hypot(*(centres - end).T)
-    costs = cost_to_go(window.cost, targets, target_costs, window.cell_m)
     start_cell = window.free_cell_near(start, 2 * radius_m)
-    if start_cell is None or not np.isfinite(costs[start_cell]):
+    if start_cell is None:
+        return None
+    costs = cost_to_go(window.cost, targets, target_costs, window.cell_m, stop=start_cell)
+    if not np.isfinite(costs[start_cell]):
         return None
     return descend(costs, start_cell, shape[0] * shape[1])
 

@@ -69,7 +69,7 @@ class LocalMap:
         from vplane_mj.planning.kernels import grid, map_update  # numba: loaded by the first map a run makes
 
         self._fold_scan = map_update.fold_scan
-        self._cells_near = grid.cells_near
+        self._cells_near, self._mark_disc = grid.cells_near, grid.mark_disc
         self._dilate, self._label_regions = grid.dilate, grid.label_regions
         self.cell_m = cell_m
         self.n = max(8, math.ceil(size_m / cell_m))
@@ -157,16 +157,9 @@ class LocalMap:
         """Mark swept (and seen) the cells whose centre lies within `radius_m` of a point (m):
         the robot's own disc stands there, so no obstacle does."""
         origin = self._follow(position)
-        reach = math.ceil(radius_m / self.cell_m) + 1
-        centre = np.floor(np.asarray(position) / self.cell_m).astype(int) - origin
-        lo, hi = np.maximum(centre - reach, 0), np.minimum(centre + reach + 1, self.n)
-        if np.any(hi <= lo):
-            return
-        rel_x = (origin[0] + np.arange(lo[0], hi[0]) + 0.5) * self.cell_m - position[0]
-        rel_y = (origin[1] + np.arange(lo[1], hi[1]) + 0.5) * self.cell_m - position[1]
-        inside = np.hypot(rel_x[:, None], rel_y[None, :]) <= radius_m
-        self._swept[lo[0] : hi[0], lo[1] : hi[1]] |= inside
-        self._seen[lo[0] : hi[0], lo[1] : hi[1]] |= inside
+        self._mark_disc(
+            self._swept, self._seen, origin, self.cell_m, float(position[0]), float(position[1]), radius_m
+        )
 
     def cells(
         self,

@@ -299,15 +299,7 @@ class VPlanePlusPlanner(VPlanePlanner):
     def _mapped_cells_near(self, position: np.ndarray, reach_m: float) -> np.ndarray:
         """Centres (N, 2) of the mapped obstacle cells (not swept) within a square of half side
         `reach_m` around a point (m)."""
-        p, cell = self.params, self.map.cell_m
-        reach = math.ceil(reach_m / cell) + 1
-        centre = np.floor(position / cell).astype(int) - self.map.origin
-        lo, hi = np.maximum(centre - reach, 0), np.minimum(centre + reach + 1, self.map.n)
-        if np.any(hi <= lo):
-            return np.empty((0, 2))
-        near = (slice(lo[0], hi[0]), slice(lo[1], hi[1]))
-        i, j = np.nonzero((self.map.grid[near] >= p.map_threshold) & ~self.map.swept[near])
-        return (np.column_stack((i, j)) + lo + self.map.origin + 0.5) * cell
+        return self.map.cells(self.params.map_threshold, position, reach_m, skip_swept=True)[0]
 
     def _way_is_blocked(self, position: np.ndarray, way: list[np.ndarray]) -> bool:
         """Whether a mapped obstacle cell now lies within the robot's half width of the way's next

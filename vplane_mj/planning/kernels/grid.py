@@ -1,4 +1,5 @@
-"""Reading the local map's grid, compiled: its obstacle cells near a point, its clusters."""
+"""Reading the local map's grid, compiled: its obstacle cells near a point, its clusters; marking
+the cells the robot stands on."""
 
 from __future__ import annotations
 
@@ -60,6 +61,28 @@ def cells_near(
                 certainty[k] = grid[i, j]
                 k += 1
     return centres, certainty
+
+
+@njit(cache=True)
+def mark_disc(
+    swept: np.ndarray,
+    seen: np.ndarray,
+    first_cell: np.ndarray,
+    cell_m: float,
+    x: float,
+    y: float,
+    radius_m: float,
+) -> None:
+    """Set in `swept` and `seen` (masks of the grid) the cells of the `square` around (x, y) (m)
+    whose centres lie within `radius_m` of it; cell (i, j) as in `cells_near`."""
+    lo_i, lo_j, hi_i, hi_j = square(first_cell, swept.shape[0], cell_m, x, y, radius_m)
+    for i in range(lo_i, hi_i):
+        rel_x = ((first_cell[0] + i) + 0.5) * cell_m - x
+        for j in range(lo_j, hi_j):
+            rel_y = ((first_cell[1] + j) + 0.5) * cell_m - y
+            if math.hypot(rel_x, rel_y) <= radius_m:
+                swept[i, j] = True
+                seen[i, j] = True
 
 
 @njit(cache=True)

@@ -12,10 +12,14 @@ _STEPS = np.array([[-1, -1], [-1, 0], [-1, 1], [0, -1], [0, 1], [1, -1], [1, 0],
 
 
 @njit(cache=True)
-def cost_to_go(cost: np.ndarray, targets: np.ndarray, target_costs: np.ndarray, cell_m: float) -> np.ndarray:
+def cost_to_go(
+    cost: np.ndarray, targets: np.ndarray, target_costs: np.ndarray, cell_m: float, stop: int
+) -> np.ndarray:
     """Least cost (m) from every cell of `cost` (nx, ny; step costs, inf blocked) to the
     `targets` (flat indices of free cells, each starting at its `target_costs`, m, at least
-    1e-9); inf where none is reachable. A move to one of the 8 neighbours costs its length
+    1e-9); inf where none is reachable. With a `stop` cell (a flat index; -1 for none) the
+    search ends once that cell is settled: every cell cheaper than it has its least cost, the
+    others keep an upper bound (or inf). A move to one of the 8 neighbours costs its length
     (`cell_m`, or `cell_m` sqrt 2 diagonally, only between two free orthogonal neighbours)
     times the mean of the two cells' step costs. Each cell's cost is the least over its
     neighbours of theirs plus the move, whatever the order cells are settled in, so it is the
@@ -34,6 +38,8 @@ def cost_to_go(cost: np.ndarray, targets: np.ndarray, target_costs: np.ndarray, 
         d, u = heapq.heappop(heap)
         if d > dist[u]:
             continue
+        if u == stop:
+            break
         i, j = u // ny, u % ny
         for s in range(8):
             a, b = i + _STEPS[s, 0], j + _STEPS[s, 1]
