@@ -476,7 +476,8 @@ class Governor:
         near = np.hypot(rel[:, 0], rel[:, 1]) < self.reach_m
         unseen = near & ~_in_view(obs, np.arctan2(rel[:, 1], rel[:, 0]) - obs.yaw)
         known = np.vstack((points, self.remembered[unseen]))
-        _, first = np.unique(np.floor(known / MEMORY_CELL_M), axis=0, return_index=True)
+        cells = np.floor(known / MEMORY_CELL_M).astype(np.int64)
+        _, first = np.unique(cells[:, 0] * (1 << 32) + cells[:, 1], return_index=True)  # one key a cell
         self.remembered = known[np.sort(first)]
         return known
 
