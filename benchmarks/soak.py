@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import statistics
 import sys
 import time
 from dataclasses import asdict
@@ -62,6 +63,7 @@ from vplane_mj.worlds.families import generate
 JOURNAL = "soak.jsonl"
 PLAN = "plan.json"
 OUTCOMES = ("reached", "timeout", "stuck", "error")
+ODOMETRY_FAULT = 'sensors.pose="odometry"'
 
 
 def draw_faults(rng: np.random.Generator) -> list[str]:
@@ -90,7 +92,7 @@ def draw_faults(rng: np.random.Generator) -> list[str]:
     if on():
         faults.append(f"robot.motor_bias_nm={draw(-0.05, 0.05, 2)}")
     if on(0.25):
-        faults += ['sensors.pose="odometry"', f"sensors.odometry_noise={draw(0.0, 0.02)}"]
+        faults += [ODOMETRY_FAULT, f"sensors.odometry_noise={draw(0.0, 0.02)}"]
     return faults
 
 
@@ -151,6 +153,13 @@ def report(runs: list[tuple[Job, list[str]]], rows: dict[str, dict], wall_s: flo
             success[planner][family] = sum(r["success"] for r in mine) / len(mine) if mine else None
             for row in mine:
                 outcomes[planner][row["outcome"]] += 1
+    on_odometry = {job.key for job, faults in runs if ODOMETRY_FAULT in faults}
+    by_pose: dict[str, dict] = {planner: {} for planner in planners}
+    for planner in planners:
+        for pose, odometry in (("true pose", False), ("odometry", True)):
+            mine = [r for j, r in summaries if j.planner == planner and (j.key in on_odometry) == odometry]
+            by_pose[planner][pose] = sum(r["success"] for r in mine) / len(mine) if mine else None
+    odometry_errors = [r["odometry_error_m"] for j, r in summaries if j.key in on_odometry]
     run_wall = [row["wall_time_s"] for _, row in summaries]
     return {
         "format": 1,
@@ -163,6 +172,8 @@ def report(runs: list[tuple[Job, list[str]]], rows: dict[str, dict], wall_s: flo
         ],
         "outcomes_per_planner": outcomes,
         "success_rate_per_planner_and_family": success,
+        "success_rate_per_planner_and_pose": by_pose,
+        "odometry_error_m_median": statistics.median(odometry_errors) if odometry_errors else None,
         "errors": [
             {"run": base_name(j), "message": r["message"]} for j, r in summaries if r["outcome"] == "error"
         ],
@@ -178,11 +189,13 @@ def print_report(figures: dict) -> None:
     crashes, missing = figures["crashes"], figures["without_summary"]
     print(f"runs: {figures['runs']}, crashes: {len(crashes)}, without a summary: {len(missing)}\n")
     success = figures["success_rate_per_planner_and_family"]
-    families = list(next(iter(success.values())))
-    table = [["planner", *OUTCOMES, *(f"success {family}" for family in families)]]
+    by_pose = figures["success_rate_per_planner_and_pose"]
+    families, poses = list(next(iter(success.values()))), list(next(iter(by_pose.values())))
+    table = [["planner", *OUTCOMES, *(f"success {name}" for name in families + poses)]]
     for planner, counts in figures["outcomes_per_planner"].items():
-        rates = ["-" if rate is None else f"{100 * rate:.0f}%" for rate in success[planner].values()]
-        table.append([planner, *(str(counts[outcome]) for outcome in OUTCOMES), *rates])
+        rates = [*success[planner].values(), *by_pose[planner].values()]
+        cells = ["-" if rate is None else f"{100 * rate:.0f}%" for rate in rates]
+        table.append([planner, *(str(counts[outcome]) for outcome in OUTCOMES), *cells])
     widths = [max(len(line[k]) for line in table) for k in range(len(table[0]))]
     for line in table:
         print("  ".join(cell.rjust(width) for cell, width in zip(line, widths, strict=True)))
@@ -198,6 +211,8 @@ def print_report(figures: dict) -> None:
     total, mean, longest = (figures[f"run_wall_time_s_{k}"] for k in ("total", "mean", "max"))
     print(f"\nwall time {figures['wall_time_s']:.0f} s; simulation loops {total:.0f} s in all", end="")
     print(f", {mean:.2f} s mean, {longest:.1f} s max per run" if mean is not None else "")
+    if figures["odometry_error_m_median"] is not None:
+        print(f"odometry's position error at the end: {figures['odometry_error_m_median']:.2f} m median")
 
 
 def plot(figures: dict, path: Path) -> Path:
@@ -219,6 +234,7 @@ def plot(figures: dict, path: Path) -> Path:
         ax.bar(planners, counts, bottom=bottom, color=colour, label=label)
         bottom += counts
     ax.set(ylabel="runs", title=f"soak: {figures['runs']} runs with random faults")
+    ax.tick_params(axis="x", labelrotation=30)  # long planner names stay apart
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     figure.tight_layout()
     return write_atomically(path, lambda tmp: figure.savefig(tmp, format="png", dpi=100))
