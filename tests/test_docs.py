@@ -148,6 +148,7 @@ def test_the_page_has_commands_with_their_output():
     assert any(step.command.startswith("vplane-mj run paper_c_escape\n") for step in STEPS)
 
 
+@pytest.mark.slow  # the page's commands as processes, one after another: about 20 s
 @pytest.mark.parametrize("index", range(len(STEPS)), ids=[step.command.split("\n")[0][:60] for step in STEPS])
 def test_a_command_of_the_page_exits_0_and_prints_and_writes_what_it_shows(session, index):
     home, done = session
