@@ -145,6 +145,28 @@ def test_a_predicted_motion_keeps_a_growing_margin_and_nears_no_close_point():
     assert motion.intrusion(JACKAL, beside, sideways, 0.03) == pytest.approx(0.008)
 
 
+@pytest.mark.parametrize("profile", ["jackal", "pioneer3dx", "turtlebot3_burger"])
+def test_the_intrusion_is_the_largest_over_every_point_and_pose_of_the_distances(profile):
+    body = robot_body(profile)
+    rng = np.random.default_rng(7)
+    decided = []
+    for _ in range(40):
+        local = rng.uniform(-2.0, 2.0, (int(rng.integers(2, 40)), 2))
+        steps = rng.uniform(-0.05, 0.05, (30, 3))
+        poses = np.vstack((np.zeros((1, 3)), np.cumsum(steps, axis=0)))
+        moved = np.hypot(*np.diff(poses[:, :2], axis=0).T) + body.radius_m * np.abs(np.diff(poses[:, 2]))
+        margins = 0.03 + motion.PREDICTION_ERROR * np.concatenate(([0.0], np.cumsum(moved)))
+        distances = motion.pose_distances(body, local, poses)
+        expected = max(0.0, float((np.minimum(margins[:, None], distances[0]) - distances).max()))
+        got = motion.intrusion(body, local, poses, 0.03)
+        assert got == pytest.approx(expected, abs=1e-12)
+        # Stopping at the first value above a tolerance decides as the largest does.
+        quick = motion.intrusion(body, local, poses, 0.03, motion.INTRUSION_TOLERANCE_M)
+        assert (quick <= motion.INTRUSION_TOLERANCE_M) == (expected <= motion.INTRUSION_TOLERANCE_M)
+        decided.append(expected <= motion.INTRUSION_TOLERANCE_M)
+    assert any(decided) and not all(decided)  # safe motions and unsafe ones
+
+
 def test_a_turn_is_commanded_to_stop_facing_the_force_and_the_default_robot_is_left_alone():
     governor = motion.Governor(JACKAL, 0.1, 0.03)
     steering = governor.steer(np.array([0.0, 1.0]), _observation(), np.empty((0, 2)))

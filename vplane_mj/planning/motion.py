@@ -99,16 +99,21 @@ def pose_distances(body: RobotBody, local: np.ndarray, poses: np.ndarray) -> np.
     (a point is inside when it lies behind every edge; `kernels.outline`)."""
     from vplane_mj.planning.kernels import outline  # numba: loaded by the first call
 
-    a = body.footprint
-    edge = np.roll(a, -1, axis=0) - a
-    # Each edge's outward normal (the polygon is counter-clockwise).
-    normal = np.column_stack((edge[:, 1], -edge[:, 0])) / np.hypot(edge[:, 0], edge[:, 1])[:, None]
+    footprint, normals = _outline(body)
     return outline.pose_distances(
-        np.ascontiguousarray(a, float),
-        normal,
+        footprint,
+        normals,
         np.ascontiguousarray(local, float).reshape(-1, 2),
         np.ascontiguousarray(poses, float).reshape(-1, 3),
     )
+
+
+def _outline(body: RobotBody) -> tuple[np.ndarray, np.ndarray]:
+    """The footprint (k, 2) and each edge's outward unit normal (k, 2; the polygon is
+    counter-clockwise), as the kernels take them."""
+    a = np.ascontiguousarray(body.footprint, float)
+    edge = np.roll(a, -1, axis=0) - a
+    return a, np.column_stack((edge[:, 1], -edge[:, 0])) / np.hypot(edge[:, 0], edge[:, 1])[:, None]
 
 
 def free_turn(body: RobotBody, local: np.ndarray, side: float, limit_rad: float, margin_m: float) -> float:
@@ -288,13 +293,17 @@ def _integrated(t: np.ndarray, v: np.ndarray, w: np.ndarray, slid: np.ndarray) -
     return np.column_stack((x[keep], y[keep], yaw[keep]))
 
 
-def intrusion(body: RobotBody, local: np.ndarray, poses: np.ndarray, margin_m: float) -> float:
+def intrusion(
+    body: RobotBody, local: np.ndarray, poses: np.ndarray, margin_m: float, enough: float = math.inf
+) -> float:
     """How far (m) the footprint along `poses` (robot frame; the first is where it starts)
     comes closer to a point of `local` (robot frame) than it may: `margin_m` plus
     PREDICTION_ERROR of the way its outline has swept so far (its travel plus radius_m times
     its turn), or for a point already closer, its distance now (a point already close does
     not freeze the robot, but it may come no closer). 0 when the motion keeps every point at
-    its distance."""
+    its distance. With `enough` (m), any value above it once one is found (`kernels.outline`)."""
+    from vplane_mj.planning.kernels import outline  # numba: loaded by the first call
+
     swept = np.concatenate(
         (
             [0.0],
@@ -308,9 +317,16 @@ def intrusion(body: RobotBody, local: np.ndarray, poses: np.ndarray, margin_m: f
     near = local[np.hypot(local[:, 0], local[:, 1]) < reach]
     if not len(near):
         return 0.0
-    distances = pose_distances(body, near, poses)
-    allowed = np.minimum(margins[:, None], distances[0])
-    return float(max(0.0, (allowed - distances).max()))
+    footprint, normals = _outline(body)
+    return outline.intrusion(
+        footprint,
+        normals,
+        float(body.radius_m),
+        np.ascontiguousarray(near, float),
+        np.ascontiguousarray(poses, float),
+        margins,
+        float(enough),
+    )
 
 
 @dataclass(frozen=True)
@@ -599,7 +615,7 @@ class Governor:
     def _safe(self, command: tuple[float, float], local: np.ndarray, margin: float) -> bool:
         """Whether the motion predicted for `command` keeps `margin` (m) and its growth (`intrusion`)."""
         poses = self.drive.poses(command, self.drive.period_s)
-        return intrusion(self.body, local, poses, margin) <= INTRUSION_TOLERANCE_M
+        return intrusion(self.body, local, poses, margin, INTRUSION_TOLERANCE_M) <= INTRUSION_TOLERANCE_M
 
     @property
     def back_off_speed(self) -> float:

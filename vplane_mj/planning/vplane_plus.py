@@ -305,13 +305,15 @@ class VPlanePlusPlanner(VPlanePlanner):
         """Whether a mapped obstacle cell now lies within the robot's half width of the way's next
         `BLOCK_LOOKAHEAD_M` (the sonar has seen something new on it): the robot drives along the
         way aligned with it."""
-        ahead = [point for point in way if np.hypot(*(point - position)) <= BLOCK_LOOKAHEAD_M]
-        if not ahead:
+        if not way:
+            return False
+        points = np.asarray(way)
+        points = points[np.hypot(*(points - position).T) <= BLOCK_LOOKAHEAD_M]
+        if not len(points):
             return False
         cells = self._mapped_cells_near(position, BLOCK_LOOKAHEAD_M + self.radius)
         if not len(cells):
             return False
-        points = np.array(ahead)
         gaps = np.hypot(*(cells[:, None, :] - points[None, :, :]).transpose(2, 0, 1))
         return bool(gaps.min() < self.robot.half_width_m)
 

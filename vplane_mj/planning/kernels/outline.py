@@ -1,4 +1,5 @@
-"""Distances from points to a convex footprint at many poses, compiled (`motion.pose_distances`)."""
+"""Distances from points to a convex footprint at many poses, and how far a motion of the
+footprint intrudes on them, compiled (`motion.pose_distances`, `motion.intrusion`)."""
 
 from __future__ import annotations
 
@@ -9,29 +10,70 @@ from numba import njit
 
 
 @njit(cache=True)
+def _gap(footprint: np.ndarray, normals: np.ndarray, x: float, y: float) -> float:
+    """Distance (m) from the point (x, y), in the footprint's frame, to the convex `footprint`
+    (k, 2; counter-clockwise, each edge's outward unit normal in `normals`); 0 inside."""
+    sides = footprint.shape[0]
+    outside = False
+    gap = math.inf
+    for k in range(sides):
+        ax, ay = footprint[k, 0], footprint[k, 1]
+        nxt = (k + 1) % sides
+        ex, ey = footprint[nxt, 0] - ax, footprint[nxt, 1] - ay
+        px, py = x - ax, y - ay
+        if px * normals[k, 0] + py * normals[k, 1] > 0.0:
+            outside = True
+        t = min(max((px * ex + py * ey) / (ex * ex + ey * ey), 0.0), 1.0)
+        gap = min(gap, math.hypot(px - t * ex, py - t * ey))
+    return gap if outside else 0.0
+
+
+@njit(cache=True)
 def pose_distances(
     footprint: np.ndarray, normals: np.ndarray, local: np.ndarray, poses: np.ndarray
 ) -> np.ndarray:
     """Distance (m) from each point of `local` (N, 2) to the convex `footprint` (k, 2; counter-
     clockwise, with each edge's outward unit normal in `normals`, k x 2) placed at each of
     `poses` (M, 3: x, y in m, yaw in rad, all in the frame of `local`): (M, N), 0 inside."""
-    count, sides = local.shape[0], footprint.shape[0]
+    count = local.shape[0]
     out = np.empty((poses.shape[0], count))
     for m in range(poses.shape[0]):
         c, s = math.cos(poses[m, 2]), math.sin(poses[m, 2])
         for n in range(count):
             dx, dy = local[n, 0] - poses[m, 0], local[n, 1] - poses[m, 1]
-            x, y = c * dx + s * dy, -s * dx + c * dy  # the point seen from the footprint
-            outside = False
-            gap = math.inf
-            for k in range(sides):
-                ax, ay = footprint[k, 0], footprint[k, 1]
-                nxt = (k + 1) % sides
-                ex, ey = footprint[nxt, 0] - ax, footprint[nxt, 1] - ay
-                px, py = x - ax, y - ay
-                if px * normals[k, 0] + py * normals[k, 1] > 0.0:
-                    outside = True
-                t = min(max((px * ex + py * ey) / (ex * ex + ey * ey), 0.0), 1.0)
-                gap = min(gap, math.hypot(px - t * ex, py - t * ey))
-            out[m, n] = gap if outside else 0.0
+            out[m, n] = _gap(footprint, normals, c * dx + s * dy, -s * dx + c * dy)
     return out
+
+
+@njit(cache=True)
+def intrusion(
+    footprint: np.ndarray,
+    normals: np.ndarray,
+    radius_m: float,
+    local: np.ndarray,
+    poses: np.ndarray,
+    margins: np.ndarray,
+    enough: float,
+) -> float:
+    """The largest min(margins[m], d0) - d over the points of `local` (N, 2) and `poses` (M, 3,
+    as in `pose_distances`; M >= 1), d a point's distance to the footprint at pose m and d0 at
+    the first pose, and 0 at least (`motion.intrusion`). A point whose distance to pose m's
+    origin less `radius_m` (the footprint's circumscribed radius) already keeps it from raising
+    the largest so far is not measured there. Returns as soon as the largest exceeds `enough`
+    (inf: the exact largest)."""
+    count = local.shape[0]
+    first = pose_distances(footprint, normals, local, poses[:1])[0]
+    worst = 0.0
+    for m in range(1, poses.shape[0]):
+        c, s = math.cos(poses[m, 2]), math.sin(poses[m, 2])
+        for n in range(count):
+            allowed = min(margins[m], first[n])
+            dx, dy = local[n, 0] - poses[m, 0], local[n, 1] - poses[m, 1]
+            if math.hypot(dx, dy) - radius_m >= allowed - worst:
+                continue  # farther than the circumscribed disc allows: cannot intrude more
+            gap = _gap(footprint, normals, c * dx + s * dy, -s * dx + c * dy)
+            if allowed - gap > worst:
+                worst = allowed - gap
+                if worst > enough:
+                    return worst
+    return worst
