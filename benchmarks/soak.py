@@ -137,6 +137,11 @@ def base_name(job: Job) -> str:
     return f"{job.scenario}-{job.planner}-{job.seed}"
 
 
+def success_rate(rows: list[dict]) -> float | None:
+    """The share of `rows` that succeeded; None for no rows."""
+    return sum(row["success"] for row in rows) / len(rows) if rows else None
+
+
 def report(runs: list[tuple[Job, list[str]]], rows: dict[str, dict], wall_s: float) -> dict:
     """The soak's figures from the journal rows of its runs (by key)."""
     planners = sorted({job.planner for job, _ in runs})
@@ -150,7 +155,7 @@ def report(runs: list[tuple[Job, list[str]]], rows: dict[str, dict], wall_s: flo
     for planner in planners:
         for family in families:
             mine = [r for j, r in summaries if j.planner == planner and family_of(j.scenario) == family]
-            success[planner][family] = sum(r["success"] for r in mine) / len(mine) if mine else None
+            success[planner][family] = success_rate(mine)
             for row in mine:
                 outcomes[planner][row["outcome"]] += 1
     on_odometry = {job.key for job, faults in runs if ODOMETRY_FAULT in faults}
@@ -158,7 +163,7 @@ def report(runs: list[tuple[Job, list[str]]], rows: dict[str, dict], wall_s: flo
     for planner in planners:
         for pose, odometry in (("true pose", False), ("odometry", True)):
             mine = [r for j, r in summaries if j.planner == planner and (j.key in on_odometry) == odometry]
-            by_pose[planner][pose] = sum(r["success"] for r in mine) / len(mine) if mine else None
+            by_pose[planner][pose] = success_rate(mine)
     odometry_errors = [r["odometry_error_m"] for j, r in summaries if j.key in on_odometry]
     run_wall = [row["wall_time_s"] for _, row in summaries]
     return {

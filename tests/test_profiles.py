@@ -291,14 +291,18 @@ def test_each_robot_stops_turning_its_turn_lag_after_its_ramp(name):
     # Turning in place, then stopped: the drive ramps the turn rate down at the top turn
     # acceleration (omega^2 / 2 alpha of turn); the robot turns its turn lag x omega beyond.
     profile = PROFILES[name]
-    limits = profile.limits
     for share in (0.5, 1.0):
-        turn = share * limits.max_turn_rate_radps
-        run = drive_from_standing(profile, 0.0, turn, ramp=True, seconds=5.0, stop_s=3.0)
-        after = run.time > 3.0
-        coast = float(np.sum(run.yaw_rate[after] * np.diff(run.time, prepend=0.0)[after]))
-        beyond = (coast - turn * turn / (2 * limits.max_turn_accel_radps2)) / turn
-        assert beyond == pytest.approx(limits.turn_lag_s, abs=0.03)
+        beyond = _turn_beyond_ramp(profile, share * profile.limits.max_turn_rate_radps)
+        assert beyond == pytest.approx(profile.limits.turn_lag_s, abs=0.03)
+
+
+def _turn_beyond_ramp(profile: RobotProfile, turn: float) -> float:
+    """Turning in place at `turn` (rad/s), then stopped: how much farther (rad) the robot
+    turns than the ramp's omega^2 / 2 alpha, per rad/s of turn (s)."""
+    run = drive_from_standing(profile, 0.0, turn, ramp=True, seconds=5.0, stop_s=3.0)
+    after = run.time > 3.0
+    coast = float(np.sum(run.yaw_rate[after] * np.diff(run.time, prepend=0.0)[after]))
+    return (coast - turn * turn / (2 * profile.limits.max_turn_accel_radps2)) / turn
 
 
 @pytest.mark.parametrize("name", [name for name in NAMES if PROFILES[name].limits.turning_brake_mps2])
@@ -309,19 +313,20 @@ def test_a_robot_told_to_stop_and_turn_hard_slides_within_its_turning_brake(name
     profile = PROFILES[name]
     limits = profile.limits
     speed = min(1.0, limits.max_speed_mps)
-    straight = drive_from_standing(profile, speed, 0.0, ramp=True, seconds=4.0, stop_s=2.5)
-    assert _slid(straight, 2.5) == pytest.approx(speed**2 / (2 * limits.max_accel_mps2), rel=0.1)
+    straight = _slide(profile, speed, (0.0, 0.0))
+    assert straight == pytest.approx(speed**2 / (2 * limits.max_accel_mps2), rel=0.1)
     for share in (0.5, 0.75, 1.0):
-        turning = (0.0, share * limits.max_turn_rate_radps)
-        run = drive_from_standing(profile, speed, 0.0, ramp=True, seconds=5.0, stop_s=2.5, then=turning)
-        assert _slid(straight, 2.5) < _slid(run, 2.5) <= speed**2 / (2 * limits.turning_brake_mps2)
+        slid = _slide(profile, speed, (0.0, share * limits.max_turn_rate_radps))
+        assert straight < slid <= speed**2 / (2 * limits.turning_brake_mps2)
     if name == "jackal":
-        assert _slid(run, 2.5) > 2 * _slid(straight, 2.5)
+        assert slid > 2 * straight
 
 
-def _slid(run: Run, stop_s: float) -> float:
-    """How far (m) the robot got from where it was at `stop_s` (s), by the end of `run`."""
-    at = int(np.searchsorted(run.time, stop_s))
+def _slide(profile: RobotProfile, speed: float, then: tuple[float, float]) -> float:
+    """How far (m) the robot goes, driven straight at `speed` (m/s) and then commanded `then`
+    (speed m/s, turn rad/s) from 2.5 s on, from where it was at 2.5 s to where it is at 5 s."""
+    run = drive_from_standing(profile, speed, 0.0, ramp=True, seconds=5.0, stop_s=2.5, then=then)
+    at = int(np.searchsorted(run.time, 2.5))
     return float(np.hypot(run.x[-1] - run.x[at], run.y[-1] - run.y[at]))
 
 
@@ -351,18 +356,12 @@ def measured_table() -> str:
         rows["turn"].append(f"{turning.steady(turning.yaw_rate) / rate:.2f}")
         lags, slides = [], []
         for share in (0.5, 1.0) if profile.ramped else ():
-            stop = drive_from_standing(profile, 0.0, share * rate, ramp=True, seconds=5.0, stop_s=3.0)
-            after = stop.time > 3.0
-            coast = float(np.sum(stop.yaw_rate[after] * np.diff(stop.time, prepend=0.0)[after]))
-            lags.append(
-                f"{(coast - (share * rate) ** 2 / (2 * limits.max_turn_accel_radps2)) / (share * rate):.3f}"
-            )
+            lags.append(f"{_turn_beyond_ramp(profile, share * rate):.3f}")
         speed = min(1.0, top)
         for then in (
             [(0.0, 0.0)] + [(0.0, share * rate) for share in (0.5, 0.75, 1.0)] if profile.ramped else []
         ):
-            slide = drive_from_standing(profile, speed, 0.0, ramp=True, seconds=5.0, stop_s=2.5, then=then)
-            slides.append(_slid(slide, 2.5))
+            slides.append(_slide(profile, speed, then))
         rows["lag"].append(", ".join(lags) or "-")
         rows["slide"].append(
             f"{slides[0]:.3f}; " + ", ".join(f"{s:.3f}" for s in slides[1:]) if slides else "-"

@@ -34,6 +34,12 @@ class DriveLimits:
     turn_lag_s: float = 0.0
     turning_brake_mps2: float | None = None
 
+    @property
+    def braking_in_turn_mps2(self) -> float:
+        """The braking (m/s^2) left while turning hard: `turning_brake_mps2`, or
+        `max_accel_mps2` when the drive does not say."""
+        return self.max_accel_mps2 if self.turning_brake_mps2 is None else self.turning_brake_mps2
+
 
 @dataclass(frozen=True)
 class HeadingGains:

@@ -35,6 +35,7 @@ were.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -108,9 +109,11 @@ def pose_distances(body: RobotBody, local: np.ndarray, poses: np.ndarray) -> np.
     )
 
 
+@functools.lru_cache(maxsize=16)
 def _outline(body: RobotBody) -> tuple[np.ndarray, np.ndarray]:
     """The footprint (k, 2) and each edge's outward unit normal (k, 2; the polygon is
-    counter-clockwise), as the kernels take them."""
+    counter-clockwise), as the kernels take them; made once per body (a body is hashed by
+    identity), shared by every call, so never written."""
     a = np.ascontiguousarray(body.footprint, float)
     edge = np.roll(a, -1, axis=0) - a
     return a, np.column_stack((edge[:, 1], -edge[:, 0])) / np.hypot(edge[:, 0], edge[:, 1])[:, None]
@@ -239,11 +242,9 @@ class DriveModel:
     def braking(self, command: tuple[float, float]) -> float:
         """The braking (m/s^2) of the motion `command` starts: the top acceleration, less as the
         robot turns harder (the fastest of the command's, the ramp's and the measured turn
-        rate), down to `turning_brake_mps2` at half the top turn rate and beyond."""
+        rate), down to the drive's braking in a turn at half the top turn rate and beyond."""
         limits = self.limits
-        full, turning = limits.max_accel_mps2, limits.turning_brake_mps2
-        if turning is None:
-            return full
+        full, turning = limits.max_accel_mps2, limits.braking_in_turn_mps2
         turn = max(abs(command[1]), abs(self.ramp[1]), abs(self.turn))
         return full - (full - turning) * min(1.0, turn / (limits.max_turn_rate_radps / 2))
 
@@ -437,7 +438,7 @@ class Governor:
         along that motion and the longest coast of a turn."""
         limits, period = self.body.limits, self.drive.period_s
         top, rate = limits.max_speed_mps, limits.max_turn_rate_radps
-        brake = min(limits.max_accel_mps2, limits.turning_brake_mps2 or math.inf)
+        brake = min(limits.max_accel_mps2, limits.braking_in_turn_mps2)
         travel = top * (period + top / (2 * brake))
         turn = rate * (period + limits.turn_lag_s) + rate * rate / (2 * limits.max_turn_accel_radps2)
         swept = travel + self.body.radius_m * turn
