@@ -34,9 +34,10 @@ from vplane_mj.logs.writer import (
     time_ns,
 )
 from vplane_mj.planning.events import Event, EventKind
+from vplane_mj.planning.types import Decision
 from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import load_scenario, parse_scenario
-from vplane_mj.sim.loop import run_scenario
+from vplane_mj.sim.loop import Tick, run_scenario
 from vplane_mj.sim.sensors import scan_bearings
 from vplane_mj.sim.world import OBSTACLE_HEIGHT_M
 
@@ -388,7 +389,7 @@ _CHILD = textwrap.dedent(
     from vplane_mj.logs.writer import McapLog
     from vplane_mj.robots.facts import robot_radius_m
     from vplane_mj.scenario import load_scenario
-    from vplane_mj.sim.loop import run_scenario
+    from vplane_mj.sim.loop import Tick, run_scenario
     from vplane_mj.sim.sensors import scan_bearings
 
     class Slow:  # keep the run going until it is killed
@@ -451,6 +452,33 @@ def test_warning_levels_close_is_idempotent_and_ticks_after_close_are_ignored(tm
     assert levels == [3, 3, 2]  # WARNING, WARNING, INFO
     assert contents.summary == {"outcome": "stuck", "value": 1.5, "gap": [None, 2]}
     assert len(contents.times_ns) == 0 and contents.complete
+
+
+def test_ticks_are_written_in_order_with_the_forces_they_had_when_they_came(tmp_path):
+    """Ticks are written in batches, yet a planner that reuses its force array, and an event
+    between ticks, change nothing in the file."""
+    scenario = load_scenario("paper_c_escape")
+    path = tmp_path / "batched.mcap"
+    log = make_log(path, scenario)
+    force = np.zeros(2)  # one array, changed in place at every tick
+    ranges = np.full(len(scan_bearings(scenario)), np.nan)
+    for k in range(5):
+        force[:] = (k + 1.0, 0.0)
+        decision = Decision(force=force, mode="normal")
+        log.on_tick(Tick(0.1 * k, np.array([1.0, 1.0]), 0.0, 0.0, ranges, decision, (0.0, 0.0)))
+        if k == 2:
+            log.on_event(0.2, Event(EventKind.LOCAL_MINIMUM, "between ticks"))
+    force[:] = (99.0, 0.0)
+    log.close()
+    metrics = [m.message for m in iter_messages(path, ("/metrics",))]
+    assert [record["force_total"] for record in metrics] == [1.0, 2.0, 3.0, 4.0, 5.0]
+    with open(path, "rb") as stream:
+        order = [
+            (channel.topic, message.log_time)
+            for _, channel, message in make_reader(stream).iter_messages(log_time_order=False)
+            if channel.topic in ("/metrics", "/events")
+        ]
+    assert order.index(("/events", time_ns(0.2))) == order.index(("/metrics", time_ns(0.2))) + 1
 
 
 CYLINDER_APF = """

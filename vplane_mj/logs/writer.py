@@ -52,6 +52,9 @@ planner and its parameters, package versions, time base, plus the caller's
 `metadata` entries, which win over a same-named key) and, at close, record
 `summary` whose key `json` holds the run summary as JSON text.
 
+A tick's messages are written with the rest of its simulated second, just before the flush
+(events first write the ticks before them, so the file keeps the run's order).
+
 Crash safety: the writer is flushed (open chunk finished and written to disk) about
 once per simulated second, so a process killed with SIGKILL loses at most about the
 last second; `vplane_mj.logs.reader.read_log` recovers every complete chunk of such a file.
@@ -85,6 +88,7 @@ from vplane_mj.logs.scene import (
     WORLD_FRAME,
 )
 from vplane_mj.planning.events import EVENT_POINTS, Event, EventKind
+from vplane_mj.planning.types import Decision
 from vplane_mj.robots.facts import robot_body
 from vplane_mj.robots.profiles import PROFILES
 from vplane_mj.scenario import Scenario
@@ -152,6 +156,12 @@ EVENTS_JSON_SCHEMA: dict[str, Any] = {
 """An event as data; its points are present only when the event has them."""
 _FORCE_ARROWS = tuple((name, FORCE_COLOURS[name], dz) for name, (_, dz) in FORCE_STYLE.items())
 """Each force arrow's name, colour and extra height, in the order they are drawn."""
+_Forces = tuple[tuple[float, float] | None, ...]
+"""A tick's force vectors (N) in `_FORCE_ARROWS`' order, None where the planner gives none."""
+_METRIC_FORCES = tuple(
+    list(FORCE_STYLE).index(name) for name in ("attractive", "repulsive", "virtual", "total")
+)
+"""Where /metrics' force magnitudes are among `_FORCE_ARROWS`."""
 WARNING_EVENTS = {EventKind.COLLISION, EventKind.GAVE_UP, EventKind.ERROR, EventKind.BELIEVED_ARRIVED}
 """Events logged at the Warning level."""
 
@@ -221,6 +231,7 @@ class McapLog:
         self._path_dirty = False
         self._modes: dict[str, str] = {}  # mode -> its JSON string
         self._next_flush_s = 0.0  # the first tick flushes, so /path starts with the run
+        self._pending: list[tuple[Tick, _Forces]] = []
 
     # -- metadata and the static world -------------------------------------------------------
     def _run_metadata(self, extra: dict[str, str]) -> dict[str, str]:
@@ -252,26 +263,14 @@ class McapLog:
 
     # -- the Observer protocol ---------------------------------------------------------------
     def on_tick(self, tick: Tick) -> None:
+        """Keep the tick; its messages are written with the others of the same simulated second,
+        before the flush (one tight loop runs faster than the same work between physics steps)."""
         if self._closed:
             return
-        ns = time_ns(tick.time_s)
-        self._last_ns = max(self._last_ns, ns)
-        stamp = scene.stamp(ns)
-        x, y, yaw = float(tick.position[0]), float(tick.position[1]), float(tick.yaw)
-        if math.isfinite(x) and math.isfinite(y) and math.isfinite(yaw):
-            self._last_pose = (x, y, yaw)
-        else:  # never log a non-finite pose: repeat the last good one
-            x, y, yaw = self._last_pose
-        self._log_pose(ns, stamp, x, y, yaw)
-        self._log_belief(ns, stamp, tick.believed_pose)
-        self._log_scan(ns, stamp, tick.ranges)
-        self._log_forces(ns, stamp, x, y, tick)
-        self._log_virtual(ns, stamp, tick)
-        self._log_metrics(ns, tick)
-        self._path.add(x, y)
-        self._path_dirty = True
+        self._pending.append((tick, _force_vectors(tick.decision)))
         if tick.time_s >= self._next_flush_s - 1e-9:
-            self._log_path(ns)
+            self._write_pending()
+            self._log_path(self._last_ns)
             self._writer.flush()
             while self._next_flush_s <= tick.time_s + 1e-9:
                 self._next_flush_s += FLUSH_PERIOD_S
@@ -279,6 +278,7 @@ class McapLog:
     def on_event(self, time_s: float, event: Event) -> None:
         if self._closed:
             return
+        self._write_pending()  # the ticks before the event first: the file keeps their order
         ns = time_ns(time_s)
         self._last_ns = max(self._last_ns, ns)
         level = fm.LogLevel.Warning if event.kind in WARNING_EVENTS else fm.LogLevel.Info
@@ -296,6 +296,7 @@ class McapLog:
             return
         self._closed = True
         try:
+            self._write_pending()
             if self._path_dirty:
                 self._log_path(self._last_ns)
             if summary is not None:
@@ -311,6 +312,30 @@ class McapLog:
         self.close()
 
     # -- per-tick topics ---------------------------------------------------------------------
+    def _write_pending(self) -> None:
+        """Write the messages of the ticks kept since the last call, in their order."""
+        pending, self._pending = self._pending, []
+        for tick, forces in pending:
+            self._write_tick(tick, forces)
+
+    def _write_tick(self, tick: Tick, forces: _Forces) -> None:
+        ns = time_ns(tick.time_s)
+        self._last_ns = max(self._last_ns, ns)
+        stamp = scene.stamp(ns)
+        x, y, yaw = float(tick.position[0]), float(tick.position[1]), float(tick.yaw)
+        if math.isfinite(x) and math.isfinite(y) and math.isfinite(yaw):
+            self._last_pose = (x, y, yaw)
+        else:  # never log a non-finite pose: repeat the last good one
+            x, y, yaw = self._last_pose
+        self._log_pose(ns, stamp, x, y, yaw)
+        self._log_belief(ns, stamp, tick.believed_pose)
+        self._log_scan(ns, stamp, tick.ranges)
+        self._log_forces(ns, stamp, x, y, forces)
+        self._log_virtual(ns, stamp, tick)
+        self._log_metrics(ns, tick, forces)
+        self._path.add(x, y)
+        self._path_dirty = True
+
     def _log_pose(self, ns: int, stamp: fm.Timestamp, x: float, y: float, yaw: float) -> None:
         turn = fm.Quaternion(x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))  # scene.yaw_quaternion
         where = fm.Vector3(x=x, y=y, z=0.0)
@@ -354,16 +379,13 @@ class McapLog:
         )
         self._scan_ch.log(scan, log_time=ns)
 
-    def _log_forces(self, ns: int, stamp: fm.Timestamp, x: float, y: float, tick: Tick) -> None:
-        decision = tick.decision
-        components = decision.components
+    def _log_forces(self, ns: int, stamp: fm.Timestamp, x: float, y: float, forces: _Forces) -> None:
         entities = []
         shown = []
-        for name, colour, dz in _FORCE_ARROWS:
-            vector = decision.force if name == "total" else components.get(name)
+        for (name, colour, dz), vector in zip(_FORCE_ARROWS, forces, strict=True):
             if vector is None:
                 continue
-            arrow = scene.force_arrow(x, y, float(vector[0]), float(vector[1]), colour, dz)
+            arrow = scene.force_arrow(x, y, vector[0], vector[1], colour, dz)
             if arrow is None:
                 continue
             shown.append(name)
@@ -405,17 +427,17 @@ class McapLog:
         self._shown_planes = len(planes)
         self._virtual_ch.log(fm.SceneUpdate(deletions=deletions, entities=entities), log_time=ns)
 
-    def _log_metrics(self, ns: int, tick: Tick) -> None:
-        components = tick.decision.components
+    def _log_metrics(self, ns: int, tick: Tick, forces: _Forces) -> None:
         x, y = float(tick.position[0]), float(tick.position[1])
+        attractive, repulsive, virtual, total = (_length(forces[k]) for k in _METRIC_FORCES)
         values = (
             tick.time_s,
             tick.speed,
             math.hypot(self._goal[0] - x, self._goal[1] - y),
-            _magnitude(components.get("attractive")),
-            _magnitude(components.get("repulsive")),
-            _magnitude(components.get("virtual")),
-            _magnitude(tick.decision.force),
+            attractive,
+            repulsive,
+            virtual,
+            total,
             tick.command[0],
             tick.command[1],
             None if tick.believed_pose is None else math.dist(tick.believed_pose[:2], (x, y)),
@@ -475,10 +497,21 @@ def time_ns(time_s: float) -> int:
     return round(time_s * 1e9)
 
 
-def _magnitude(vector: np.ndarray | None) -> float | None:
-    if vector is None:
-        return None
-    return math.hypot(float(vector[0]), float(vector[1]))
+def _force_vectors(decision: Decision) -> _Forces:
+    """The decision's forces in `_FORCE_ARROWS`' order, as numbers (None: not given): taken when
+    the tick arrives, whatever a planner later does with its arrays."""
+    components = decision.components
+    return tuple(
+        _numbers(decision.force if name == "total" else components.get(name)) for name, _, _ in _FORCE_ARROWS
+    )
+
+
+def _length(vector: tuple[float, float] | None) -> float | None:
+    return None if vector is None else math.hypot(vector[0], vector[1])
+
+
+def _numbers(vector: np.ndarray | None) -> tuple[float, float] | None:
+    return None if vector is None else (float(vector[0]), float(vector[1]))
 
 
 def _package_version(name: str) -> str:

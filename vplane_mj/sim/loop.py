@@ -45,7 +45,8 @@ EXTERNAL_PLANNER = "external"
 
 @dataclass(frozen=True)
 class Tick:
-    """Everything known at one control tick, for observers (logs, renders)."""
+    """Everything known at one control tick, for observers (logs, renders). An observer may keep
+    it: the run never changes its arrays afterwards (the `decision`'s are the planner's own)."""
 
     time_s: float
     position: np.ndarray
