@@ -604,3 +604,18 @@ def test_an_arc_no_wider_than_a_cell_marks_beyond_the_hit_range():
     assert len(marked["jackal_laser"]) >= 8  # the wall's 12 cells, but for its ends
     assert np.all(np.abs(marked["jackal_laser"][:, 0] - 3.0) <= 0.05)
     assert np.all(np.abs(marked["jackal_laser"][:, 1]) <= 0.3 + 0.05)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_compiled_distance_transform_equals_scipys_bit_for_bit(seed):
+    from scipy import ndimage
+
+    from vplane_mj.planning.kernels.edt import distance_transform
+
+    rng = np.random.default_rng(seed)
+    for density in (0.002, 0.05, 0.5, 0.95):
+        shape = tuple(rng.integers(1, 70, 2))
+        free = rng.random(shape) >= density
+        free.flat[rng.integers(free.size)] = False  # at least one cell to be near
+        np.testing.assert_array_equal(distance_transform(free), ndimage.distance_transform_edt(free))
+    assert np.isinf(distance_transform(np.ones((3, 4), bool))).all()  # nothing to be near

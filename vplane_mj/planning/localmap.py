@@ -232,9 +232,9 @@ class LocalMap:
         if free.all():  # farther than any cell of the map could be
             values = np.full(free.shape, 2.0 * self.n * self.cell_m)
         else:
-            from scipy import ndimage  # only the planners that need it pay for scipy's import
+            from vplane_mj.planning.kernels.edt import distance_transform  # numba: loaded by the first call
 
-            values = ndimage.distance_transform_edt(free) * self.cell_m
+            values = distance_transform(free) * self.cell_m
         return ClearanceField(values, origin + np.array(lo), self.cell_m)
 
     @property

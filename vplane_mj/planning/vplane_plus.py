@@ -456,6 +456,8 @@ class VPlanePlusPlanner(VPlanePlanner):
         """The paper's objective if the map has seen it free, clear of obstacles and reachable,
         else the nearest such cell outside the trap; with the map's way there. (None, []) when
         there is none."""
+        from vplane_mj.planning.kernels.edt import distance_transform  # numba: loaded by the first call
+
         start = window.free_cell_near(robot, 2 * self.radius)
         if start is None:
             return None, []
@@ -468,7 +470,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         roomy = gridsearch.clear_step_cost(
             OBJECTIVE_ROOM_M, self.params.inflation_m, self.params.inflation_weight
         )
-        seen_around = ndimage.distance_transform_edt(window.seen) * window.cell_m >= room
+        seen_around = distance_transform(window.seen) * window.cell_m >= room
         usable = np.isfinite(costs) & seen_around & (window.cost <= roomy)
         centres = window.centres()
         if plane is not None:

@@ -1,14 +1,19 @@
-"""Dijkstra over an 8-connected grid of step costs, compiled (`gridsearch.cost_to_go`)."""
+"""Dijkstra over an 8-connected grid of step costs, compiled (`gridsearch.cost_to_go`).
+
+The queue is a binary heap of cells, each cell in it at most once (its key lowered in place
+when a cheaper way reaches it), so the heap stays as small as the search's frontier.
+"""
 
 from __future__ import annotations
 
-import heapq
 import math
 
 import numpy as np
 from numba import njit
 
 _STEPS = np.array([[-1, -1], [-1, 0], [-1, 1], [0, -1], [0, 1], [1, -1], [1, 0], [1, 1]])
+_NEVER_QUEUED = -1
+_SETTLED = -2
 
 
 @njit(cache=True)
@@ -26,18 +31,23 @@ def cost_to_go(
     same, bit for bit, as any other correct Dijkstra's over the same weights."""
     nx, ny = cost.shape
     dist = np.full(nx * ny, np.inf)
-    heap = [(0.0, 0)]
-    heap.pop()
+    slot = np.full(nx * ny, _NEVER_QUEUED)  # each cell's place in the heap, or a state
+    keys = np.empty(nx * ny)
+    cells = np.empty(nx * ny, dtype=np.int64)
+    size = 0
     for k in range(targets.shape[0]):
         start = max(target_costs[k], 1e-9)
         if start < dist[targets[k]]:
             dist[targets[k]] = start
-            heapq.heappush(heap, (start, targets[k]))
+            size = _queue(keys, cells, slot, size, targets[k], start)
     diagonal_m = cell_m * math.sqrt(2)
-    while heap:
-        d, u = heapq.heappop(heap)
-        if d > dist[u]:
-            continue
+    while size:
+        d, u = keys[0], cells[0]
+        slot[u] = _SETTLED
+        size -= 1
+        if size:
+            keys[0], cells[0] = keys[size], cells[size]
+            _sift_down(keys, cells, slot, size)
         if u == stop:
             break
         i, j = u // ny, u % ny
@@ -45,14 +55,55 @@ def cost_to_go(
             a, b = i + _STEPS[s, 0], j + _STEPS[s, 1]
             if a < 0 or a >= nx or b < 0 or b >= ny or not math.isfinite(cost[a, b]):
                 continue
+            v = a * ny + b
+            if slot[v] == _SETTLED:
+                continue
             length = cell_m
             if a != i and b != j:  # diagonal: both orthogonal neighbours free, no corner cut
                 if not (math.isfinite(cost[a, j]) and math.isfinite(cost[i, b])):
                     continue
                 length = diagonal_m
             candidate = d + length * 0.5 * (cost[i, j] + cost[a, b])
-            v = a * ny + b
             if candidate < dist[v]:
                 dist[v] = candidate
-                heapq.heappush(heap, (candidate, v))
+                size = _queue(keys, cells, slot, size, v, candidate)
     return dist.reshape(nx, ny)
+
+
+@njit(cache=True)
+def _queue(keys, cells, slot, size, cell, key):
+    """Queue `cell` with `key`, or lower its key if it is queued already; the heap's new size."""
+    at = slot[cell]
+    if at < 0:
+        at = size
+        size += 1
+    while at > 0:  # sift up
+        parent = (at - 1) >> 1
+        if keys[parent] <= key:
+            break
+        keys[at], cells[at] = keys[parent], cells[parent]
+        slot[cells[at]] = at
+        at = parent
+    keys[at], cells[at] = key, cell
+    slot[cell] = at
+    return size
+
+
+@njit(cache=True)
+def _sift_down(keys, cells, slot, size):
+    """Move the heap's first entry down to its place."""
+    key, cell = keys[0], cells[0]
+    at = 0
+    while True:
+        child = 2 * at + 1
+        if child >= size:
+            break
+        if child + 1 < size and keys[child + 1] < keys[child]:
+            child += 1
+        if key <= keys[child]:
+            break
+        keys[at], cells[at] = keys[child], cells[child]
+        slot[cells[at]] = at
+        at = child
+    keys[at], cells[at] = key, cell
+    slot[cell] = at
