@@ -1,4 +1,4 @@
-"""The travelled path as a simplified polyline, built point by point (pure numpy)."""
+"""The travelled path as a simplified polyline, built point by point (numpy, one compiled check)."""
 
 from __future__ import annotations
 
@@ -52,18 +52,12 @@ class PathSimplifier:
 
     def _beyond_tolerance(self, held: int, point: tuple[float, float]) -> bool:
         """Whether a held-back position is farther than the tolerance from the edge from the
-        last vertex to `point` (the arithmetic of `distances_to_segment`, squared)."""
+        last vertex to `point` (`kernels.beyond_tolerance`)."""
+        from vplane_mj.geometry import kernels  # numba: loaded by the first call
+
         ax, ay = self._vertices[-1]
         dx, dy = point[0] - ax, point[1] - ay
-        px, py = self._rel_x[:held], self._rel_y[:held]
-        length2 = dx * dx + dy * dy
-        if length2 > 0:
-            t = (px * dx + py * dy) / length2
-            np.minimum(np.maximum(t, 0.0, out=t), 1.0, out=t)  # np.clip to [0, 1], without its overhead
-        else:
-            t = np.zeros(held)
-        ex, ey = px - t * dx, py - t * dy
-        return bool((ex * ex + ey * ey).max() > self.tolerance_m**2)
+        return kernels.beyond_tolerance(self._rel_x, self._rel_y, held, dx, dy, self.tolerance_m**2)
 
     def polyline(self) -> list[tuple[float, float]]:
         """The vertices from the first position to the newest one."""

@@ -357,17 +357,27 @@ class DwaPlanner(Planner):
         moving = speeds > 0  # a turn on the spot sweeps nothing the disc does not already cover
         if not moving.any():
             return dist
+        from vplane_mj.planning.kernels import arcs  # numba: loaded by the first call
+
         curvature = turns / speeds[moving, None]
-        points, _ = arc_poses(
-            obs.position, obs.yaw, self.arc_lengths, curvature[..., None] * self.arc_lengths
-        )
         safe = self.radius + p.margin_m
         field = self.map.clearance_field(p.map_threshold, obs.position, self.lookahead + safe + self.step_m)
-        clearance = field.at(np.vstack((obs.position, points.reshape(-1, 2))))
-        limit = min(safe, clearance[0])  # never closer than the robot already is
-        hits = clearance[1:].reshape(points.shape[:-1]) < limit
-        hits = self._past_the_goal_free(obs, points, hits)
-        dist[moving] = np.where(hits.any(axis=-1), np.argmax(hits, axis=-1) * self.step_m, self.lookahead)
+        arriving = obs.distance_to_goal() < self.lookahead + obs.goal_tolerance  # arcs may enter the goal
+        first = arcs.first_hits(
+            float(obs.position[0]),
+            float(obs.position[1]),
+            float(obs.yaw),
+            curvature,
+            self.arc_lengths,
+            np.ascontiguousarray(field.values, float),
+            float(field.first_cell[0]),
+            float(field.first_cell[1]),
+            field.cell_m,
+            safe,
+            np.asarray(obs.goal, float),
+            float(obs.goal_tolerance) if arriving else -1.0,
+        )
+        dist[moving] = np.where(first >= 0, first * self.step_m, self.lookahead)
         return dist
 
     def _swept_free_distance(self, obs: Observation, speeds: np.ndarray, turns: np.ndarray) -> np.ndarray:

@@ -1,4 +1,5 @@
-"""`dwa`'s arcs and the clearance along them, compiled (`dwa.arc_poses`, `ClearanceField.at`)."""
+"""`dwa`'s arcs and the clearance along them, compiled (`dwa.arc_poses`, `ClearanceField.at`,
+the round robot's free distance)."""
 
 from __future__ import annotations
 
@@ -8,19 +9,43 @@ import numpy as np
 from numba import njit
 
 
+@njit(cache=True, inline="always")
+def _arc_point(x0: float, y0: float, cos_yaw: float, sin_yaw: float, travel: float, turn: float) -> tuple:
+    """The point (m) after travelling `travel` (m) along a circle while turning by `turn` (rad)
+    from (x0, y0) heading (cos_yaw, sin_yaw): the chord 2 sin(turn / 2) / curvature (the travel
+    itself when the turn is below 2e-12 rad) along yaw + turn / 2."""
+    half = turn / 2
+    sin_half, cos_half = math.sin(half), math.cos(half)
+    chord = travel * (sin_half / half if abs(half) > 1e-12 else 1.0)
+    return (
+        x0 + chord * (cos_yaw * cos_half - sin_yaw * sin_half),
+        y0 + chord * (sin_yaw * cos_half + cos_yaw * sin_half),
+    )
+
+
+@njit(cache=True, inline="always")
+def _bilinear_at(values: np.ndarray, first_i: float, first_j: float, cell_m: float, x: float, y: float):
+    """`values` at the world point (x, y) (m); see `bilinear`."""
+    rows, cols = values.shape
+    u = x / cell_m - first_i - 0.5
+    v = y / cell_m - first_j - 0.5
+    i = min(max(math.floor(u), 0), rows - 2)
+    j = min(max(math.floor(v), 0), cols - 2)
+    fx = min(max(u - i, 0.0), 1.0)
+    fy = min(max(v - j, 0.0), 1.0)
+    below = values[i, j] + (values[i + 1, j] - values[i, j]) * fx
+    above = values[i, j + 1] + (values[i + 1, j + 1] - values[i, j + 1]) * fx
+    return below + (above - below) * fy
+
+
 @njit(cache=True)
 def arc_points(x0: float, y0: float, yaw: float, travel: np.ndarray, turn: np.ndarray) -> np.ndarray:
     """Points (N, 2; m) after travelling `travel` (N,; m) along a circle while turning by `turn`
-    (N,; rad) from (x0, y0) at `yaw` (rad): the chord 2 sin(turn / 2) / curvature (the travel
-    itself when the turn is below 2e-12 rad) along yaw + turn / 2."""
+    (N,; rad) from (x0, y0) at `yaw` (rad) (`_arc_point`)."""
     cos_yaw, sin_yaw = math.cos(yaw), math.sin(yaw)
     out = np.empty((travel.shape[0], 2))
     for k in range(travel.shape[0]):
-        half = turn[k] / 2
-        sin_half, cos_half = math.sin(half), math.cos(half)
-        chord = travel[k] * (sin_half / half if abs(half) > 1e-12 else 1.0)
-        out[k, 0] = x0 + chord * (cos_yaw * cos_half - sin_yaw * sin_half)
-        out[k, 1] = y0 + chord * (sin_yaw * cos_half + cos_yaw * sin_half)
+        out[k, 0], out[k, 1] = _arc_point(x0, y0, cos_yaw, sin_yaw, travel[k], turn[k])
     return out
 
 
@@ -31,16 +56,44 @@ def bilinear(
     """`values` (rows, cols; at the centres of the cells from world cell (first_i, first_j), of
     `cell_m` m) at world points (N, 2; m), bilinear between the centres; points beyond the
     outermost centres take the border's values."""
-    rows, cols = values.shape
     out = np.empty(points.shape[0])
     for k in range(points.shape[0]):
-        u = points[k, 0] / cell_m - first_i - 0.5
-        v = points[k, 1] / cell_m - first_j - 0.5
-        i = min(max(math.floor(u), 0), rows - 2)
-        j = min(max(math.floor(v), 0), cols - 2)
-        fx = min(max(u - i, 0.0), 1.0)
-        fy = min(max(v - j, 0.0), 1.0)
-        below = values[i, j] + (values[i + 1, j] - values[i, j]) * fx
-        above = values[i, j + 1] + (values[i + 1, j + 1] - values[i, j + 1]) * fx
-        out[k] = below + (above - below) * fy
+        out[k] = _bilinear_at(values, first_i, first_j, cell_m, points[k, 0], points[k, 1])
     return out
+
+
+@njit(cache=True)
+def first_hits(
+    x0: float,
+    y0: float,
+    yaw: float,
+    curvature: np.ndarray,
+    lengths: np.ndarray,
+    values: np.ndarray,
+    first_i: float,
+    first_j: float,
+    cell_m: float,
+    safe_m: float,
+    goal: np.ndarray,
+    goal_tolerance_m: float,
+) -> np.ndarray:
+    """For each arc of `curvature` (speeds, turns; 1/m) from (x0, y0) at `yaw`, sampled at the
+    `lengths` (L,; m) along it: the index of the first sample whose clearance (`values`, as in
+    `bilinear`) is below the limit, -1 when none is. The limit is `safe_m`, or the clearance
+    at (x0, y0) when that is less (never closer than the robot already is). A sample at or
+    after one within `goal_tolerance_m` of `goal` (m; a negative tolerance: never) is no hit:
+    the arc has arrived."""
+    cos_yaw, sin_yaw = math.cos(yaw), math.sin(yaw)
+    limit = min(safe_m, _bilinear_at(values, first_i, first_j, cell_m, x0, y0))
+    rows, cols = curvature.shape
+    first = np.full((rows, cols), -1, dtype=np.int64)
+    for a in range(rows):
+        for b in range(cols):
+            for k in range(lengths.shape[0]):
+                x, y = _arc_point(x0, y0, cos_yaw, sin_yaw, lengths[k], curvature[a, b] * lengths[k])
+                if goal_tolerance_m >= 0.0 and np.hypot(x - goal[0], y - goal[1]) <= goal_tolerance_m:
+                    break
+                if _bilinear_at(values, first_i, first_j, cell_m, x, y) < limit:
+                    first[a, b] = k
+                    break
+    return first
