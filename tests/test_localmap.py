@@ -619,3 +619,14 @@ def test_the_compiled_distance_transform_equals_scipys_bit_for_bit(seed):
         free.flat[rng.integers(free.size)] = False  # at least one cell to be near
         np.testing.assert_array_equal(distance_transform(free), ndimage.distance_transform_edt(free))
     assert np.isinf(distance_transform(np.ones((3, 4), bool))).all()  # nothing to be near
+
+
+def test_mask_cells_are_numpys_nonzero():
+    from vplane_mj.planning.localmap import mask_cells
+
+    rng = np.random.default_rng(0)
+    for shape in ((1, 1), (3, 5), (64, 64), (7, 1)):
+        mask = rng.random(shape) < 0.1
+        for got, expected in zip(mask_cells(mask), np.nonzero(mask), strict=True):
+            np.testing.assert_array_equal(got, expected)
+            assert got.dtype == expected.dtype

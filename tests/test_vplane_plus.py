@@ -221,6 +221,25 @@ def test_a_search_stopped_at_the_start_gives_the_same_costs_below_it_and_the_sam
     assert gridsearch.descend(stopped, start_cell, 10_000) == gridsearch.descend(full, start_cell, 10_000)
 
 
+def test_line_of_sight_checks_linspaces_points_every_half_cell():
+    """The compiled check against its definition: np.linspace's points, each on a free cell or
+    outside the window; segments along a row, a column, and of no length among them."""
+    rng = np.random.default_rng(3)
+    for trial in range(3000):
+        cost = np.ones((30, 20))
+        cost[rng.random(cost.shape) < 0.03] = np.inf
+        window = gridsearch.Window(cost, rng.uniform(-1, 1, 2), 0.05, np.zeros(cost.shape, bool))
+        a, b = rng.uniform(-1.5, 2.0, 2), rng.uniform(-1.5, 2.0, 2)
+        if trial % 3 == 0:
+            b[0] = a[0]
+        if trial % 5 == 0:
+            b[1] = a[1]
+        steps = max(2, math.ceil(2 * float(np.hypot(*(b - a))) / 0.05) + 1)
+        i, j = np.floor((np.linspace(a, b, steps) - window.corner) / 0.05).astype(int).T
+        inside = (i >= 0) & (i < 30) & (j >= 0) & (j < 20)
+        assert window.line_of_sight(a, b) == bool(np.isfinite(cost[i[inside], j[inside]]).all())
+
+
 def test_the_way_goes_round_a_wall_through_its_gap():
     cost = np.ones((60, 60))
     cost[30, :] = np.inf

@@ -155,12 +155,13 @@ class Window:
 
     def line_of_sight(self, a: np.ndarray, b: np.ndarray) -> bool:
         """Whether the straight segment between two world points (m) stays on free cells (or
-        leaves the window), sampled every half cell."""
+        leaves the window), sampled every half cell (`kernels.grid.segment_free`)."""
+        from vplane_mj.planning.kernels import grid  # numba: loaded by the first call
+
         steps = max(2, math.ceil(2 * float(np.hypot(*(b - a))) / self.cell_m) + 1)
-        cells = np.floor((np.linspace(a, b, steps) - self.corner) / self.cell_m).astype(int)
-        i, j = cells[:, 0], cells[:, 1]
-        inside = (i >= 0) & (i < self.cost.shape[0]) & (j >= 0) & (j < self.cost.shape[1])
-        return bool(np.all(np.isfinite(self.cost[i[inside], j[inside]])))
+        corner = self.corner
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        return grid.segment_free(self.cost, float(corner[0]), float(corner[1]), self.cell_m, a, b, steps)
 
 
 def cost_to_go(

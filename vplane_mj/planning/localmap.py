@@ -202,7 +202,7 @@ class LocalMap:
         """
         occupied = self._grid >= min_certainty
         grid_labels = self._label_regions(self._dilate(occupied, _disk(link_m / 2, self.cell_m)))
-        i, j = np.nonzero(occupied)
+        i, j = mask_cells(occupied)
         if self.origin is None or len(i) == 0:
             return np.empty((0, 2)), np.empty(0, dtype=int), grid_labels
         centres = (np.column_stack((i, j)) + self.origin + 0.5) * self.cell_m
@@ -290,6 +290,12 @@ def _disk(radius_m: float, cell_m: float) -> np.ndarray:
     """A disc-shaped structuring element of `radius_m` in cells (at least one cell)."""
     reach = max(1, math.ceil(radius_m / cell_m - 1e-9))
     return np.hypot(*np.mgrid[-reach : reach + 1, -reach : reach + 1]) <= reach
+
+
+def mask_cells(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rows and columns of a 2-D mask's true cells, row-major: `np.nonzero(mask)`, through the
+    flat indices (numpy's 2-D nonzero takes some twenty times as long on the map)."""
+    return np.divmod(np.flatnonzero(mask), mask.shape[1])
 
 
 def angular_extremes(origin: np.ndarray, points: np.ndarray) -> tuple[int, int, float]:

@@ -43,7 +43,7 @@ from scipy import ndimage
 from vplane_mj.planning import fields, gridsearch, scan
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.events import Event, EventKind, point
-from vplane_mj.planning.localmap import LocalMap, angular_extremes
+from vplane_mj.planning.localmap import LocalMap, angular_extremes, mask_cells
 from vplane_mj.planning.motion import Steering
 from vplane_mj.planning.params import param, with_default
 from vplane_mj.planning.types import Decision, Observation
@@ -417,7 +417,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         labels, _ = ndimage.label(
             ndimage.binary_dilation(occupied, structure=offsets), structure=np.ones((3, 3), bool)
         )
-        i, j = np.nonzero(occupied)
+        i, j = mask_cells(occupied)
         centres = (np.column_stack((i, j)) + self.map.origin + 0.5) * self.map.cell_m
         rel = centres - position
         distance = np.hypot(rel[:, 0], rel[:, 1])
