@@ -630,3 +630,18 @@ def test_mask_cells_are_numpys_nonzero():
         for got, expected in zip(mask_cells(mask), np.nonzero(mask), strict=True):
             np.testing.assert_array_equal(got, expected)
             assert got.dtype == expected.dtype
+
+
+def test_the_whole_grids_cells_are_the_squares_with_no_bound():
+    """`cells` of the whole grid (numpy) and of an unbounded square around a point (compiled)
+    give the same centres and certainties in the same order, swept cells skipped or not."""
+    grid = mapped(WALL, (0.0, 0.0))
+    grid.sweep(np.array([1.9, 0.0]), 0.2)  # sweep some of the wall's cells
+    for skip in (False, True):
+        whole = grid.cells(4, skip_swept=skip)
+        square = grid.cells(4, near=np.zeros(2), within_m=math.inf, skip_swept=skip)
+        assert len(whole[0]) > 5
+        for got, expected in zip(whole, square, strict=True):
+            np.testing.assert_array_equal(got, expected)
+            assert got.dtype == expected.dtype
+    assert len(grid.cells(4, skip_swept=True)[0]) < len(grid.cells(4)[0])

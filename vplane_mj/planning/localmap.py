@@ -50,6 +50,8 @@ from vplane_mj.planning.beams import BeamFan
 
 _NONE = np.zeros((0, 0), dtype=bool)
 """An empty mask: no cell skipped."""
+_LAST_STAMP = int(np.iinfo(np.int32).max)
+"""The largest stamp of a cell judged (the stamps then start again from 0)."""
 
 
 class LocalMap:
@@ -109,7 +111,7 @@ class LocalMap:
         `bearings` (rad, robot frame; any order, duplicates allowed), each beam `beam` wide (rad)."""
         origin = self._follow(position)
         fan = self._fan_of(bearings, beam)
-        if self._stamp >= np.iinfo(np.int32).max:
+        if self._stamp >= _LAST_STAMP:
             self._stamps[:] = 0
             self._stamp = 0
         self._stamp += 1
@@ -176,15 +178,20 @@ class LocalMap:
         """
         if self.origin is None:
             return np.empty((0, 2)), np.empty(0, dtype=np.int64)
-        x, y = (0.0, 0.0) if near is None else (float(near[0]), float(near[1]))
+        if near is None:  # the whole grid: numpy's passes over it are the quicker
+            chosen = self._grid >= min_certainty
+            if skip_swept:
+                chosen &= ~self._swept
+            i, j = mask_cells(chosen)
+            return self._centres(i, j), self._grid[i, j].astype(np.int64)
         return self._cells_near(
             self._grid,
             self.origin,
             self.cell_m,
             min_certainty,
-            x,
-            y,
-            math.inf if near is None else float(within_m),
+            float(near[0]),
+            float(near[1]),
+            float(within_m),
             self._swept if skip_swept else _NONE,
         )
 
@@ -205,8 +212,11 @@ class LocalMap:
         i, j = mask_cells(occupied)
         if self.origin is None or len(i) == 0:
             return np.empty((0, 2)), np.empty(0, dtype=int), grid_labels
-        centres = (np.column_stack((i, j)) + self.origin + 0.5) * self.cell_m
-        return centres, grid_labels[i, j], grid_labels
+        return self._centres(i, j), grid_labels[i, j], grid_labels
+
+    def _centres(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """The centres (N, 2; m) of grid cells (i, j)."""
+        return (np.column_stack((i, j)) + self._placed_origin + 0.5) * self.cell_m
 
     def lookup(self, grid_values: np.ndarray, points: np.ndarray) -> np.ndarray:
         """The value of a grid-shaped array at world points (N, 2); 0 outside the grid."""
