@@ -223,6 +223,10 @@ def test_clusters_are_the_regions_of_the_grown_obstacle_cells(seed):
     grid = LocalMap(cell_m=0.1, size_m=6.0)
     grid.update(np.zeros(2), 0.0, BEARINGS, np.full(16, np.nan), BEAM)  # anchor the grid
     grid.grid[...] = (rng.random(grid.grid.shape) < 0.02 * (seed + 1)) * rng.integers(1, 16, grid.grid.shape)
+    if seed % 2:  # obstacles in one part of the grid only, as around a robot that has seen little
+        kept = grid.grid[12:30, 20:41].copy()
+        grid.grid[...] = 0
+        grid.grid[12:30, 20:41] = kept
     link = [0.15, 0.48, 0.9, 2.0][seed]
     occupied = grid.grid >= 4
     reach = max(1, math.ceil(link / 2 / 0.1 - 1e-9))
@@ -230,10 +234,7 @@ def test_clusters_are_the_regions_of_the_grown_obstacle_cells(seed):
     expected, _ = ndimage.label(ndimage.binary_dilation(occupied, structure=disk))
     cells, labels, label_grid = grid.clusters(4, link)
     assert len(cells) == occupied.sum() > 0
-    np.testing.assert_array_equal(label_grid == 0, expected == 0)
-    # the same regions: a one-to-one correspondence between the two labellings
-    pairs = set(zip(label_grid.ravel().tolist(), expected.ravel().tolist(), strict=True))
-    assert len(pairs) == len(set(label_grid.ravel().tolist())) == len(set(expected.ravel().tolist()))
+    np.testing.assert_array_equal(label_grid, expected)  # the same regions, numbered alike
     np.testing.assert_array_equal(labels, label_grid[occupied])
 
 

@@ -208,10 +208,19 @@ class LocalMap:
         the 4-connected regions of the obstacle cells grown by a disc of `link_m` / 2.
         """
         occupied = self._grid >= min_certainty
-        grid_labels = self._label_regions(self._dilate(occupied, _disk(link_m / 2, self.cell_m)))
+        grid_labels = np.zeros(occupied.shape, dtype=np.int32)
         i, j = mask_cells(occupied)
         if self.origin is None or len(i) == 0:
             return np.empty((0, 2)), np.empty(0, dtype=int), grid_labels
+        # Only the box of the grown cells can hold a label: labelled there alone, the regions
+        # are the same, numbered in the same (row-major) order.
+        disk = _disk(link_m / 2, self.cell_m)
+        reach = disk.shape[0] // 2
+        box = (
+            slice(max(int(i.min()) - reach, 0), int(i.max()) + reach + 1),
+            slice(max(int(j.min()) - reach, 0), int(j.max()) + reach + 1),
+        )
+        grid_labels[box] = self._label_regions(self._dilate(np.ascontiguousarray(occupied[box]), disk))
         return self._centres(i, j), grid_labels[i, j], grid_labels
 
     def _centres(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
