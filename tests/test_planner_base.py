@@ -13,7 +13,7 @@ from vplane_mj.errors import ScenarioError
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.params import ParamError
 from vplane_mj.planning.registry import PLANNERS, make_planner
-from vplane_mj.planning.vectors import unit, wrap_angle
+from vplane_mj.planning.vectors import evenly_spaced, unit, wrap_angle
 from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import load_scenario
 
@@ -85,3 +85,14 @@ def test_wrap_angle_keeps_floats_floats_and_wraps_arrays_element_by_element():
 def test_unit_has_length_one_or_is_zero():
     assert np.allclose(unit(np.array([3.0, 4.0])), [0.6, 0.8])
     assert np.all(unit(np.array([1e-15, 0.0])) == 0.0)
+
+
+def test_evenly_spaced_is_numpys_linspace_bit_for_bit():
+    rng = np.random.default_rng(0)
+    for _ in range(20000):
+        start = float(rng.uniform(-3.0, 3.0))
+        stop = float(rng.choice([rng.uniform(-3.0, 3.0), start, start + 5e-324, 0.0]))
+        count = int(rng.integers(0, 25))
+        got, expected = evenly_spaced(start, stop, count), np.linspace(start, stop, count)
+        np.testing.assert_array_equal(got, expected)
+        assert got.dtype == expected.dtype

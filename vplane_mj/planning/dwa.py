@@ -90,7 +90,7 @@ from vplane_mj.planning.groups import LocalMapParams, MinimumParams
 from vplane_mj.planning.minima import report_trap
 from vplane_mj.planning.params import param
 from vplane_mj.planning.types import Decision, Observation
-from vplane_mj.planning.vectors import wrap_angle
+from vplane_mj.planning.vectors import evenly_spaced, wrap_angle
 
 MIN_LOOKAHEAD_M = 1.0
 """The shortest look-ahead (m) when `lookahead_m` is 0 (the default robot's, at 0.5 m/s)."""
@@ -196,7 +196,7 @@ def dynamic_window(
     dv, dw = limits.max_accel_mps2 * period_s, limits.max_turn_accel_radps2 * period_s
     slow, fast = min(max(speed - dv, 0.0), top), min(max(speed + dv, 0.0), top)
     left, right = min(max(turn - dw, -top_turn), top_turn), min(max(turn + dw, -top_turn), top_turn)
-    return np.linspace(slow, fast, speed_samples), np.linspace(left, right, turn_samples)
+    return evenly_spaced(slow, fast, speed_samples), evenly_spaced(left, right, turn_samples)
 
 
 def arc_poses(

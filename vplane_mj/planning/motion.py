@@ -43,7 +43,7 @@ import numpy as np
 
 from vplane_mj.planning.body import DriveLimits, RobotBody
 from vplane_mj.planning.types import Observation
-from vplane_mj.planning.vectors import wrap_angle
+from vplane_mj.planning.vectors import evenly_spaced, wrap_angle
 
 SHAPED_STOP_M = 0.1
 """A round robot whose braking distance from its top speed is at most this (m) is not governed."""
@@ -129,7 +129,7 @@ def free_turn(body: RobotBody, local: np.ndarray, side: float, limit_rad: float,
     if not len(near):
         return limit_rad
     steps = max(1, math.ceil(limit_rad / TURN_STEP_RAD))
-    angles = math.copysign(1.0, side) * np.linspace(0.0, limit_rad, steps + 1)
+    angles = math.copysign(1.0, side) * evenly_spaced(0.0, limit_rad, steps + 1)
     distances = outline_distances(body, near, angles)
     # A point counts against the turn where the turn brings the outline closer than both the
     # margin and the point's distance now (a point already close does not freeze the robot).
