@@ -152,11 +152,11 @@ def ramped(start: float, phases: list[tuple[float, float, float]], time_s: np.nd
     turn; after the last phase it holds."""
     value = np.full(len(time_s), float(start))
     begin = 0.0
-    for target, duration, rate in phases:
+    for target, duration, rate in phases:  # (np.clip's arithmetic without its overhead)
         inside = time_s > begin
-        step = np.clip(time_s[inside] - begin, 0.0, duration) * rate
-        value[inside] = start + np.clip(target - start, -step, step)
-        start += float(np.clip(target - start, -rate * duration, rate * duration))
+        step = np.minimum(np.maximum(time_s[inside] - begin, 0.0), duration) * rate
+        value[inside] = start + np.minimum(np.maximum(target - start, -step), step)
+        start += min(max(target - start, -rate * duration), rate * duration)
         begin += duration
     return value
 
@@ -289,8 +289,9 @@ def _integrated(t: np.ndarray, v: np.ndarray, w: np.ndarray, slid: np.ndarray) -
     x = np.concatenate(([0.0], np.cumsum(ds * np.cos(mid))))
     y = np.concatenate(([0.0], np.cumsum(ds * np.sin(mid)))) + slid
     moved = np.concatenate(([0.0], np.cumsum(np.abs(ds) + np.abs(np.diff(slid)) + np.abs(np.diff(yaw)))))
-    keep = np.flatnonzero(np.diff(np.floor(moved / SWEEP_STEP_M), prepend=-1.0) > 0)
-    keep = np.union1d(keep, [len(t) - 1])
+    keep = np.flatnonzero(np.diff(np.floor(moved / SWEEP_STEP_M), prepend=-1.0) > 0)  # keep[0] == 0
+    if keep[-1] != len(t) - 1:
+        keep = np.append(keep, len(t) - 1)
     return np.column_stack((x[keep], y[keep], yaw[keep]))
 
 
