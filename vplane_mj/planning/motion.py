@@ -67,6 +67,7 @@ INTRUSION_TOLERANCE_M = 1e-4
 """A predicted motion that intrudes less than this (m) on a point's allowed distance is safe."""
 SWEEP_STEP_M = 0.02
 """A predicted motion is checked at poses about this far apart (m of travel plus rad of turn)."""
+_NO_TIMES = np.empty(0)
 
 
 def body_frame(points: np.ndarray, position: np.ndarray, yaw: float) -> np.ndarray:
@@ -144,28 +145,6 @@ def brake_speed(distance: float, accel: float, delay_s: float) -> float:
     """The largest speed (or turn rate) v from which a drive that keeps it for `delay_s` (s) and
     then brakes at `accel` stops within `distance`: v t + v^2 / 2a <= distance (any units)."""
     return accel * (math.sqrt(delay_s * delay_s + 2 * max(0.0, distance) / accel) - delay_s)
-
-
-def ramped(start: float, phases: list[tuple[float, float, float]], time_s: np.ndarray) -> np.ndarray:
-    """A ramped drive's speed (or turn rate) at each of `time_s` (s from now): from `start` it
-    moves toward each phase's target at the phase's rate (per s) for its duration (s), in
-    turn; after the last phase it holds."""
-    value = np.full(len(time_s), float(start))
-    begin = 0.0
-    for target, duration, rate in phases:  # (np.clip's arithmetic without its overhead)
-        inside = time_s > begin
-        step = np.minimum(np.maximum(time_s[inside] - begin, 0.0), duration) * rate
-        value[inside] = start + np.minimum(np.maximum(target - start, -step), step)
-        start += min(max(target - start, -rate * duration), rate * duration)
-        begin += duration
-    return value
-
-
-def faded(speed: float, rate: float, time_s: np.ndarray) -> np.ndarray:
-    """How far (m, signed as `speed`) a slide at `speed` (m/s) goes by each of `time_s` (s from
-    now) while it fades at `rate` (m/s^2): v t - a t^2 / 2 up to v / a, v^2 / 2a after."""
-    t = np.minimum(np.asarray(time_s, float), abs(speed) / rate)
-    return speed * t - math.copysign(rate, speed) * t * t / 2
 
 
 @dataclass
@@ -257,42 +236,28 @@ class DriveModel:
         omega^2 / 2 alpha); its slide across its heading fades at `braking`. Poses are kept
         where the robot has moved about SWEEP_STEP_M (m of travel plus rad of turn) since the
         last kept one; the first and last are always kept."""
+        from vplane_mj.planning.kernels import drive_model  # numba: loaded by the first call
+
         limits = self.limits
         alpha, lag = limits.max_turn_accel_radps2, limits.turn_lag_s
         brake = self.braking(command)
         # A robot faster than its ramp (a skid-steer braking in a hard turn) slows from its speed.
         start = self.speed if abs(self.speed) > abs(self.ramp[0]) else self.ramp[0]
         faster = abs(command[0]) > abs(start) and command[0] * start >= 0
-        speeds = [(command[0], hold_s, limits.max_accel_mps2 if faster else brake), (0.0, math.inf, brake)]
-        turns = [(command[1], hold_s, alpha), (0.0, math.inf, alpha)]
-        end_of_hold = np.array([hold_s])
-        v1, w1 = ramped(start, speeds, end_of_hold)[0], ramped(self.ramp[1], turns, end_of_hold)[0]
+        speeds = np.array(
+            [(command[0], hold_s, limits.max_accel_mps2 if faster else brake), (0.0, math.inf, brake)]
+        )
+        turns = np.array([(command[1], hold_s, alpha), (0.0, math.inf, alpha)])
+        v1, w1 = drive_model.ramp_at(start, speeds, hold_s), drive_model.ramp_at(self.ramp[1], turns, hold_s)
         end = lag + hold_s + max(abs(v1) / brake, abs(w1) / alpha, abs(self.slide) / brake)
         t = np.arange(0.0, end + MOTION_STEP_S, MOTION_STEP_S)
-        v = ramped(start, speeds, t)
-        w = ramped(self.ramp[1], turns, t - lag)
+        late_turns = _NO_TIMES
         if lag > 0 and self.time_s is not None:
             times, rates = np.array(self.past).T
-            late = t < lag
-            w[late] = np.interp(self.time_s + t[late] - lag, times, rates)
-        return _integrated(t, v, w, faded(self.slide, brake, t))
-
-
-def _integrated(t: np.ndarray, v: np.ndarray, w: np.ndarray, slid: np.ndarray) -> np.ndarray:
-    """The poses (K, 3) of a robot starting at the origin with speeds `v` (m/s) and turn rates
-    `w` (rad/s) at times `t` (s), slid `slid` (m) to its left of now besides, kept about
-    SWEEP_STEP_M apart (see `DriveModel.poses`)."""
-    dt = np.diff(t)
-    yaw = np.concatenate(([0.0], np.cumsum(0.5 * (w[1:] + w[:-1]) * dt)))
-    mid = 0.5 * (yaw[1:] + yaw[:-1])
-    ds = 0.5 * (v[1:] + v[:-1]) * dt
-    x = np.concatenate(([0.0], np.cumsum(ds * np.cos(mid))))
-    y = np.concatenate(([0.0], np.cumsum(ds * np.sin(mid)))) + slid
-    moved = np.concatenate(([0.0], np.cumsum(np.abs(ds) + np.abs(np.diff(slid)) + np.abs(np.diff(yaw)))))
-    keep = np.flatnonzero(np.diff(np.floor(moved / SWEEP_STEP_M), prepend=-1.0) > 0)  # keep[0] == 0
-    if keep[-1] != len(t) - 1:
-        keep = np.append(keep, len(t) - 1)
-    return np.column_stack((x[keep], y[keep], yaw[keep]))
+            late_turns = np.interp(self.time_s + t[t < lag] - lag, times, rates)
+        return drive_model.predicted_poses(
+            t, start, speeds, self.ramp[1], turns, lag, late_turns, self.slide, brake, SWEEP_STEP_M
+        )
 
 
 def intrusion(
