@@ -271,27 +271,15 @@ def intrusion(
     its distance. With `enough` (m), any value above it once one is found (`kernels.outline`)."""
     from vplane_mj.planning.kernels import outline  # numba: loaded by the first call
 
-    swept = np.concatenate(
-        (
-            [0.0],
-            np.cumsum(
-                np.hypot(*np.diff(poses[:, :2], axis=0).T) + body.radius_m * np.abs(np.diff(poses[:, 2]))
-            ),
-        )
-    )
-    margins = margin_m + PREDICTION_ERROR * swept
-    reach = np.hypot(poses[:, 0], poses[:, 1]).max() + body.radius_m + margins[-1]
-    near = local[np.hypot(local[:, 0], local[:, 1]) < reach]
-    if not len(near):
-        return 0.0
     footprint, normals = _outline(body)
     return outline.intrusion(
         footprint,
         normals,
         float(body.radius_m),
-        np.ascontiguousarray(near, float),
+        np.ascontiguousarray(local, float).reshape(-1, 2),
         np.ascontiguousarray(poses, float),
-        margins,
+        float(margin_m),
+        PREDICTION_ERROR,
         float(enough),
     )
 

@@ -52,19 +52,41 @@ def intrusion(
     radius_m: float,
     local: np.ndarray,
     poses: np.ndarray,
-    margins: np.ndarray,
+    margin_m: float,
+    growth: float,
     enough: float,
 ) -> float:
     """The largest min(margins[m], d0) - d over the points of `local` (N, 2) and `poses` (M, 3,
     as in `pose_distances`; M >= 1), d a point's distance to the footprint at pose m and d0 at
-    the first pose, and 0 at least (`motion.intrusion`). A point whose distance to pose m's
-    origin less `radius_m` (the footprint's circumscribed radius) already keeps it from raising
-    the largest so far is not measured there. Returns as soon as the largest exceeds `enough`
-    (inf: the exact largest)."""
+    the first pose, and 0 at least (`motion.intrusion`); margins[m] is `margin_m` plus `growth`
+    times the way the outline has swept up to pose m (its travel plus `radius_m`, the
+    footprint's circumscribed radius, times its turn). Only the points within reach of the
+    motion are measured, and a point whose distance to pose m's origin less `radius_m` already
+    keeps it from raising the largest so far is not measured there. Returns as soon as the
+    largest exceeds `enough` (inf: the exact largest)."""
+    steps = poses.shape[0]
+    margins = np.empty(steps)
+    margins[0] = margin_m + growth * 0.0
+    swept = 0.0
+    farthest = math.hypot(poses[0, 0], poses[0, 1])
+    for m in range(1, steps):
+        way = math.hypot(poses[m, 0] - poses[m - 1, 0], poses[m, 1] - poses[m - 1, 1]) + radius_m * abs(
+            poses[m, 2] - poses[m - 1, 2]
+        )
+        swept = way if m == 1 else swept + way  # a cumulative sum, as numpy's
+        margins[m] = margin_m + growth * swept
+        farthest = max(farthest, math.hypot(poses[m, 0], poses[m, 1]))
+    reach = farthest + radius_m + margins[steps - 1]
+    near = np.empty(local.shape[0], dtype=np.bool_)
+    for n in range(local.shape[0]):
+        near[n] = math.hypot(local[n, 0], local[n, 1]) < reach
+    local = local[near]
     count = local.shape[0]
+    if count == 0:
+        return 0.0
     first = pose_distances(footprint, normals, local, poses[:1])[0]
     worst = 0.0
-    for m in range(1, poses.shape[0]):
+    for m in range(1, steps):
         c, s = math.cos(poses[m, 2]), math.sin(poses[m, 2])
         for n in range(count):
             allowed = min(margins[m], first[n])
