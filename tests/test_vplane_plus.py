@@ -240,6 +240,28 @@ def test_line_of_sight_checks_linspaces_points_every_half_cell():
         assert window.line_of_sight(a, b) == bool(np.isfinite(cost[i[inside], j[inside]]).all())
 
 
+def test_descent_steps_to_the_first_cheapest_neighbour_until_none_is_cheaper():
+    """The compiled descent against its definition, on cost fields with ties and walls."""
+    neighbours = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1))
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        cost = np.round(rng.random((23, 31)) * 4) + 1.0  # many equal step costs
+        cost[rng.random(cost.shape) < 0.2] = np.inf
+        target = rng.choice(np.flatnonzero(np.isfinite(cost)), 1)
+        costs = gridsearch.cost_to_go(cost, target, np.zeros(1), 0.05)
+        start = tuple(int(v) for v in np.unravel_index(rng.integers(cost.size), cost.shape))
+        expected, (i, j) = [start], start
+        while np.isfinite(costs[i, j]):
+            steps = [(i + di, j + dj) for di, dj in neighbours if 0 <= i + di < 23 and 0 <= j + dj < 31]
+            best = min(steps, key=lambda cell: costs[cell])  # the first of the cheapest
+            if not costs[best] < costs[i, j]:
+                break
+            expected.append(best)
+            i, j = best
+        assert gridsearch.descend(costs, start, 10_000) == expected
+        assert gridsearch.descend(costs, start, 2) == expected[:3]
+
+
 def test_the_way_goes_round_a_wall_through_its_gap():
     cost = np.ones((60, 60))
     cost[30, :] = np.inf

@@ -506,7 +506,7 @@ class DwaPlanner(Planner):
         cells = gridsearch.way_to(window, obs.position, obs.goal, passage)
         if cells is None:
             return obs.goal
-        way = np.array([window.centre(c) for c in cells[1:]]).reshape(-1, 2)
+        way = window.centres_of(cells[1:])
         travelled = np.cumsum(np.hypot(*np.diff(np.vstack((obs.position, way)), axis=0).T))
         limits = self.limits
         ahead = np.flatnonzero(travelled >= look_ahead_m(self.command[0], limits.max_accel_mps2))

@@ -24,7 +24,6 @@ import numpy as np
 
 INFLATED_STEP_COST = 10.0
 """Step cost of blocked cells made passable (under the robot's own disc, at the goal)."""
-_NEIGHBOURS = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1))
 
 
 def step_costs(
@@ -97,6 +96,10 @@ class Window:
     def centre(self, cell: tuple[int, int]) -> np.ndarray:
         """The world point (m) at a cell's centre."""
         return self.corner + (np.asarray(cell, float) + 0.5) * self.cell_m
+
+    def centres_of(self, cells: list[tuple[int, int]]) -> np.ndarray:
+        """The world points (N, 2; m) at the centres of `cells`."""
+        return self.corner + (np.asarray(cells, float).reshape(-1, 2) + 0.5) * self.cell_m
 
     def centres(self) -> np.ndarray:
         """Every cell's centre (m), shaped like `cost` plus a last axis of 2."""
@@ -223,20 +226,9 @@ def way_to(
 
 def descend(costs: np.ndarray, start: tuple[int, int], max_cells: int) -> list[tuple[int, int]]:
     """The cells from `start` down the cost to the target (steepest descent over 8 neighbours),
-    at most `max_cells` steps; just `start` when it has no finite cost."""
-    nx, ny = costs.shape
-    path = [start]
-    i, j = start
-    if not np.isfinite(costs[i, j]):
-        return path
-    for _ in range(max_cells):
-        best, best_cost = None, costs[i, j]
-        for di, dj in _NEIGHBOURS:
-            a, b = i + di, j + dj
-            if 0 <= a < nx and 0 <= b < ny and costs[a, b] < best_cost:
-                best, best_cost = (a, b), costs[a, b]
-        if best is None:
-            break
-        i, j = best
-        path.append(best)
-    return path
+    at most `max_cells` steps; just `start` when it has no finite cost (`kernels.grid_dijkstra`)."""
+    from vplane_mj.planning.kernels import grid_dijkstra  # numba: loaded by the first call
+
+    costs = np.ascontiguousarray(costs, float)
+    cells = grid_dijkstra.descend(costs, int(start[0]), int(start[1]), int(max_cells))
+    return [(int(i), int(j)) for i, j in cells.tolist()]

@@ -623,7 +623,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         cells = gridsearch.way_to(window, start, end, self.radius)
         if cells is None:
             return None
-        way = [window.centre(c) for c in cells[1:]]
+        way = list(window.centres_of(cells[1:]))
         if window.cell_of(end) is not None:
             way.append(np.asarray(end, float))
         self.sight = window

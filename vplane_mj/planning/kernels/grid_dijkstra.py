@@ -107,3 +107,29 @@ def _sift_down(keys, cells, slot, size):
         at = child
     keys[at], cells[at] = key, cell
     slot[cell] = at
+
+
+@njit(cache=True)
+def descend(costs: np.ndarray, i: int, j: int, max_cells: int) -> np.ndarray:
+    """The cells (K, 2) from (i, j) down `costs` to the target: from each cell to its cheapest
+    neighbour (the first of the 8 in `_STEPS`' order among equals) while that one is cheaper,
+    at most `max_cells` steps; just (i, j) when its cost is not finite."""
+    nx, ny = costs.shape
+    path = np.empty((min(max_cells, nx * ny) + 1, 2), dtype=np.int64)
+    path[0, 0], path[0, 1] = i, j
+    count = 1
+    if not math.isfinite(costs[i, j]):
+        return path[:1]
+    for _ in range(max_cells):
+        best_cost = costs[i, j]
+        best = -1
+        for s in range(8):
+            a, b = i + _STEPS[s, 0], j + _STEPS[s, 1]
+            if 0 <= a < nx and 0 <= b < ny and costs[a, b] < best_cost:
+                best, best_cost = s, costs[a, b]
+        if best < 0:
+            break
+        i, j = i + _STEPS[best, 0], j + _STEPS[best, 1]
+        path[count, 0], path[count, 1] = i, j
+        count += 1
+    return path[:count]
