@@ -11,8 +11,6 @@ there. A scan of at most `DENSE_BEAMS` beams (every sonar ring) is used as it is
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from vplane_mj.planning.types import Observation
@@ -43,16 +41,13 @@ def repulsion_points(obs: Observation) -> np.ndarray:
 
 def _nearest_per_sector(obs: Observation) -> np.ndarray:
     """The nearest echo of each sector k (bearings within half a sector of k 2 pi / RING_SECTORS,
-    robot frame), in world coordinates; sectors without an echo give none."""
-    hit = np.flatnonzero(np.isfinite(obs.ranges))
-    if not len(hit):
-        return np.empty((0, 2))
-    width = 2 * math.pi / RING_SECTORS
-    sector = np.floor(obs.bearings[hit] / width + 0.5).astype(int) % RING_SECTORS
-    order = np.lexsort((obs.ranges[hit], sector))
-    first = np.ones(len(order), dtype=bool)
-    first[1:] = sector[order[1:]] != sector[order[:-1]]
-    nearest = hit[order[first]]
-    angles = obs.yaw + obs.bearings[nearest]
-    r = obs.ranges[nearest]
-    return obs.position + np.column_stack((r * np.cos(angles), r * np.sin(angles)))
+    robot frame), in world coordinates; sectors without an echo give none (`kernels.points`)."""
+    from vplane_mj.planning.kernels import points  # numba: loaded by the first call
+
+    return points.nearest_per_sector(
+        np.asarray(obs.position, float),
+        float(obs.yaw),
+        np.asarray(obs.bearings, float),
+        np.asarray(obs.ranges, float),
+        RING_SECTORS,
+    )
