@@ -262,6 +262,26 @@ def test_descent_steps_to_the_first_cheapest_neighbour_until_none_is_cheaper():
         assert gridsearch.descend(costs, start, 2) == expected[:3]
 
 
+def test_a_way_exists_exactly_when_the_search_finds_one():
+    """The flood fill against the search, ends inside the window and beyond it, walls that cut
+    the window in two and diagonal gaps no way may slip through."""
+    rng = np.random.default_rng(11)
+    found = {True: 0, False: 0}
+    for trial in range(300):
+        cost = 1.0 + rng.random((30, 40))
+        cost[rng.random(cost.shape) < rng.uniform(0.1, 0.5)] = np.inf
+        if trial % 3 == 0:
+            cost[:, 20] = np.inf  # a wall across the window
+            cost[rng.integers(30), 20] = 1.0 if trial % 2 else np.inf
+        start, end = rng.uniform(0.0, 1.5, 2), rng.uniform(-0.5, 2.5, 2)
+        unseen = np.zeros(cost.shape, bool)
+        windows = [gridsearch.Window(cost.copy(), np.zeros(2), 0.05, unseen) for _ in range(2)]
+        exists = gridsearch.way_exists(windows[0], start, end, 0.1)
+        assert exists == (gridsearch.way_to(windows[1], start, end, 0.1) is not None)
+        found[exists] += 1
+    assert min(found.values()) > 30  # both answers, many times
+
+
 def test_the_way_goes_round_a_wall_through_its_gap():
     cost = np.ones((60, 60))
     cost[30, :] = np.inf

@@ -204,6 +204,37 @@ def way_to(
     else to the window's edge, each edge cell starting at its straight distance to the end.
     The start is the free cell nearest it within 2 `radius_m`; None when there is none, or no
     way from it."""
+    ends = _ends(window, start, end, radius_m)
+    if ends is None:
+        return None
+    targets, target_costs, start_cell = ends
+    costs = cost_to_go(window.cost, targets, target_costs, window.cell_m, stop=start_cell)
+    if not np.isfinite(costs[start_cell]):
+        return None
+    return descend(costs, start_cell, costs.size)
+
+
+def way_exists(window: Window, start: np.ndarray, end: np.ndarray, radius_m: float) -> bool:
+    """Whether `way_to` finds a way (the window made passable around the end as it does): the
+    start's cell joined to a target by the same moves, found by a flood fill instead of the
+    search for the cheapest."""
+    from vplane_mj.planning.kernels import grid_dijkstra  # numba: loaded by the first call
+
+    ends = _ends(window, start, end, radius_m)
+    if ends is None:
+        return False
+    targets, _, start_cell = ends
+    targets = targets[np.isfinite(window.cost).ravel()[targets]]
+    start_index = int(np.ravel_multi_index(start_cell, window.cost.shape))
+    return bool(grid_dijkstra.reaches(np.ascontiguousarray(window.cost, float), targets, start_index))
+
+
+def _ends(
+    window: Window, start: np.ndarray, end: np.ndarray, radius_m: float
+) -> tuple[np.ndarray, np.ndarray, tuple[int, int]] | None:
+    """What a way from `start` toward `end` (m) joins (see `way_to`): the target cells (flat
+    indices) and their starting costs (m), and the start's cell; None without a start cell.
+    The window is made passable within `radius_m` of the end when it holds the end."""
     shape = window.cost.shape
     end_cell = window.cell_of(end)
     if end_cell is not None:
@@ -218,10 +249,7 @@ def way_to(
     start_cell = window.free_cell_near(start, 2 * radius_m)
     if start_cell is None:
         return None
-    costs = cost_to_go(window.cost, targets, target_costs, window.cell_m, stop=start_cell)
-    if not np.isfinite(costs[start_cell]):
-        return None
-    return descend(costs, start_cell, shape[0] * shape[1])
+    return targets, target_costs, start_cell
 
 
 def descend(costs: np.ndarray, start: tuple[int, int], max_cells: int) -> list[tuple[int, int]]:

@@ -353,7 +353,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         plane: VirtualPlane | None = None
         if self._spans_a_gap(mouth, others):
             decision.events.append(plane_refused(e1, e2, "would span a gap between obstacles"))
-        elif self._find_way(obs.position, obs.goal, [*self.planes, mouth]):
+        elif self._way_exists(obs.position, obs.goal, [*self.planes, mouth]):
             decision.events.append(
                 plane_refused(e1, e2, "would close no trap (the map shows another way out)")
             )
@@ -382,7 +382,7 @@ class VPlanePlusPlanner(VPlanePlanner):
                 Event(EventKind.ESCAPE_FINISHED, "objective reached: target re-activated (no virtual plane)")
             )
             return
-        if self._find_way(obs.position, obs.goal, [*self.planes, plane]) is None:
+        if not self._way_exists(obs.position, obs.goal, [*self.planes, plane]):
             decision.events.append(
                 Event(
                     EventKind.ESCAPE_FINISHED,
@@ -568,6 +568,17 @@ class VPlanePlusPlanner(VPlanePlanner):
             if way is not None:
                 return way
         return None
+
+    def _way_exists(self, robot: np.ndarray, goal: np.ndarray, planes: list[VirtualPlane]) -> bool:
+        """Whether `_find_way` finds a way (searched the same way round), without the way itself:
+        a flood fill decides instead of the search for the cheapest. Like `_way`, a window
+        that holds a way becomes the one the robot's sight is checked on."""
+        for margin in (self.params.search_margin_m, None):
+            window = self._window(robot, goal, planes, margin)
+            if gridsearch.way_exists(window, robot, goal, self.radius):
+                self.sight = window
+                return True
+        return False
 
     # -- the map -----------------------------------------------------------------------------
     def _window(

@@ -1,4 +1,6 @@
-"""Dijkstra over an 8-connected grid of step costs, compiled (`gridsearch.cost_to_go`).
+"""Dijkstra over an 8-connected grid of step costs, the descent along its costs and whether a
+cell is joined to the targets at all, compiled (`gridsearch.cost_to_go`, `descend`,
+`way_exists`).
 
 The queue is a binary heap of cells, each cell in it at most once (its key lowered in place
 when a cheaper way reaches it), so the heap stays as small as the search's frontier.
@@ -133,3 +135,38 @@ def descend(costs: np.ndarray, i: int, j: int, max_cells: int) -> np.ndarray:
         path[count, 0], path[count, 1] = i, j
         count += 1
     return path[:count]
+
+
+@njit(cache=True)
+def reaches(cost: np.ndarray, targets: np.ndarray, start: int) -> bool:
+    """Whether the cell `start` (a flat index of a free cell of `cost`, nx x ny, inf blocked) is
+    joined to one of the free `targets` (flat indices) by `cost_to_go`'s moves: its cost there
+    is finite. Moves are the same both ways, so a flood fill from the start decides."""
+    nx, ny = cost.shape
+    wanted = np.zeros(nx * ny, dtype=np.bool_)
+    for k in range(targets.shape[0]):
+        wanted[targets[k]] = True
+    seen = np.zeros(nx * ny, dtype=np.bool_)
+    stack = np.empty(nx * ny, dtype=np.int64)
+    stack[0] = start
+    seen[start] = True
+    top = 1
+    while top:
+        top -= 1
+        u = stack[top]
+        if wanted[u]:
+            return True
+        i, j = u // ny, u % ny
+        for s in range(8):
+            a, b = i + _STEPS[s, 0], j + _STEPS[s, 1]
+            if a < 0 or a >= nx or b < 0 or b >= ny or not math.isfinite(cost[a, b]):
+                continue
+            v = a * ny + b
+            if seen[v]:
+                continue
+            if a != i and b != j and not (math.isfinite(cost[a, j]) and math.isfinite(cost[i, b])):
+                continue  # a diagonal only between two free orthogonal neighbours
+            seen[v] = True
+            stack[top] = v
+            top += 1
+    return False
