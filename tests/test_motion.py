@@ -235,6 +235,27 @@ def test_a_dense_scan_repels_through_its_nearest_echo_per_ring_sector():
     assert scan.repulsion_points(sonar) is sonar.echo_points()
 
 
+def test_the_nearest_echo_of_each_sector_is_the_first_of_the_nearest():
+    """Against its definition, with ties, missing echoes and bearings all round."""
+    rng = np.random.default_rng(2)
+    width = 2 * math.pi / scan.RING_SECTORS
+    for _ in range(50):
+        bearings = np.sort(rng.uniform(-math.pi, math.pi, 400))
+        ranges = np.round(rng.uniform(0.2, 3.0, 400), 1)  # many equal ranges
+        ranges[rng.random(400) < 0.3] = np.nan
+        position, yaw = rng.uniform(-1.0, 1.0, 2), float(rng.uniform(-3.0, 3.0))
+        obs = Observation(0.0, position, yaw, np.zeros(2), 0.2, bearings, ranges, 0.01)
+        sectors = [math.floor(b / width + 0.5) % scan.RING_SECTORS for b in bearings]
+        expected = []
+        for sector in range(scan.RING_SECTORS):
+            echoes = [k for k in range(400) if sectors[k] == sector and np.isfinite(ranges[k])]
+            if echoes:
+                k = min(echoes, key=lambda k: ranges[k])  # the first of the nearest
+                angle = yaw + bearings[k]
+                expected.append(position + ranges[k] * np.array([math.cos(angle), math.sin(angle)]))
+        np.testing.assert_array_equal(scan.repulsion_points(obs), np.array(expected).reshape(-1, 2))
+
+
 def test_gaps_are_sized_by_the_robots_width_and_the_default_robot_keeps_its_radius():
     narrow = RobotBody.polygon([[0.4, 0.1], [-0.4, 0.1], [-0.4, -0.1], [0.4, -0.1]])
     assert narrow.half_width_m == pytest.approx(0.1) and narrow.radius_m > 0.4
