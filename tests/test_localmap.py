@@ -646,3 +646,20 @@ def test_the_whole_grids_cells_are_the_squares_with_no_bound():
             np.testing.assert_array_equal(got, expected)
             assert got.dtype == expected.dtype
     assert len(grid.cells(4, skip_swept=True)[0]) < len(grid.cells(4)[0])
+
+
+def test_the_nearest_cell_is_the_first_nearest_of_the_cells_near_a_point():
+    rng = np.random.default_rng(4)
+    grid = LocalMap(cell_m=0.1, size_m=6.0)
+    grid.update(np.zeros(2), 0.0, BEARINGS, np.full(16, np.nan), BEAM)  # anchor the grid
+    grid.grid[...] = (rng.random(grid.grid.shape) < 0.03) * rng.integers(1, 16, grid.grid.shape)
+    grid.sweep(np.array([0.5, 0.0]), 0.4)
+    for _ in range(200):
+        point = np.round(rng.uniform(-3.5, 3.5, 2), 2)  # on cell edges and centres too: ties
+        within, skip = float(rng.uniform(0.05, 1.0)), bool(rng.integers(2))
+        cells, _ = grid.cells(4, near=point, within_m=within, skip_swept=skip)
+        nearest = grid.nearest_cell(4, point, within, skip_swept=skip)
+        if not len(cells):
+            assert nearest is None
+        else:
+            np.testing.assert_array_equal(nearest, cells[np.argmin(np.hypot(*(cells - point).T))])

@@ -71,7 +71,8 @@ class LocalMap:
         from vplane_mj.planning.kernels import grid, map_update  # numba: loaded by the first map a run makes
 
         self._fold_scan = map_update.fold_scan
-        self._cells_near, self._mark_disc = grid.cells_near, grid.mark_disc
+        self._cells_near, self._nearest_cell = grid.cells_near, grid.nearest_cell
+        self._mark_disc = grid.mark_disc
         self._dilate, self._label_regions = grid.dilate, grid.label_regions
         self.cell_m = cell_m
         self.n = max(8, math.ceil(size_m / cell_m))
@@ -194,6 +195,25 @@ class LocalMap:
             float(within_m),
             self._swept if skip_swept else _NONE,
         )
+
+    def nearest_cell(
+        self, min_certainty: int, near: np.ndarray, within_m: float, skip_swept: bool = False
+    ) -> np.ndarray | None:
+        """The centre (m) of the cell of `cells(min_certainty, near, within_m, skip_swept)`
+        nearest `near` (the first of equally near ones), None when there is none."""
+        if self.origin is None:
+            return None
+        centre = self._nearest_cell(
+            self._grid,
+            self.origin,
+            self.cell_m,
+            min_certainty,
+            float(near[0]),
+            float(near[1]),
+            float(within_m),
+            self._swept if skip_swept else _NONE,
+        )
+        return centre if len(centre) else None
 
     def any_cells(self, min_certainty: int = 1) -> bool:
         """Whether any cell is at or above a certainty."""

@@ -321,10 +321,9 @@ class VPlanePlusPlanner(VPlanePlanner):
         """FIRAS repulsion (eq. 5) of the nearest mapped obstacle cell within `guard_m`: the map
         remembers corners that fall between the sonar's rays at close range."""
         p = self.params
-        cells = self._mapped_cells_near(position, p.guard_m)
-        if not len(cells):
+        nearest = self.map.nearest_cell(p.map_threshold, position, p.guard_m, skip_swept=True)
+        if nearest is None:
             return np.zeros(2)
-        nearest = cells[np.argmin(np.hypot(*(cells - position).T))]
         return fields.repulsive_force(position, nearest[None], p.repulse_gain, p.guard_m)
 
     # -- Algorithm 2 with the map ------------------------------------------------------------

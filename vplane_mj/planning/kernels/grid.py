@@ -164,3 +164,33 @@ def segment_free(
         if 0 <= i < rows and 0 <= j < cols and not math.isfinite(cost[i, j]):
             return False
     return True
+
+
+@njit(cache=True)
+def nearest_cell(
+    grid: np.ndarray,
+    first_cell: np.ndarray,
+    cell_m: float,
+    min_certainty: int,
+    x: float,
+    y: float,
+    within_m: float,
+    skip: np.ndarray,
+) -> np.ndarray:
+    """The centre (2,; m) of the cell of `cells_near` (the same cells) nearest (x, y) (m), the
+    first in row-major order of equally near ones; empty (0,) when there is none."""
+    lo_i, lo_j, hi_i, hi_j = square(first_cell, grid.shape[0], cell_m, x, y, within_m)
+    skipping = skip.size > 0
+    best = math.inf
+    out = np.empty(2)
+    found = False
+    for i in range(lo_i, hi_i):
+        cx = ((i + first_cell[0]) + 0.5) * cell_m
+        for j in range(lo_j, hi_j):
+            if grid[i, j] >= min_certainty and not (skipping and skip[i, j]):
+                cy = ((j + first_cell[1]) + 0.5) * cell_m
+                distance = np.hypot(cx - x, cy - y)
+                if distance < best:
+                    best, found = distance, True
+                    out[0], out[1] = cx, cy
+    return out if found else out[:0]
