@@ -342,7 +342,7 @@ class VPlanePlanner(Planner):
     def _concave_edge_waypoint(self, obs: Observation) -> np.ndarray | None:
         """A point just past the nearer edge of a concave obstacle ahead, or None."""
         p = self.params
-        cells, _ = self.map.cells(p.map_threshold)
+        cells, labels, _ = self.map.clusters(p.map_threshold, self._link_m())
         heading = unit(obs.goal - obs.position)
         rel = cells - obs.position
         forward = rel @ heading
@@ -352,7 +352,6 @@ class VPlanePlanner(Planner):
         if not ahead.any():
             return None
         nearest = np.flatnonzero(ahead)[np.argmin(forward[ahead])]
-        _, labels, _ = self.map.clusters(p.map_threshold, self._link_m())  # the same cells, in order
         cluster = cells[labels == labels[nearest]]
         i1, i2, span = angular_extremes(obs.position, cluster)
         if span >= math.pi:  # it surrounds the robot: that is a trap, not an obstacle ahead
