@@ -517,14 +517,21 @@ class DwaPlanner(Planner):
     ) -> np.ndarray:
         """alpha heading + beta dist + gamma velocity (speeds, turns), each term in [0, 1]; the
         heading toward `aim` (m)."""
+        from vplane_mj.planning.kernels import arcs  # numba: loaded by the first call
+
         p, limits = self.params, self.limits
-        travel = (speeds * self.period + speeds**2 / (2 * limits.max_accel_mps2))[:, None]
-        turned = (turns * self.period + turns * np.abs(turns) / (2 * limits.max_turn_accel_radps2))[None, :]
-        points, headings = arc_poses(obs.position, obs.yaw, travel, turned)
-        to_aim = aim - points
-        theta = wrap_angle(np.arctan2(to_aim[..., 1], to_aim[..., 0]) - headings)
-        return (
-            p.heading_weight * (1 - np.abs(theta) / math.pi)
-            + p.clearance_weight * dist / self.lookahead
-            + p.velocity_weight * (speeds / limits.max_speed_mps)[:, None]
+        travel = speeds * self.period + speeds**2 / (2 * limits.max_accel_mps2)
+        turned = turns * self.period + turns * np.abs(turns) / (2 * limits.max_turn_accel_radps2)
+        return arcs.objective(
+            float(obs.position[0]),
+            float(obs.position[1]),
+            float(obs.yaw),
+            travel,
+            turned,
+            np.asarray(aim, float),
+            np.ascontiguousarray(dist, float),
+            np.asarray(speeds, float),
+            np.array([p.heading_weight, p.clearance_weight, p.velocity_weight], float),
+            float(self.lookahead),
+            float(limits.max_speed_mps),
         )

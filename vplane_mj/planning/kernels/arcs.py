@@ -97,3 +97,37 @@ def first_hits(
                     first[a, b] = k
                     break
     return first
+
+
+@njit(cache=True)
+def objective(
+    x0: float,
+    y0: float,
+    yaw: float,
+    travel: np.ndarray,
+    turned: np.ndarray,
+    aim: np.ndarray,
+    dist: np.ndarray,
+    speeds: np.ndarray,
+    weights: np.ndarray,
+    lookahead_m: float,
+    top_speed: float,
+) -> np.ndarray:
+    """dwa's objective (speeds, turns): alpha heading + beta dist / L + gamma speed / top, each
+    term in [0, 1] (`weights` alpha, beta, gamma), the heading term 1 - |theta| / pi with theta
+    the angle (wrapped into [-pi, pi)) from the robot's heading after travelling `travel[s]`
+    (m) while turning by `turned[t]` (rad) from (x0, y0) at `yaw` (`_arc_point`) to `aim` (m)."""
+    cos_yaw, sin_yaw = math.cos(yaw), math.sin(yaw)
+    rows, cols = travel.shape[0], turned.shape[0]
+    out = np.empty((rows, cols))
+    for s in range(rows):
+        speed_term = weights[2] * (speeds[s] / top_speed)
+        for t in range(cols):
+            x, y = _arc_point(x0, y0, cos_yaw, sin_yaw, travel[s], turned[t])
+            theta = (np.arctan2(aim[1] - y, aim[0] - x) - (yaw + turned[t]) + math.pi) % (
+                2 * math.pi
+            ) - math.pi
+            out[s, t] = (
+                weights[0] * (1 - abs(theta) / math.pi) + weights[1] * dist[s, t] / lookahead_m + speed_term
+            )
+    return out
