@@ -256,6 +256,33 @@ def test_the_nearest_echo_of_each_sector_is_the_first_of_the_nearest():
         np.testing.assert_array_equal(scan.repulsion_points(obs), np.array(expected).reshape(-1, 2))
 
 
+def test_the_governor_remembers_what_its_laser_no_longer_sees_once_a_square():
+    """Points out of a 270-degree laser's view stay while within reach, one per memory square
+    (the first); points in view that the scan no longer gives are forgotten."""
+    governor = motion.Governor(JACKAL, 0.1, 0.03)
+    bearings = np.linspace(-3 * math.pi / 4, 3 * math.pi / 4, 720)
+
+    def seen_from(position, yaw):
+        ranges = np.full(720, np.nan)
+        return Observation(0.0, np.array(position), yaw, np.array([5.0, 0.0]), 0.2, bearings, ranges, 0.01)
+
+    behind, ahead, far_behind = [-0.6, 0.0], [0.6, 0.0], [-0.6 - 2 * governor.reach_m, 0.0]
+    twin = [-0.6 + motion.MEMORY_CELL_M / 4, 0.0]  # the same memory square as `behind`
+    first = np.array([behind, twin, ahead, far_behind])
+    known = governor._with_unseen(first, seen_from([0.0, 0.0], 0.0))
+    np.testing.assert_array_equal(known, first)  # nothing remembered yet
+    np.testing.assert_array_equal(governor.remembered, first[[0, 2, 3]])  # one a square
+    known = governor._with_unseen(np.empty((0, 2)), seen_from([0.0, 0.0], 0.0))
+    np.testing.assert_array_equal(known, [behind])  # out of view and in reach; `ahead` is in view
+    known = governor._with_unseen(np.empty((0, 2)), seen_from([0.0, 0.0], math.pi))  # turned round
+    assert len(known) == 0  # `behind` is in view now, and the scan shows nothing there
+    all_round = Observation(
+        0.0, np.zeros(2), 0.0, np.ones(2), 0.2, np.arange(16) * math.pi / 8, np.full(16, np.nan), 0.4
+    )
+    governor.remembered = np.array([behind])
+    assert len(governor._with_unseen(np.empty((0, 2)), all_round)) == 0  # a ring sees all round
+
+
 def test_gaps_are_sized_by_the_robots_width_and_the_default_robot_keeps_its_radius():
     narrow = RobotBody.polygon([[0.4, 0.1], [-0.4, 0.1], [-0.4, -0.1], [0.4, -0.1]])
     assert narrow.half_width_m == pytest.approx(0.1) and narrow.radius_m > 0.4
