@@ -334,15 +334,17 @@ class SpeedPolicy:
         return force * (cap / length) if length > cap else force
 
 
-def _field_of_view(obs: Observation) -> np.ndarray:
-    """(low, span) (rad, robot frame) of the scan of `obs`: from the least of its beams' bearings,
-    widened by half a beam, counter-clockwise over their span, widened by half a beam each
-    way; a span of 2 pi or more for a scan all round, a negative one for no beams."""
+def _in_view(obs: Observation, bearings: np.ndarray) -> np.ndarray:
+    """Whether each of `bearings` (rad, robot frame) lies in the field of view of the scan of
+    `obs`: within the span of its beams' bearings, widened by half a beam each way."""
     if not len(obs.bearings):
-        return np.array([0.0, -1.0])
+        return np.zeros(len(bearings), dtype=bool)
     half = obs.beam_width / 2
     low, high = float(np.min(obs.bearings)) - half, float(np.max(obs.bearings)) + half
-    return np.array([low, high - low])
+    if high - low >= 2 * math.pi:
+        return np.ones(len(bearings), dtype=bool)
+    offset = np.mod(np.asarray(bearings) - low, 2 * math.pi)
+    return offset <= high - low
 
 
 @dataclass(frozen=True)
@@ -440,18 +442,14 @@ class Governor:
         does not look at now: outside its field of view (the span of its bearings, a half beam
         wider each way; none for a sensor that looks all round), as behind a 270-degree laser.
         Remembers `points` and those, one per MEMORY_CELL_M square, for the next ticks."""
-        from vplane_mj.planning.kernels import points as compiled  # numba: loaded by the first call
-
-        known, kept = compiled.remembered_with_unseen(
-            np.ascontiguousarray(points, float).reshape(-1, 2),
-            self.remembered,
-            np.asarray(obs.position, float),
-            float(obs.yaw),
-            float(self.reach_m),
-            _field_of_view(obs),
-            MEMORY_CELL_M,
-        )
-        self.remembered = known[kept]
+        points = np.asarray(points, float).reshape(-1, 2)
+        rel = self.remembered - obs.position
+        near = np.hypot(rel[:, 0], rel[:, 1]) < self.reach_m
+        unseen = near & ~_in_view(obs, np.arctan2(rel[:, 1], rel[:, 0]) - obs.yaw)
+        known = np.vstack((points, self.remembered[unseen]))
+        cells = np.floor(known / MEMORY_CELL_M).astype(np.int64)
+        _, first = np.unique(cells[:, 0] * (1 << 32) + cells[:, 1], return_index=True)  # one key a cell
+        self.remembered = known[np.sort(first)]
         return known
 
     def _command(
