@@ -184,7 +184,7 @@ class LocalMap:
             if skip_swept:
                 chosen &= ~self._swept
             i, j = mask_cells(chosen)
-            return self._centres(i, j), self._grid[i, j].astype(np.int64)
+            return self.centres_of(i, j), self._grid[i, j].astype(np.int64)
         return self._cells_near(
             self._grid,
             self.origin,
@@ -241,9 +241,9 @@ class LocalMap:
             slice(max(int(j.min()) - reach, 0), int(j.max()) + reach + 1),
         )
         grid_labels[box] = self._label_regions(self._dilate(np.ascontiguousarray(occupied[box]), disk))
-        return self._centres(i, j), grid_labels[i, j], grid_labels
+        return self.centres_of(i, j), grid_labels[i, j], grid_labels
 
-    def _centres(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    def centres_of(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
         """The centres (N, 2; m) of grid cells (i, j)."""
         return (np.column_stack((i, j)) + self._placed_origin + 0.5) * self.cell_m
 

@@ -67,7 +67,8 @@ INTRUSION_TOLERANCE_M = 1e-4
 """A predicted motion that intrudes less than this (m) on a point's allowed distance is safe."""
 SWEEP_STEP_M = 0.02
 """A predicted motion is checked at poses about this far apart (m of travel plus rad of turn)."""
-_NO_TIMES = np.empty(0)
+_NO_LATE_TURNS = np.empty(0)
+"""No turn rates to take from the past (a drive without a lag, or before its first tick)."""
 
 
 def body_frame(points: np.ndarray, position: np.ndarray, yaw: float) -> np.ndarray:
@@ -251,7 +252,7 @@ class DriveModel:
         v1, w1 = drive_model.ramp_at(start, speeds, hold_s), drive_model.ramp_at(self.ramp[1], turns, hold_s)
         end = lag + hold_s + max(abs(v1) / brake, abs(w1) / alpha, abs(self.slide) / brake)
         t = np.arange(0.0, end + MOTION_STEP_S, MOTION_STEP_S)
-        late_turns = _NO_TIMES
+        late_turns = _NO_LATE_TURNS
         if lag > 0 and self.time_s is not None:
             times, rates = np.array(self.past).T
             late_turns = np.interp(self.time_s + t[t < lag] - lag, times, rates)

@@ -417,7 +417,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             ndimage.binary_dilation(occupied, structure=offsets), structure=np.ones((3, 3), bool)
         )
         i, j = mask_cells(occupied)
-        centres = (np.column_stack((i, j)) + self.map.origin + 0.5) * self.map.cell_m
+        centres = self.map.centres_of(i, j)
         rel = centres - position
         distance = np.hypot(rel[:, 0], rel[:, 1])
         near = distance <= TRAP_REACH_M
