@@ -185,16 +185,7 @@ class LocalMap:
                 chosen &= ~self._swept
             i, j = mask_cells(chosen)
             return self.centres_of(i, j), self._grid[i, j].astype(np.int64)
-        return self._cells_near(
-            self._grid,
-            self.origin,
-            self.cell_m,
-            min_certainty,
-            float(near[0]),
-            float(near[1]),
-            float(within_m),
-            self._swept if skip_swept else _NONE,
-        )
+        return self._cells_near(*self._square(min_certainty, near, within_m, skip_swept))
 
     def nearest_cell(
         self, min_certainty: int, near: np.ndarray, within_m: float, skip_swept: bool = False
@@ -203,17 +194,14 @@ class LocalMap:
         nearest `near` (the first of equally near ones), None when there is none."""
         if self.origin is None:
             return None
-        centre = self._nearest_cell(
-            self._grid,
-            self.origin,
-            self.cell_m,
-            min_certainty,
-            float(near[0]),
-            float(near[1]),
-            float(within_m),
-            self._swept if skip_swept else _NONE,
-        )
+        centre = self._nearest_cell(*self._square(min_certainty, near, within_m, skip_swept))
         return centre if len(centre) else None
+
+    def _square(self, min_certainty: int, near: np.ndarray, within_m: float, skip_swept: bool) -> tuple:
+        """The arguments of the compiled reads of the cells around `near` (`kernels.grid`)."""
+        swept = self._swept if skip_swept else _NONE
+        x, y = float(near[0]), float(near[1])
+        return self._grid, self.origin, self.cell_m, min_certainty, x, y, float(within_m), swept
 
     def any_cells(self, min_certainty: int = 1) -> bool:
         """Whether any cell is at or above a certainty."""
