@@ -9,6 +9,7 @@ force) and the kind of range sensor. Pure data and plane geometry; no MuJoCo.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -85,12 +86,12 @@ class RobotBody:
         radius = float(np.max(np.hypot(polygon[:, 0], polygon[:, 1])))
         return cls(_frozen(polygon), radius, disc=False, **kwargs)
 
-    @property
+    @functools.cached_property
     def half_width_m(self) -> float:
         """Half the robot's width across its heading (m): max |y| of the footprint, or the radius."""
         return self.radius_m if self.disc else float(np.max(np.abs(self.footprint[:, 1])))
 
-    @property
+    @functools.cached_property
     def inner_radius_m(self) -> float:
         """Radius (m) of the largest disc about base_link's origin inside the footprint: the
         ground the robot covers whatever its heading; the radius for a round robot."""
@@ -101,12 +102,12 @@ class RobotBody:
         # The origin's distance to each edge's line (it lies inside the convex footprint).
         return float(np.min(np.abs(a[:, 0] * edge[:, 1] - a[:, 1] * edge[:, 0]) / np.hypot(*edge.T)))
 
-    @property
+    @functools.cached_property
     def front_m(self) -> float:
         """How far the footprint reaches ahead of base_link's origin (m)."""
         return self.radius_m if self.disc else float(np.max(self.footprint[:, 0]))
 
-    @property
+    @functools.cached_property
     def rear_m(self) -> float:
         """How far the footprint reaches behind base_link's origin (m)."""
         return self.radius_m if self.disc else float(-np.min(self.footprint[:, 0]))
