@@ -50,7 +50,8 @@ def step_costs(
     closeness = np.clip((lethal_m + inflation_m - d) / inflation_m, 0.0, 1.0)
     cost += inflation_weight * closeness**2 + np.where(d < lethal_m, doubt_cost, 0.0)
     if sure.any():
-        cost[distance_transform(~sure) * cell_m < lethal_m] = np.inf
+        sure_d = d if not doubtful.any() else distance_transform(~sure) * cell_m  # the same cells: the same d
+        cost[sure_d < lethal_m] = np.inf
     return cost
 
 
