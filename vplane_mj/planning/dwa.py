@@ -362,7 +362,6 @@ class DwaPlanner(Planner):
         curvature = turns / speeds[moving, None]
         safe = self.radius + p.margin_m
         field = self.map.clearance_field(p.map_threshold, obs.position, self.lookahead + safe + self.step_m)
-        arriving = obs.distance_to_goal() < self.lookahead + obs.goal_tolerance  # arcs may enter the goal
         first = arcs.first_hits(
             float(obs.position[0]),
             float(obs.position[1]),
@@ -375,7 +374,7 @@ class DwaPlanner(Planner):
             field.cell_m,
             safe,
             np.asarray(obs.goal, float),
-            float(obs.goal_tolerance) if arriving else -1.0,
+            self._arrival_tolerance(obs),
         )
         dist[moving] = np.where(first >= 0, first * self.step_m, self.lookahead)
         return dist
@@ -480,10 +479,17 @@ class DwaPlanner(Planner):
     def _past_the_goal_free(self, obs: Observation, points: np.ndarray, hits: np.ndarray) -> np.ndarray:
         """The hits (..., count) of arcs whose points (..., count, 2) go on, without those after
         an arc enters the goal tolerance."""
-        if obs.distance_to_goal() < self.lookahead + obs.goal_tolerance:  # arcs may enter the goal
-            arrived = np.hypot(*np.moveaxis(points - obs.goal, -1, 0)) <= obs.goal_tolerance
+        tolerance = self._arrival_tolerance(obs)
+        if tolerance >= 0.0:
+            arrived = np.hypot(*np.moveaxis(points - obs.goal, -1, 0)) <= tolerance
             hits &= ~np.logical_or.accumulate(arrived, axis=-1)
         return hits
+
+    def _arrival_tolerance(self, obs: Observation) -> float:
+        """The goal tolerance (m) when an arc of the look-ahead may enter the goal (and its points
+        past the goal then count as arrived, not hit), else -1: none can."""
+        tolerance = float(obs.goal_tolerance)
+        return tolerance if obs.distance_to_goal() < self.lookahead + tolerance else -1.0
 
     def aim(self, obs: Observation) -> np.ndarray:
         """The point (m) the heading term aims at (step 5 of the module docstring): the goal; with
