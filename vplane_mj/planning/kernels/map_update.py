@@ -83,19 +83,21 @@ def fold_scan(
     far_y = max(abs(y - first_cell[1] * cell_m), abs((first_cell[1] + n) * cell_m - y))
     extent2 = far_x * far_x + far_y * far_y + cell_m * cell_m
     arc_m = ARC_HALF_WIDTH * cell_m
-    scan = (x, y, yaw + directions[0], cell_m, beam, arc_m, spacing, silent_m)
-    fan = (directions, bounds, ranges, marks, rule, track_seen)
-    cells = (first_cell, grid.reshape(-1), seen.reshape(-1), stamps, stamp)
+    first_i, first_j = first_cell[0], first_cell[1]
+    axis0 = yaw + directions[0]
+    flat, seen_flat = grid.reshape(-1), seen.reshape(-1)
+    # One loop nest, its helpers given numbers alone: an array handed to a compiled function
+    # costs two atomic reference counts a call, which here took 40% of the time.
     for c in range(directions.shape[0]):
         if ranges[c] != ranges[c] and silent_m <= 0.0:
             continue  # a silent beam: no information here
         band_lo2, band_hi2, clear, show = _cone_reach(
             ranges[c], marks[c], arc_m, cell_m, silent_m, track_seen
         )
-        reach2 = min(max(band_hi2, clear * clear, show * show), extent2)
+        clear2, show2 = clear * clear, show * show
+        reach2 = min(max(band_hi2, clear2, show2), extent2)
         if reach2 <= 0.0:
             continue
-        reach = (reach2, band_lo2, band_hi2, clear * clear, show * show)
         axis = yaw + directions[c]
         start = axis - half_before[c] - ANGLE_MARGIN_RAD
         span = half_before[c] + half_after[c] + 2 * ANGLE_MARGIN_RAD
@@ -105,38 +107,70 @@ def fold_scan(
             low = start + k * width - ANGLE_MARGIN_RAD
             high = low + width + 2 * ANGLE_MARGIN_RAD
             sight = (math.cos(low), math.sin(low), math.cos(high), math.sin(high))
-            _walk_piece(n, sight, reach, scan, fan, cells)
+            us, vs, edges, lines, first_v, step_u, step_v = _piece_lines(
+                n, sight, reach2, x, y, cell_m, first_i, first_j
+            )
+            for line in range(lines[0], lines[1] + 1):
+                u = (lines[2] + line + 0.5) * cell_m
+                run_first, run_last = _run(u, us, vs, edges, cell_m, first_v, n)
+                du2 = (u - us[0]) * (u - us[0])
+                for along in range(run_first, run_last + 1):
+                    dv = (first_v + along + 0.5) * cell_m - vs[0]
+                    d2 = du2 + dv * dv
+                    index = line * step_u + along * step_v
+                    if (
+                        not (
+                            band_lo2 <= d2 <= band_hi2
+                            or (d2 < clear2 and flat[index] > 0)
+                            or (track_seen and d2 < show2 and not seen_flat[index])
+                        )
+                        or stamps[index] == stamp
+                    ):
+                        continue
+                    stamps[index] = stamp
+                    # The map's rule for this cell, by its nearest direction.
+                    rel_x = (first_i + index // n + 0.5) * cell_m - x
+                    rel_y = (first_j + index % n + 0.5) * cell_m - y
+                    angle = math.atan2(rel_y, rel_x) - axis0
+                    if spacing > 0.0:
+                        nearest, offset = nearest_in_ring(angle, axis0, spacing, directions.shape[0])
+                    else:
+                        nearest, offset = nearest_by_search(angle, bounds, directions)
+                    value, shown = _judged(
+                        flat[index],
+                        math.hypot(rel_x, rel_y),
+                        offset,
+                        ranges[nearest],
+                        marks[nearest],
+                        beam,
+                        cell_m,
+                        arc_m,
+                        silent_m,
+                        rule[0],
+                        rule[1],
+                        rule[2],
+                    )
+                    flat[index] = value
+                    if track_seen and shown:
+                        seen_flat[index] = True
 
 
 @njit(cache=True)
-def _judge(index, n, scan, fan, cells):
-    """Apply the map's rule to the cell `index` (flat, row-major in the n x n grid)."""
-    px, py, axis, cell_m, beam, arc_m, spacing, silent_m = scan
-    directions, bounds, ranges, marks, rule, track_seen = fan
-    first_cell, flat, seen_flat, _, _ = cells
-    rel_x = (first_cell[0] + index // n + 0.5) * cell_m - px
-    rel_y = (first_cell[1] + index % n + 0.5) * cell_m - py
-    distance = math.hypot(rel_x, rel_y)
-    angle = math.atan2(rel_y, rel_x) - axis
-    if spacing > 0.0:
-        nearest, offset = nearest_in_ring(angle, axis, spacing, directions.shape[0])
-    else:
-        nearest, offset = nearest_by_search(angle, bounds, directions)
+def _judged(value, distance, offset, reading, marks, beam, cell_m, arc_m, silent_m, hit, miss, most):
+    """A cell's certainty after one scan, from `value`, and whether the scan shows it free: the
+    cell `distance` (m) from the robot and `offset` (rad) from the axis of its nearest
+    direction, whose range is `reading` (m, NaN: no echo) and whose arc marks when `marks`."""
     in_beam = abs(offset) <= beam / 2
-    echo = ranges[nearest] == ranges[nearest]  # not NaN
-    reading = ranges[nearest] if echo and in_beam else -1.0
-    shown_free = distance < reading - cell_m
+    echo = reading == reading  # not NaN
+    shown_range = reading if echo and in_beam else -1.0
+    shown_free = distance < shown_range - cell_m
     delta = 0
-    if abs(distance - reading) <= arc_m and marks[nearest]:
-        delta += rule[0]
+    if abs(distance - shown_range) <= arc_m and marks:
+        delta += hit
     if shown_free:
-        delta -= rule[1]
-    flat[index] = min(max(flat[index] + delta, 0), rule[2])
-    if track_seen:
-        if silent_m > 0.0 and in_beam and not echo and distance < silent_m:
-            shown_free = True
-        if shown_free:
-            seen_flat[index] = True
+        delta -= miss
+    silent_free = silent_m > 0.0 and in_beam and not echo and distance < silent_m
+    return min(max(value + delta, 0), most), shown_free or silent_free
 
 
 @njit(cache=True)
@@ -189,58 +223,38 @@ def _cone_reach(
 
 
 @njit(cache=True)
-def _walk_piece(n, sight, reach, scan, fan, cells):
-    """Judge the cells of one piece of a cone that the scan may change (each once: its stamp):
-    from the direction (ax, ay) of `sight` counter-clockwise to (bx, by), at most a quarter
-    turn. `reach` holds the squared distances (m^2): how far the piece reaches, the arc band's
-    bounds, and how far it clears marked cells and shows unseen ones."""
-    first_cell, flat, seen_flat, stamps, stamp = cells
-    _, band_lo2, band_hi2, clear2, show2 = reach
-    track_seen = fan[5]
-    cell_m = scan[3]
-    us, vs, edges, lines, first_v, step_u, step_v = _piece_lines(n, sight, reach[0], scan, first_cell)
-    for line in range(lines[0], lines[1] + 1):
-        u = (lines[2] + line + 0.5) * cell_m
-        lo, hi = -math.inf, math.inf
-        for k in range(4):
-            lo, hi = _bound(lo, hi, u, edges[k][0], edges[k][1], us[k], vs[k])
-        if lo > hi:
-            continue
-        run_first = max(0, math.ceil((lo - 1e-9) / cell_m - first_v - 0.5))
-        run_last = min(n - 1, math.floor((hi + 1e-9) / cell_m - first_v - 0.5))
-        du2 = (u - us[0]) * (u - us[0])
-        for along in range(run_first, run_last + 1):
-            dv = (first_v + along + 0.5) * cell_m - vs[0]
-            d2 = du2 + dv * dv
-            index = line * step_u + along * step_v
-            if (
-                band_lo2 <= d2 <= band_hi2
-                or (d2 < clear2 and flat[index] > 0)
-                or (track_seen and d2 < show2 and not seen_flat[index])
-            ) and stamps[index] != stamp:
-                stamps[index] = stamp
-                _judge(index, n, scan, fan, cells)
+def _run(u, us, vs, edges, cell_m, first_v, n):
+    """The first and last cell (indices along the line, within the grid) of the run of a piece's
+    quadrilateral (see `_piece_lines`) on the grid line at `u` (m); first > last: none."""
+    lo, hi = -math.inf, math.inf
+    for k in range(4):
+        lo, hi = _bound(lo, hi, u, edges[k][0], edges[k][1], us[k], vs[k])
+    if lo > hi:
+        return 1, 0
+    return (
+        max(0, math.ceil((lo - 1e-9) / cell_m - first_v - 0.5)),
+        min(n - 1, math.floor((hi + 1e-9) / cell_m - first_v - 0.5)),
+    )
 
 
 @njit(cache=True)
-def _piece_lines(n, sight, reach2, scan, first_cell):
-    """How to walk one piece of a cone (see `_walk_piece`): the corners (u, v) of the
+def _piece_lines(n, sight, reach2, x0, y0, cell_m, first_i, first_j):
+    """How to walk one piece of a cone (see `fold_scan`): the corners (u, v) of the
     quadrilateral that holds it (the robot, the arc's start, the corner where the tangents at
     the arc's ends meet, the arc's end), its four edges (`_edge`), the first and last grid
     line it crosses and the first line's world cell, the first cell along a line, and the flat
     index steps between lines and along one. Lines are rows (u = x) or columns (u = y),
     whichever are fewer."""
     ax, ay, bx, by = sight
-    x0, y0, cell_m = scan[0], scan[1], scan[3]
     far_m = math.sqrt(reach2)
     sx, sy = ax + bx, ay + by
     far = 2.0 * far_m / (sx * sx + sy * sy)
     xs = (x0, x0 + far_m * ax, x0 + far * sx, x0 + far_m * bx)
     ys = (y0, y0 + far_m * ay, y0 + far * sy, y0 + far_m * by)
     if max(xs) - min(xs) <= max(ys) - min(ys):
-        us, vs, first_u, first_v, step_u, step_v, orient = xs, ys, first_cell[0], first_cell[1], n, 1, 1.0
+        us, vs, first_u, first_v, step_u, step_v, orient = xs, ys, first_i, first_j, n, 1, 1.0
     else:
-        us, vs, first_u, first_v, step_u, step_v, orient = ys, xs, first_cell[1], first_cell[0], 1, n, -1.0
+        us, vs, first_u, first_v, step_u, step_v, orient = ys, xs, first_j, first_i, 1, n, -1.0
     # Each edge bounds a line's run from below or above (or, parallel to the lines, keeps or
     # drops whole lines); its inner side is the left one in x, y.
     edges = (
