@@ -50,8 +50,6 @@ from vplane_mj.planning.beams import BeamFan
 
 _NONE = np.zeros((0, 0), dtype=bool)
 """An empty mask: no cell skipped."""
-_LAST_STAMP = int(np.iinfo(np.int32).max)
-"""The largest stamp of a cell judged (the stamps then start again from 0)."""
 
 
 class LocalMap:
@@ -86,8 +84,6 @@ class LocalMap:
         self._grid = np.zeros((self.n, self.n), dtype=np.int16)
         self._seen = np.zeros((self.n, self.n), dtype=bool)
         self._swept = np.zeros((self.n, self.n), dtype=bool)
-        self._stamps = np.zeros(self.n * self.n, dtype=np.int32)  # per cell: the last scan that judged it
-        self._stamp = 0
 
     @property
     def grid(self) -> np.ndarray:
@@ -112,10 +108,6 @@ class LocalMap:
         `bearings` (rad, robot frame; any order, duplicates allowed), each beam `beam` wide (rad)."""
         origin = self._follow(position)
         fan = self._fan_of(bearings, beam)
-        if self._stamp >= _LAST_STAMP:
-            self._stamps[:] = 0
-            self._stamp = 0
-        self._stamp += 1
         # An arc at most a cell wide (range x beam <= cell) places its echo as precisely as the
         # grid can hold it, at any range.
         mark_range = max(self.hit_range_m, self.cell_m / beam if beam > 0 else math.inf)
@@ -138,8 +130,6 @@ class LocalMap:
             self.track_seen,
             self._grid,
             self._seen,
-            self._stamps,
-            self._stamp,
         )
 
     def _fan_of(self, bearings: np.ndarray, beam: float) -> BeamFan:

@@ -11,8 +11,9 @@ of the grid are visited, so an echo beyond the grid costs no more than one at it
 Of the cells of a cone, a cell is taken when it lies in the beam's arc band, or nearer than the
 band and marked (an echo clears it), or nearer and not yet seen (with `seen`); the bounds are
 wider than the rule by a margin, so rounding never drops a cell. Each cell taken is then judged
-once (a stamp per cell), as it is found, by the map's rule (`vplane_mj.planning.localmap`): its beam is the
-nearest direction (`nearest_in_ring` for an evenly spaced ring, `nearest_by_search` for any
+by the map's rule (`vplane_mj.planning.localmap`), in the walk of its own beam's cone alone
+(the cones overlap at their margins; its own holds every cell the beam can change), so once:
+its beam is the nearest direction (`nearest_in_ring` for an evenly spaced ring, `nearest_by_search` for any
 directions: one rule, two ways, which agree wherever rounding does not decide), and it must lie
 within half a beam width of that direction's axis; a cell within ARC_HALF_WIDTH cell of the
 range, along its beam, is on the arc and gains `hit`; a cell nearer than the range less one
@@ -56,8 +57,6 @@ def fold_scan(
     track_seen: bool,
     grid: np.ndarray,
     seen: np.ndarray,
-    stamps: np.ndarray,
-    stamp: int,
 ) -> None:
     """Fold one scan into `grid` (n, n certainties) and `seen` (n, n), in place.
 
@@ -68,8 +67,7 @@ def fold_scan(
     directions, then searched among `bounds`. `ranges[k]` (m, NaN: no echo) is direction k's;
     an echo marks its arc when it is at most `mark_range_m` away. When some direction has no
     echo, its cone shows free for `silent_free_m` (m, with `track_seen`). `rule` is (hit,
-    miss, max_certainty). `stamps` (n * n) remembers the cells judged: a cell is judged once,
-    and its stamp becomes `stamp`.
+    miss, max_certainty).
     """
     n = grid.shape[0]
     marks = np.empty(directions.shape[0], dtype=np.bool_)
@@ -118,24 +116,24 @@ def fold_scan(
                     dv = (first_v + along + 0.5) * cell_m - vs[0]
                     d2 = du2 + dv * dv
                     index = line * step_u + along * step_v
-                    if (
-                        not (
-                            band_lo2 <= d2 <= band_hi2
-                            or (d2 < clear2 and flat[index] > 0)
-                            or (track_seen and d2 < show2 and not seen_flat[index])
-                        )
-                        or stamps[index] == stamp
+                    if not (
+                        band_lo2 <= d2 <= band_hi2
+                        or (d2 < clear2 and flat[index] > 0)
+                        or (track_seen and d2 < show2 and not seen_flat[index])
                     ):
                         continue
-                    stamps[index] = stamp
-                    # The map's rule for this cell, by its nearest direction.
-                    rel_x = (first_i + index // n + 0.5) * cell_m - x
-                    rel_y = (first_j + index % n + 0.5) * cell_m - y
+                    # The map's rule for this cell, by its nearest direction: judged only in
+                    # the walk of that direction's cone (which holds every cell it can change).
+                    i, j = (line, along) if step_u == n else (along, line)
+                    rel_x = (first_i + i + 0.5) * cell_m - x
+                    rel_y = (first_j + j + 0.5) * cell_m - y
                     angle = math.atan2(rel_y, rel_x) - axis0
                     if spacing > 0.0:
                         nearest, offset = nearest_in_ring(angle, axis0, spacing, directions.shape[0])
                     else:
                         nearest, offset = nearest_by_search(angle, bounds, directions)
+                    if nearest != c:
+                        continue
                     value, shown = _judged(
                         flat[index],
                         math.hypot(rel_x, rel_y),
