@@ -20,6 +20,10 @@ import math
 import numpy as np
 from numba import njit
 
+RING_MARGIN_M = 1e-9
+"""How much nearer (m) than its cells' bound a ring of cells is taken to be, so that rounding
+(a point binned a cell off) never skips an obstacle."""
+
 
 def footprint_clearance(
     occupied: np.ndarray,
@@ -100,16 +104,13 @@ def _signed_distance(polygon: np.ndarray, px: float, py: float) -> float:
 
 
 @njit(cache=True)
-def _nearer(
-    polygon: np.ndarray, radius: float, c: float, s: float, dx: float, dy: float, best: float
-) -> float:
-    """The lesser of `best` and the signed distance from the footprint at yaw (cos c, sin s) to
-    an obstacle at (dx, dy) from the pose; an obstacle at r from the pose is at least r - radius
-    from the footprint, so one that far is not measured."""
+def _may_be_nearer(radius: float, dx: float, dy: float, best: float) -> bool:
+    """Whether an obstacle at (dx, dy) (m) from a pose may lie nearer than `best` to the
+    footprint: one at r from the pose is at least r - radius (the circumscribed radius) from
+    it. (The test takes numbers alone: an array handed to a compiled function costs two atomic
+    reference counts a call.)"""
     bound = radius + best
-    if bound <= 0.0 or dx * dx + dy * dy >= bound * bound:
-        return best
-    return min(best, _signed_distance(polygon, c * dx + s * dy, -s * dx + c * dy))
+    return bound > 0.0 and dx * dx + dy * dy < bound * bound
 
 
 @njit(cache=True)
@@ -139,11 +140,29 @@ def _clearances(
         i_hi = min(math.floor((x + reach) / cell) - first_i, rows - 1)
         j_lo = max(math.floor((y - reach) / cell) - first_j, 0)
         j_hi = min(math.floor((y + reach) / cell) - first_j, cols - 1)
-        for i in range(i_lo, i_hi + 1):
-            cx = (first_i + i + 0.5) * cell - x
-            for j in range(j_lo, j_hi + 1):
-                if occupied[i, j]:
-                    best = _nearer(polygon, radius, c, s, cx, (first_j + j + 0.5) * cell - y, best)
-                for k in range(starts[i * cols + j], starts[i * cols + j + 1]):
-                    best = _nearer(polygon, radius, c, s, points[k, 0] - x, points[k, 1] - y, best)
+        # The square's cells ring by ring outward from the pose's cell: a point in ring r lies
+        # more than (r - 1) cells from the pose, so once that is as far as the bound (the
+        # circumscribed radius plus the best so far), no later ring holds a nearer obstacle.
+        pose_i = math.floor(x / cell) - first_i
+        pose_j = math.floor(y / cell) - first_j
+        rings = max(pose_i - i_lo, i_hi - pose_i, pose_j - j_lo, j_hi - pose_j)
+        for r in range(rings + 1 if i_lo <= i_hi and j_lo <= j_hi else 0):
+            if (r - 1) * cell - RING_MARGIN_M >= radius + best:
+                break
+            for i in range(max(pose_i - r, i_lo), min(pose_i + r, i_hi) + 1):
+                whole_row = abs(i - pose_i) == r  # else only the ring's two cells of the row
+                j_first = max(pose_j - r, j_lo) if whole_row else pose_j - r
+                j_step = 1 if whole_row else 2 * r
+                cx = (first_i + i + 0.5) * cell - x
+                for j in range(j_first, min(pose_j + r, j_hi) + 1, j_step):
+                    if j < j_lo:
+                        continue
+                    if occupied[i, j]:
+                        dx, dy = cx, (first_j + j + 0.5) * cell - y
+                        if _may_be_nearer(radius, dx, dy, best):
+                            best = min(best, _signed_distance(polygon, c * dx + s * dy, -s * dx + c * dy))
+                    for k in range(starts[i * cols + j], starts[i * cols + j + 1]):
+                        dx, dy = points[k, 0] - x, points[k, 1] - y
+                        if _may_be_nearer(radius, dx, dy, best):
+                            best = min(best, _signed_distance(polygon, c * dx + s * dy, -s * dx + c * dy))
         out[m] = best
