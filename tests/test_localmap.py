@@ -11,6 +11,7 @@ import pytest
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.synthetic import BEAM, BEARINGS, LAYOUTS, scan
 from vplane_mj.planning import beams
+from vplane_mj.planning.kernels import map_update
 from vplane_mj.planning.kernels.map_update import nearest_by_search, nearest_in_ring
 from vplane_mj.planning.localmap import LocalMap, angular_extremes
 
@@ -318,6 +319,16 @@ def test_the_ring_arithmetic_and_the_search_give_every_angle_the_same_beam(count
     np.testing.assert_array_equal(ring_beam, search_beam)
     np.testing.assert_allclose(ring_offset, search_offset, rtol=0, atol=1e-9)
     assert np.abs(ring_offset).max() <= math.pi / count + 1e-9  # the nearest: at most half the spacing
+
+
+def test_the_remainder_of_a_turn_is_pythons_modulo_bit_for_bit():
+    turn = 2 * math.pi
+    rng = np.random.default_rng(11)
+    edges = [a + d for a in (-2 * turn, -turn, 0.0, turn, 2 * turn) for d in (-1e-15, -0.0, 0.0, 1e-15)]
+    angles = [*rng.uniform(-3 * turn, 3 * turn, 20_000), *edges, -5e-324, 1e300, -1e300]
+    got = np.array([map_update._remainder_of_turn(angle) for angle in angles])
+    want = np.array([angle % turn for angle in angles])
+    assert np.array_equal(got.view(np.int64), want.view(np.int64))  # the same bits, signed zeros too
 
 
 def shifted(layer: np.ndarray, old: np.ndarray | None, new: np.ndarray) -> np.ndarray:
