@@ -167,6 +167,34 @@ def test_the_intrusion_is_the_largest_over_every_point_and_pose_of_the_distances
     assert any(decided) and not all(decided)  # safe motions and unsafe ones
 
 
+def test_the_outline_kernels_squares_decide_as_hypot_does_bit_for_bit():
+    from numba import njit
+
+    from vplane_mj.planning.kernels import outline
+
+    hypot = njit(lambda dx, dy: math.hypot(dx, dy))  # the compiled kernels' (the C library's)
+    rng = np.random.default_rng(2)
+    offsets = rng.uniform(-3.0, 3.0, (20_000, 2))
+    bounds = np.hypot(offsets[:, 0], offsets[:, 1]) * rng.choice(
+        [1.0, 1 - 1e-16, 1 + 1e-15, 0.9, 1.1], 20_000
+    )
+    bounds[::50] = -bounds[::50]  # and bounds below zero
+    for (dx, dy), bound in zip(offsets, bounds, strict=True):
+        assert outline._closer(dx, dy, bound) == (hypot(dx, dy) < bound)
+        assert not outline._surely_beyond(dx, dy, bound) or hypot(dx, dy) > bound
+    # The distance to the outline: the least hypot over the edges, the same bits.
+    body = robot_body("jackal")
+    footprint, normals = motion._outline(body)
+    corners = np.repeat(footprint, 50, axis=0) + rng.normal(0.0, 1e-12, (len(footprint) * 50, 2))
+    for x, y in np.vstack((rng.uniform(-1.0, 1.0, (5_000, 2)), corners)):
+        ends = np.roll(footprint, -1, axis=0)
+        edge, rel = ends - footprint, np.array([x, y]) - footprint
+        t = np.clip((rel * edge).sum(axis=1) / (edge * edge).sum(axis=1), 0.0, 1.0)
+        outside = ((rel * normals).sum(axis=1) > 0.0).any()
+        want = min(hypot(*(r - k * e)) for r, k, e in zip(rel, t, edge, strict=True)) if outside else 0.0
+        assert outline._gap(footprint, normals, x, y) == want
+
+
 def test_a_turn_is_commanded_to_stop_facing_the_force_and_the_default_robot_is_left_alone():
     governor = motion.Governor(JACKAL, 0.1, 0.03)
     steering = governor.steer(np.array([0.0, 1.0]), _observation(), np.empty((0, 2)))
