@@ -376,14 +376,14 @@ class Governor:
     """What a shut-in robot is doing about it: "back" (backing off) or "round" (turning the
     other way round), None while it is not shut in."""
     remembered: np.ndarray = field(default_factory=lambda: np.empty((0, 2)), init=False)
-    """The obstacle points (N, 2; world, m) given at earlier ticks within `reach_m`."""
+    """The obstacle points (N, 2; world, m) of the last tick, one per MEMORY_CELL_M square:
+    those it was given, and those out of the sensor's view still within `reach_m`."""
+    policy: SpeedPolicy = field(init=False)
+    """The speeds the body may drive at along a way."""
 
     def __post_init__(self) -> None:
         self.drive = DriveModel(self.body.limits)
-
-    @property
-    def policy(self) -> SpeedPolicy:
-        return SpeedPolicy(self.body)
+        self.policy = SpeedPolicy(self.body)
 
     @property
     def reach_m(self) -> float:
