@@ -311,6 +311,31 @@ def test_the_governor_remembers_what_its_laser_no_longer_sees_once_a_square():
     assert len(governor._with_unseen(np.empty((0, 2)), all_round)) == 0  # a ring sees all round
 
 
+@pytest.mark.parametrize("view", [(-1, -2.4, 4.8), (-1, 0.3, 0.5), (1, -3.2, 0.0), (0, 0.0, 0.0)])
+@pytest.mark.parametrize("count", [0, 1, 7, 3000])
+def test_the_memory_kernel_recalls_as_numpy_does(count, view):
+    """Unseen points: within reach and out of view (numpy's arctan2, mod and hypot); kept: the
+    first of each memory square (numpy's unique), in order."""
+    from vplane_mj.planning.kernels import memory
+
+    rng = np.random.default_rng(count)
+    points = rng.uniform(-0.3, 0.3, (count, 2)) + rng.choice([0.0, -1e4, 5e3], (count, 1))
+    points[1::3] = points[::3][: len(points[1::3])]  # repeated points, and many in one square
+    remembered = rng.uniform(-4.0, 4.0, (2 * count, 2))
+    x, y, yaw, reach = 0.2, -0.1, 2.9, 3.0
+    mode, low, span = view
+    rel = remembered - (x, y)
+    near = np.hypot(rel[:, 0], rel[:, 1]) < reach
+    in_view = np.mod(np.arctan2(rel[:, 1], rel[:, 0]) - yaw - low, 2 * math.pi) <= span
+    unseen = near & (~in_view if mode < 0 else np.full(len(near), mode == 0))
+    want = np.vstack((points, remembered[unseen]))
+    cells = np.floor(want / motion.MEMORY_CELL_M).astype(np.int64)
+    _, first = np.unique(cells[:, 0] * (1 << 32) + cells[:, 1], return_index=True)
+    known, kept = memory.recall(points, remembered, x, y, yaw, reach, mode, low, span, motion.MEMORY_CELL_M)
+    np.testing.assert_array_equal(known, want)
+    np.testing.assert_array_equal(kept, want[np.sort(first)])
+
+
 def test_gaps_are_sized_by_the_robots_width_and_the_default_robot_keeps_its_radius():
     narrow = RobotBody.polygon([[0.4, 0.1], [-0.4, 0.1], [-0.4, -0.1], [0.4, -0.1]])
     assert narrow.half_width_m == pytest.approx(0.1) and narrow.radius_m > 0.4

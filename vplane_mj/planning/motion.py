@@ -335,17 +335,17 @@ class SpeedPolicy:
         return force * (cap / length) if length > cap else force
 
 
-def _in_view(obs: Observation, bearings: np.ndarray) -> np.ndarray:
-    """Whether each of `bearings` (rad, robot frame) lies in the field of view of the scan of
-    `obs`: within the span of its beams' bearings, widened by half a beam each way."""
+def _view(obs: Observation) -> tuple[int, float, float]:
+    """The field of view of the scan of `obs`, as `kernels.memory.recall` takes it: the span of
+    its beams' bearings, widened by half a beam each way (1: all round; 0: no beams; else -1,
+    its first bearing (rad, robot frame) and its width (rad))."""
     if not len(obs.bearings):
-        return np.zeros(len(bearings), dtype=bool)
+        return 0, 0.0, 0.0
     half = obs.beam_width / 2
     low, high = float(np.min(obs.bearings)) - half, float(np.max(obs.bearings)) + half
     if high - low >= 2 * math.pi:
-        return np.ones(len(bearings), dtype=bool)
-    offset = np.mod(np.asarray(bearings) - low, 2 * math.pi)
-    return offset <= high - low
+        return 1, low, 0.0
+    return -1, low, high - low
 
 
 @dataclass(frozen=True)
@@ -443,14 +443,13 @@ class Governor:
         does not look at now: outside its field of view (the span of its bearings, a half beam
         wider each way; none for a sensor that looks all round), as behind a 270-degree laser.
         Remembers `points` and those, one per MEMORY_CELL_M square, for the next ticks."""
-        points = np.asarray(points, float).reshape(-1, 2)
-        rel = self.remembered - obs.position
-        near = np.hypot(rel[:, 0], rel[:, 1]) < self.reach_m
-        unseen = near & ~_in_view(obs, np.arctan2(rel[:, 1], rel[:, 0]) - obs.yaw)
-        known = np.vstack((points, self.remembered[unseen]))
-        cells = np.floor(known / MEMORY_CELL_M).astype(np.int64)
-        _, first = np.unique(cells[:, 0] * (1 << 32) + cells[:, 1], return_index=True)  # one key a cell
-        self.remembered = known[np.sort(first)]
+        from vplane_mj.planning.kernels import memory  # numba: loaded by the first call
+
+        points = np.ascontiguousarray(points, float).reshape(-1, 2)
+        x, y = float(obs.position[0]), float(obs.position[1])
+        known, self.remembered = memory.recall(
+            points, self.remembered, x, y, float(obs.yaw), self.reach_m, *_view(obs), MEMORY_CELL_M
+        )
         return known
 
     def _command(

@@ -1,0 +1,67 @@
+"""The governor's memory of obstacle points, compiled (`motion.Governor`): which remembered
+points the sensor no longer looks at, and one point kept per square cell."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+TURN = 2 * math.pi
+
+
+@njit(cache=True)
+def recall(
+    points: np.ndarray,
+    remembered: np.ndarray,
+    x: float,
+    y: float,
+    yaw: float,
+    reach_m: float,
+    view: int,
+    low: float,
+    span: float,
+    cell_m: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """`points` (N, 2; world, m) followed by the `remembered` points (M, 2) within `reach_m` of
+    the robot at (x, y) heading `yaw` (rad) that lie out of the sensor's view, and the first
+    of those in each square cell of `cell_m` (the cell (floor(x / cell_m), floor(y /
+    cell_m))), in their order: what to steer among, and what to remember. `view` is 1 for a
+    sensor that looks all round, 0 for none, else -1: a point's bearing (rad, robot frame) is
+    in view when its angle past `low`, modulo a turn, is at most `span` (as numpy's mod)."""
+    unseen = np.zeros(remembered.shape[0], dtype=np.bool_)
+    for k in range(remembered.shape[0]):
+        rel_x, rel_y = remembered[k, 0] - x, remembered[k, 1] - y
+        if math.hypot(rel_x, rel_y) < reach_m:
+            if view == 0:
+                unseen[k] = True
+            elif view < 0:
+                unseen[k] = not ((math.atan2(rel_y, rel_x) - yaw - low) % TURN <= span)
+    known = np.concatenate((points, remembered[unseen]))
+    return known, known[_first_in_each_cell(known, cell_m)]
+
+
+@njit(cache=True)
+def _first_in_each_cell(points: np.ndarray, cell_m: float) -> np.ndarray:
+    """Indices (ascending) of the first of `points` (N, 2; m) in each square cell of `cell_m`:
+    what `np.unique` of the cells' keys with `return_index` gives, sorted, by one pass with a
+    hash table of the cells seen."""
+    count = points.shape[0]
+    size = 2
+    while size < 2 * count:
+        size *= 2
+    keys = np.empty(size, dtype=np.int64)
+    taken = np.zeros(size, dtype=np.bool_)
+    first = np.empty(count, dtype=np.int64)
+    found = 0
+    for k in range(count):
+        key = math.floor(points[k, 0] / cell_m) * (1 << 32) + math.floor(points[k, 1] / cell_m)
+        slot = np.int64((np.uint64(key) * np.uint64(0x9E3779B97F4A7C15)) >> np.uint64(32)) & (size - 1)
+        while taken[slot] and keys[slot] != key:
+            slot = (slot + 1) & (size - 1)
+        if not taken[slot]:
+            taken[slot], keys[slot] = True, key
+            first[found] = k
+            found += 1
+    return first[:found]
