@@ -297,25 +297,25 @@ def test_the_governor_remembers_what_its_laser_no_longer_sees_once_a_square():
     behind, ahead, far_behind = [-0.6, 0.0], [0.6, 0.0], [-0.6 - 2 * governor.reach_m, 0.0]
     twin = [-0.6 + motion.MEMORY_CELL_M / 4, 0.0]  # the same memory square as `behind`
     first = np.array([behind, twin, ahead, far_behind])
-    known = governor._with_unseen(first, seen_from([0.0, 0.0], 0.0))
+    known = governor._local_points(first, seen_from([0.0, 0.0], 0.0))
     np.testing.assert_array_equal(known, first)  # nothing remembered yet
     np.testing.assert_array_equal(governor.remembered, first[[0, 2, 3]])  # one a square
-    known = governor._with_unseen(np.empty((0, 2)), seen_from([0.0, 0.0], 0.0))
+    known = governor._local_points(np.empty((0, 2)), seen_from([0.0, 0.0], 0.0))
     np.testing.assert_array_equal(known, [behind])  # out of view and in reach; `ahead` is in view
-    known = governor._with_unseen(np.empty((0, 2)), seen_from([0.0, 0.0], math.pi))  # turned round
+    known = governor._local_points(np.empty((0, 2)), seen_from([0.0, 0.0], math.pi))  # turned round
     assert len(known) == 0  # `behind` is in view now, and the scan shows nothing there
     all_round = Observation(
         0.0, np.zeros(2), 0.0, np.ones(2), 0.2, np.arange(16) * math.pi / 8, np.full(16, np.nan), 0.4
     )
     governor.remembered = np.array([behind])
-    assert len(governor._with_unseen(np.empty((0, 2)), all_round)) == 0  # a ring sees all round
+    assert len(governor._local_points(np.empty((0, 2)), all_round)) == 0  # a ring sees all round
 
 
 @pytest.mark.parametrize("view", [(-1, -2.4, 4.8), (-1, 0.3, 0.5), (1, -3.2, 0.0), (0, 0.0, 0.0)])
 @pytest.mark.parametrize("count", [0, 1, 7, 3000])
 def test_the_memory_kernel_recalls_as_numpy_does(count, view):
-    """Unseen points: within reach and out of view (numpy's arctan2, mod and hypot); kept: the
-    first of each memory square (numpy's unique), in order."""
+    """Unseen points: within reach and out of view (numpy's arctan2, mod and hypot), given in
+    the robot's frame; kept: the first of each memory square (numpy's unique), in order."""
     from vplane_mj.planning.kernels import memory
 
     rng = np.random.default_rng(count)
@@ -331,8 +331,11 @@ def test_the_memory_kernel_recalls_as_numpy_does(count, view):
     want = np.vstack((points, remembered[unseen]))
     cells = np.floor(want / motion.MEMORY_CELL_M).astype(np.int64)
     _, first = np.unique(cells[:, 0] * (1 << 32) + cells[:, 1], return_index=True)
-    known, kept = memory.recall(points, remembered, x, y, yaw, reach, mode, low, span, motion.MEMORY_CELL_M)
-    np.testing.assert_array_equal(known, want)
+    local, kept = memory.recall(points, remembered, x, y, yaw, reach, mode, low, span, motion.MEMORY_CELL_M)
+    rel, c, s = want - (x, y), math.cos(yaw), math.sin(yaw)
+    np.testing.assert_array_equal(
+        local, np.column_stack((c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]))
+    )
     np.testing.assert_array_equal(kept, want[np.sort(first)])
 
 

@@ -71,13 +71,6 @@ _NO_LATE_TURNS = np.empty(0)
 """No turn rates to take from the past (a drive without a lag, or before its first tick)."""
 
 
-def body_frame(points: np.ndarray, position: np.ndarray, yaw: float) -> np.ndarray:
-    """World points (N, 2) in the robot's frame at `position`, `yaw` (x forward, y left; m)."""
-    rel = np.asarray(points, float).reshape(-1, 2) - position
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.column_stack((c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]))
-
-
 def room_ahead(body: RobotBody, local: np.ndarray, margin_m: float, side_margin_m: float) -> float:
     """Distance (m) the robot can drive straight ahead before a point of `local` (robot frame,
     m) in its way comes within `margin_m` of its circumscribed disc. The points in its way lie
@@ -425,7 +418,7 @@ class Governor:
             self.maneuver = None
             self.drive.commanded((0.0, 0.0))
             return Steering(force, (0.0, 0.0))
-        local = body_frame(self._with_unseen(points, obs), obs.position, obs.yaw)
+        local = self._local_points(points, obs)
         wanted = math.atan2(force[1], force[0])
         direction, command = self._command(local, obs.yaw, wanted, length, speed_mps, self.turn_margin_m)
         if command is None:
@@ -438,19 +431,20 @@ class Governor:
         )
         return Steering(self.policy.limit(length * shown, abs(command[0])), command)
 
-    def _with_unseen(self, points: np.ndarray, obs: Observation) -> np.ndarray:
+    def _local_points(self, points: np.ndarray, obs: Observation) -> np.ndarray:
         """`points` (N, 2; world, m) and the remembered points within `reach_m` that the sensor
         does not look at now: outside its field of view (the span of its bearings, a half beam
-        wider each way; none for a sensor that looks all round), as behind a 270-degree laser.
-        Remembers `points` and those, one per MEMORY_CELL_M square, for the next ticks."""
+        wider each way; none for a sensor that looks all round), as behind a 270-degree laser;
+        in the robot's frame (x forward, y left; m). Remembers `points` and those, one per
+        MEMORY_CELL_M square, for the next ticks."""
         from vplane_mj.planning.kernels import memory  # numba: loaded by the first call
 
         points = np.ascontiguousarray(points, float).reshape(-1, 2)
         x, y = float(obs.position[0]), float(obs.position[1])
-        known, self.remembered = memory.recall(
+        local, self.remembered = memory.recall(
             points, self.remembered, x, y, float(obs.yaw), self.reach_m, *_view(obs), MEMORY_CELL_M
         )
-        return known
+        return local
 
     def _command(
         self, local: np.ndarray, yaw: float, wanted: float, length: float, speed_mps: float, margin: float

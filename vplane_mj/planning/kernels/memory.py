@@ -1,5 +1,6 @@
 """The governor's memory of obstacle points, compiled (`motion.Governor`): which remembered
-points the sensor no longer looks at, and one point kept per square cell."""
+points the sensor no longer looks at, one point kept per square cell, and the points to steer
+among in the robot's frame."""
 
 from __future__ import annotations
 
@@ -25,11 +26,12 @@ def recall(
     cell_m: float,
 ) -> tuple[np.ndarray, np.ndarray]:
     """`points` (N, 2; world, m) followed by the `remembered` points (M, 2) within `reach_m` of
-    the robot at (x, y) heading `yaw` (rad) that lie out of the sensor's view, and the first
-    of those in each square cell of `cell_m` (the cell (floor(x / cell_m), floor(y /
-    cell_m))), in their order: what to steer among, and what to remember. `view` is 1 for a
-    sensor that looks all round, 0 for none, else -1: a point's bearing (rad, robot frame) is
-    in view when its angle past `low`, modulo a turn, is at most `span` (as numpy's mod)."""
+    the robot at (x, y) heading `yaw` (rad) that lie out of the sensor's view: in the robot's
+    frame (x forward, y left; m), what to steer among; and in the world, the first of them in
+    each square cell of `cell_m` (the cell (floor(x / cell_m), floor(y / cell_m))), in their
+    order, what to remember. `view` is 1 for a sensor that looks all round, 0 for none, else
+    -1: a point's bearing (rad, robot frame) is in view when its angle past `low`, modulo a
+    turn, is at most `span` (as numpy's mod)."""
     unseen = np.zeros(remembered.shape[0], dtype=np.bool_)
     for k in range(remembered.shape[0]):
         rel_x, rel_y = remembered[k, 0] - x, remembered[k, 1] - y
@@ -39,7 +41,13 @@ def recall(
             elif view < 0:
                 unseen[k] = not ((math.atan2(rel_y, rel_x) - yaw - low) % TURN <= span)
     known = np.concatenate((points, remembered[unseen]))
-    return known, known[_first_in_each_cell(known, cell_m)]
+    c, s = math.cos(yaw), math.sin(yaw)
+    local = np.empty_like(known)
+    for k in range(known.shape[0]):
+        rel_x, rel_y = known[k, 0] - x, known[k, 1] - y
+        local[k, 0] = c * rel_x + s * rel_y
+        local[k, 1] = -s * rel_x + c * rel_y
+    return local, known[_first_in_each_cell(known, cell_m)]
 
 
 @njit(cache=True)
