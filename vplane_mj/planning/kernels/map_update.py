@@ -13,12 +13,12 @@ band and marked (an echo clears it), or nearer and not yet seen (with `seen`); t
 wider than the rule by a margin, so rounding never drops a cell. Each cell taken is then judged
 by the map's rule (`vplane_mj.planning.localmap`), in the walk of its own beam's cone alone
 (the cones overlap at their margins; its own holds every cell the beam can change), so once:
-its beam is the nearest direction (`nearest_in_ring` for an evenly spaced ring, `nearest_by_search` for any
-directions: one rule, two ways, which agree wherever rounding does not decide), and it must lie
-within half a beam width of that direction's axis; a cell within ARC_HALF_WIDTH cell of the
-range, along its beam, is on the arc and gains `hit`; a cell nearer than the range less one
-cell is in the free cone and loses `miss`. So the grid is what a pass over every cell would
-make of it.
+its beam is the nearest direction (`nearest_in_ring` for an evenly spaced ring,
+`nearest_by_search` for any directions: one rule, two ways, which agree wherever rounding does
+not decide), and it must lie within half a beam width of that direction's axis; a cell within
+ARC_HALF_WIDTH cell of the range, along its beam, is on the arc and gains `hit`; a cell nearer
+than the range less one cell is in the free cone and loses `miss`. So the grid is what a pass
+over every cell would make of it.
 """
 
 from __future__ import annotations
@@ -155,16 +155,16 @@ def fold_scan(
 
 
 @njit(cache=True)
-def _judged(value, distance, offset, reading, marks, beam, cell_m, arc_m, silent_m, hit, miss, most):
+def _judged(value, distance, offset, reading, marking, beam, cell_m, arc_m, silent_m, hit, miss, most):
     """A cell's certainty after one scan, from `value`, and whether the scan shows it free: the
     cell `distance` (m) from the robot and `offset` (rad) from the axis of its nearest
-    direction, whose range is `reading` (m, NaN: no echo) and whose arc marks when `marks`."""
+    direction, whose range is `reading` (m, NaN: no echo) and whose arc marks when `marking`."""
     in_beam = abs(offset) <= beam / 2
     echo = reading == reading  # not NaN
     shown_range = reading if echo and in_beam else -1.0
     shown_free = distance < shown_range - cell_m
     delta = 0
-    if abs(distance - shown_range) <= arc_m and marks:
+    if abs(distance - shown_range) <= arc_m and marking:
         delta += hit
     if shown_free:
         delta -= miss
