@@ -80,13 +80,30 @@ def fold_scan(
     far_x = max(abs(x - first_cell[0] * cell_m), abs((first_cell[0] + n) * cell_m - x))
     far_y = max(abs(y - first_cell[1] * cell_m), abs((first_cell[1] + n) * cell_m - y))
     extent2 = far_x * far_x + far_y * far_y + cell_m * cell_m
+    _fold_cones(
+        (x, y, yaw, cell_m, beam, spacing, silent_m, extent2, track_seen),
+        (first_cell[0], first_cell[1], n),
+        (directions, half_before, half_after, bounds, ranges, marks),
+        (rule[0], rule[1], rule[2]),
+        grid.reshape(-1),
+        seen.reshape(-1),
+    )
+
+
+@njit(cache=True)
+def _fold_cones(scan, cells, fan, rule, flat, seen_flat):
+    """`fold_scan`'s walk through each beam's cone and its judgement of the cells it takes: one
+    loop nest, its helpers given numbers alone (an array handed to a compiled function costs
+    two atomic reference counts a call, which took 40% of the update when the walk and the
+    judgement were helpers of their own). `flat` and `seen_flat` are the grid and the seen
+    mask, flat."""
+    x, y, yaw, cell_m, beam, spacing, silent_m, extent2, track_seen = scan
+    first_i, first_j, n = cells
+    directions, half_before, half_after, bounds, ranges, marks = fan
     arc_m = ARC_HALF_WIDTH * cell_m
     per_cell = 1.0 / cell_m
-    first_i, first_j = first_cell[0], first_cell[1]
     axis0 = yaw + directions[0]
-    flat, seen_flat = grid.reshape(-1), seen.reshape(-1)
-    # One loop nest, its helpers given numbers alone: an array handed to a compiled function
-    # costs two atomic reference counts a call, which here took 40% of the time.
+    judging = (beam, cell_m, arc_m, silent_m, rule[0], rule[1], rule[2])
     for c in range(directions.shape[0]):
         if ranges[c] != ranges[c] and silent_m <= 0.0:
             continue  # a silent beam: no information here
@@ -135,19 +152,9 @@ def fold_scan(
                         nearest, offset = nearest_by_search(angle, bounds, directions)
                     if nearest != c:
                         continue
+                    reading, marking = ranges[nearest], marks[nearest]
                     value, shown = _judged(
-                        flat[index],
-                        math.hypot(rel_x, rel_y),
-                        offset,
-                        ranges[nearest],
-                        marks[nearest],
-                        beam,
-                        cell_m,
-                        arc_m,
-                        silent_m,
-                        rule[0],
-                        rule[1],
-                        rule[2],
+                        flat[index], math.hypot(rel_x, rel_y), offset, reading, marking, judging
                     )
                     flat[index] = value
                     if track_seen and shown:
@@ -155,10 +162,12 @@ def fold_scan(
 
 
 @njit(cache=True)
-def _judged(value, distance, offset, reading, marking, beam, cell_m, arc_m, silent_m, hit, miss, most):
+def _judged(value, distance, offset, reading, marking, judging):
     """A cell's certainty after one scan, from `value`, and whether the scan shows it free: the
     cell `distance` (m) from the robot and `offset` (rad) from the axis of its nearest
-    direction, whose range is `reading` (m, NaN: no echo) and whose arc marks when `marking`."""
+    direction, whose range is `reading` (m, NaN: no echo) and whose arc marks when `marking`;
+    `judging` is (beam, cell_m, arc_m, silent_m, hit, miss, max_certainty)."""
+    beam, cell_m, arc_m, silent_m, hit, miss, most = judging
     in_beam = abs(offset) <= beam / 2
     echo = reading == reading  # not NaN
     shown_range = reading if echo and in_beam else -1.0
