@@ -197,9 +197,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         if self.temp_goal is not None and np.hypot(*(obs.position - self.temp_goal)) <= p.vno_tolerance_m:
             self._finish_escape(obs, decision)
 
-        components = p.firas_components(obs)
-        if p.goal_fade_m > 0:  # goals near obstacles stay reachable (GNRON)
-            components["repulsive"] *= min(1.0, obs.distance_to_goal() / p.goal_fade_m) ** 2
+        components: dict[str, np.ndarray] = {}
         if self.temp_goal is not None:
             decision.mode = "escaping"
             if self._way_is_blocked(obs.position, self.escape_way):
@@ -216,6 +214,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             goal_pull = fields.attractive_force(obs.position, obs.goal, p.attract_gain, p.attract_radius)
             self._along_the_way(obs, components, target, float(np.hypot(*goal_pull)), bool(self.follow_way))
         else:
+            components.update(self._firas(obs))
             self._update_avoidance(obs, decision)
             if self.avoid_waypoint is not None:
                 decision.mode = "avoiding"
@@ -265,9 +264,11 @@ class VPlanePlusPlanner(VPlanePlanner):
         as in normal mode. A governed robot on a way is not repelled (module docstring)."""
         p = self.params
         heading = unit(waypoint - obs.position)
-        components["attractive"] = pull * heading
         if not on_a_way:
+            components.update(self._firas(obs))
+            components["attractive"] = pull * heading
             return
+        components["attractive"] = pull * heading
         if not self.governor.idle:
             components["repulsive"] = np.zeros(2)
             return
@@ -278,6 +279,16 @@ class VPlanePlusPlanner(VPlanePlanner):
         farther = fade * fields.repulsive_force(obs.position, echoes[~close], gain, influence)
         near = fade * fields.repulsive_force(obs.position, echoes[close], gain, influence)
         components["repulsive"] = near + farther - min(float(farther @ heading), 0.0) * heading
+
+    def _firas(self, obs: Observation) -> dict[str, np.ndarray]:
+        """Eq. 6's two terms at the robot (`FieldParams.firas_components`), the repulsion faded
+        within `goal_fade_m` of the goal, so that goals near obstacles stay reachable (GNRON).
+        Made only where they act: on the map's way both are replaced (`_along_the_way`)."""
+        p = self.params
+        components = p.firas_components(obs)
+        if p.goal_fade_m > 0:
+            components["repulsive"] *= min(1.0, obs.distance_to_goal() / p.goal_fade_m) ** 2
+        return components
 
     def _governed(self, force: np.ndarray, obs: Observation) -> Steering:
         """The command for the force (motion.py) among the echoes and the mapped
