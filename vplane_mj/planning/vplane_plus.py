@@ -274,7 +274,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             return
         echoes = obs.echo_points()
         close = np.hypot(*(echoes - obs.position).T) < self.radius + CLOSE_ECHO_MARGIN_M
-        fade = min(1.0, obs.distance_to_goal() / p.goal_fade_m) ** 2 if p.goal_fade_m > 0 else 1.0
+        fade = self._goal_fade(obs)
         gain, influence = p.repulse_gain, p.follow_influence_m
         farther = fade * fields.repulsive_force(obs.position, echoes[~close], gain, influence)
         near = fade * fields.repulsive_force(obs.position, echoes[close], gain, influence)
@@ -284,11 +284,16 @@ class VPlanePlusPlanner(VPlanePlanner):
         """Eq. 6's two terms at the robot (`FieldParams.firas_components`), the repulsion faded
         within `goal_fade_m` of the goal, so that goals near obstacles stay reachable (GNRON).
         Made only where they act: on the map's way both are replaced (`_along_the_way`)."""
-        p = self.params
-        components = p.firas_components(obs)
-        if p.goal_fade_m > 0:
-            components["repulsive"] *= min(1.0, obs.distance_to_goal() / p.goal_fade_m) ** 2
+        components = self.params.firas_components(obs)
+        if self.params.goal_fade_m > 0:
+            components["repulsive"] *= self._goal_fade(obs)
         return components
+
+    def _goal_fade(self, obs: Observation) -> float:
+        """How much of the echoes' repulsion acts: (distance to the goal / `goal_fade_m`)^2 within
+        `goal_fade_m` of the goal, else (and without a fade) 1."""
+        p = self.params
+        return min(1.0, obs.distance_to_goal() / p.goal_fade_m) ** 2 if p.goal_fade_m > 0 else 1.0
 
     def _governed(self, force: np.ndarray, obs: Observation) -> Steering:
         """The command for the force (motion.py) among the echoes and the mapped
