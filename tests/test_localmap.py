@@ -326,7 +326,7 @@ def test_the_remainder_of_a_turn_is_pythons_modulo_bit_for_bit():
     rng = np.random.default_rng(11)
     edges = [a + d for a in (-2 * turn, -turn, 0.0, turn, 2 * turn) for d in (-1e-15, -0.0, 0.0, 1e-15)]
     angles = [*rng.uniform(-3 * turn, 3 * turn, 20_000), *edges, -5e-324, 1e300, -1e300]
-    got = np.array([map_update._remainder_of_turn(angle) for angle in angles])
+    got = np.array([map_update.remainder_of_turn(angle) for angle in angles])
     want = np.array([angle % turn for angle in angles])
     assert np.array_equal(got.view(np.int64), want.view(np.int64))  # the same bits, signed zeros too
 

@@ -29,6 +29,13 @@ def square(first_cell: np.ndarray, n: int, cell_m: float, x: float, y: float, wi
 
 
 @njit(cache=True)
+def _counted(certainty: int, min_certainty: int, skipped: bool) -> bool:
+    """Whether a cell of `certainty` is one of `cells_near` (and `nearest_cell`): at or above
+    `min_certainty`, and not skipped."""
+    return certainty >= min_certainty and not skipped
+
+
+@njit(cache=True)
 def cells_near(
     grid: np.ndarray,
     first_cell: np.ndarray,
@@ -48,14 +55,14 @@ def cells_near(
     count = 0
     for i in range(lo_i, hi_i):
         for j in range(lo_j, hi_j):
-            if grid[i, j] >= min_certainty and not (skipping and skip[i, j]):
+            if _counted(grid[i, j], min_certainty, skipping and skip[i, j]):
                 count += 1
     centres = np.empty((count, 2))
     certainty = np.empty(count, dtype=np.int64)
     k = 0
     for i in range(lo_i, hi_i):
         for j in range(lo_j, hi_j):
-            if grid[i, j] >= min_certainty and not (skipping and skip[i, j]):
+            if _counted(grid[i, j], min_certainty, skipping and skip[i, j]):
                 centres[k, 0] = ((i + first_cell[0]) + 0.5) * cell_m
                 centres[k, 1] = ((j + first_cell[1]) + 0.5) * cell_m
                 certainty[k] = grid[i, j]
@@ -187,7 +194,7 @@ def nearest_cell(
     for i in range(lo_i, hi_i):
         cx = ((i + first_cell[0]) + 0.5) * cell_m
         for j in range(lo_j, hi_j):
-            if grid[i, j] >= min_certainty and not (skipping and skip[i, j]):
+            if _counted(grid[i, j], min_certainty, skipping and skip[i, j]):
                 cy = ((j + first_cell[1]) + 0.5) * cell_m
                 distance = np.hypot(cx - x, cy - y)
                 if distance < best:

@@ -201,13 +201,13 @@ def nearest_in_ring(angle: float, axis: float, spacing: float, count: int) -> tu
 def nearest_by_search(angle: float, bounds: np.ndarray, directions: np.ndarray) -> tuple[int, float]:
     """`nearest_in_ring` for any directions (rad, ascending): a search among the `bounds` half-way
     between neighbouring directions (each relative to the first direction)."""
-    angle = _remainder_of_turn(angle)
+    angle = remainder_of_turn(angle)
     beam = np.searchsorted(bounds, angle, side="right") % directions.shape[0]
-    return beam, _remainder_of_turn(angle - (directions[beam] - directions[0]) + math.pi) - math.pi
+    return beam, remainder_of_turn(angle - (directions[beam] - directions[0]) + math.pi) - math.pi
 
 
 @njit(cache=True)
-def _remainder_of_turn(angle: float) -> float:
+def remainder_of_turn(angle: float) -> float:
     """`angle % TURN` (rad) as Python's float modulo gives it, by one conditional turn when the
     angle lies within a turn of [0, TURN) (the modulo is then that turn added or taken away,
     rounded alike)."""

@@ -9,7 +9,7 @@ import math
 import numpy as np
 from numba import njit
 
-TURN = 2 * math.pi
+from vplane_mj.planning.kernels.map_update import remainder_of_turn
 
 
 @njit(cache=True)
@@ -31,7 +31,7 @@ def recall(
     each square cell of `cell_m` (the cell (floor(x / cell_m), floor(y / cell_m))), in their
     order, what to remember. `view` is 1 for a sensor that looks all round, 0 for none, else
     -1: a point's bearing (rad, robot frame) is in view when its angle past `low`, modulo a
-    turn, is at most `span` (as numpy's mod)."""
+    turn (`map_update.remainder_of_turn`, numpy's mod bit for bit), is at most `span`."""
     unseen = np.zeros(remembered.shape[0], dtype=np.bool_)
     for k in range(remembered.shape[0]):
         rel_x, rel_y = remembered[k, 0] - x, remembered[k, 1] - y
@@ -39,7 +39,7 @@ def recall(
             if view == 0:
                 unseen[k] = True
             elif view < 0:
-                unseen[k] = not ((math.atan2(rel_y, rel_x) - yaw - low) % TURN <= span)
+                unseen[k] = not (remainder_of_turn(math.atan2(rel_y, rel_x) - yaw - low) <= span)
     known = np.concatenate((points, remembered[unseen]))
     c, s = math.cos(yaw), math.sin(yaw)
     local = np.empty_like(known)
