@@ -33,7 +33,8 @@ grid holds no cells beyond its edge, and its storage does not grow with an echo'
 
 A scan changes only the cells near its echo arcs (hits), the marked cells inside its cones
 (misses: an empty cell stays empty) and, with `seen`, the cells of its cones not yet seen. So
-an update walks each cone and judges just those cells, by the rule above, in compiled code
+an update walks the cones (neighbouring ones together) and judges just those cells, by the rule
+above, in compiled code
 (`kernels.map_update`, numba, imported by the map's constructor): the grid is what a pass over
 every cell within reach of the longest echo would make of it.
 """

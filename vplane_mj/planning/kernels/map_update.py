@@ -1,19 +1,24 @@
-"""The local map's update, compiled: each beam's cone walked, and the cells it may change judged.
+"""The local map's update, compiled: the beams' cones walked, and the cells they may change judged.
 
 A scan changes only the cells near its echo arcs (hits), the marked cells inside its cones
 (misses: an empty cell stays empty) and, with `seen`, the cells of its cones not yet seen. The
-walk visits the cells of each cone: a cone is split into pieces at most a quarter turn wide; a
-piece is held by the quadrilateral of the robot, the arc's two ends and the point where the
-tangents at those ends meet, so the cells of one grid line (a row or a column, whichever
-crosses fewer lines) that lie inside it form one run, computed from the four edges. Only cells
-of the grid are visited, so an echo beyond the grid costs no more than one at its edge.
+walk visits the cells of each wedge: the cones of neighbouring beams that adjoin and reach about
+as far, walked as one (a laser's cones are far narrower than a cell: walked one by one, most
+grid lines of a cone held a cell or none, and a cell was visited by several cones). A wedge is
+split into pieces at most a quarter turn wide; a piece is held by the quadrilateral of the
+robot, the arc's two ends and the point where the tangents at those ends meet, so the cells of
+one grid line (a row or a column, whichever crosses fewer lines) that lie inside it form one
+run, computed from the four edges. Only cells of the grid are visited, so an echo beyond the
+grid costs no more than one at its edge.
 
-Of the cells of a cone, a cell is taken when it lies in the beam's arc band, or nearer than the
-band and marked (an echo clears it), or nearer and not yet seen (with `seen`); the bounds are
-wider than the rule by a margin, so rounding never drops a cell. Each cell taken is then judged
-by the map's rule (`vplane_mj.planning.localmap`), in the walk of its own beam's cone alone
-(the cones overlap at their margins; its own holds every cell the beam can change), so once:
-its beam is the nearest direction (`nearest_in_ring` for an evenly spaced ring,
+Of the cells of a wedge, a cell is taken when it lies in the arc band of its own beam (the
+nearest direction), or nearer than the band and marked (an echo clears it), or nearer and not
+yet seen (with `seen`); the bounds are wider than the rule by a margin, so rounding never drops
+a cell, and the wedge's (its cones' widest) first spare the search for the nearest direction
+where no cone of the wedge can change the cell. Each cell taken is then judged by the map's
+rule (`vplane_mj.planning.localmap`), in the walk of the wedge that holds its own beam's cone
+alone (the wedges overlap at their margins; its own holds every cell the beam can change), so
+once: its beam is the nearest direction (`nearest_in_ring` for an evenly spaced ring,
 `nearest_by_search` for any directions: one rule, two ways, which agree wherever rounding does
 not decide), and it must lie within half a beam width of that direction's axis; a cell within
 ARC_HALF_WIDTH cell of the range, along its beam, is on the arc and gains `hit`; a cell nearer
@@ -34,6 +39,10 @@ ANGLE_MARGIN_RAD = 1e-9
 DISTANCE_MARGIN_M = 1e-6
 """How much wider than the map's rule the walk looks (rad, m), so that rounding drops no cell."""
 QUARTER_TURN = math.pi / 2
+WEDGE_SPAN_RAD = 0.2
+WEDGE_SPREAD_CELLS = 2.0
+"""A wedge of neighbouring cones walked as one spans at most this (rad), and their reaches
+differ by at most this many cells (`_wedge`)."""
 TURN = 2 * math.pi
 
 
@@ -92,31 +101,29 @@ def fold_scan(
 
 @njit(cache=True)
 def _fold_cones(scan, cells, fan, rule, flat, seen_flat):
-    """`fold_scan`'s walk through each beam's cone and its judgement of the cells it takes: one
-    loop nest, its helpers given numbers alone (an array handed to a compiled function costs
-    two atomic reference counts a call, which took 40% of the update when the walk and the
+    """`fold_scan`'s walk through the scan's wedges (`_wedge`: the cones of neighbouring beams
+    that reach about as far, walked as one) and its judgement of the cells it takes: one loop
+    nest, its helpers given numbers alone (an array handed to a compiled function costs two
+    atomic reference counts a call, which took 40% of the update when the walk and the
     judgement were helpers of their own). `flat` and `seen_flat` are the grid and the seen
     mask, flat."""
     x, y, yaw, cell_m, beam, spacing, silent_m, extent2, track_seen = scan
     first_i, first_j, n = cells
     directions, half_before, half_after, bounds, ranges, marks = fan
-    arc_m = ARC_HALF_WIDTH * cell_m
     per_cell = 1.0 / cell_m
     axis0 = yaw + directions[0]
-    judging = (beam, cell_m, arc_m, silent_m, rule[0], rule[1], rule[2])
-    for c in range(directions.shape[0]):
-        if ranges[c] != ranges[c] and silent_m <= 0.0:
-            continue  # a silent beam: no information here
-        band_lo2, band_hi2, clear, show = _cone_reach(
-            ranges[c], marks[c], arc_m, cell_m, silent_m, track_seen
-        )
-        clear2, show2 = clear * clear, show * show
-        reach2 = min(max(band_hi2, clear2, show2), extent2)
-        if reach2 <= 0.0:
+    judging = (beam, cell_m, ARC_HALF_WIDTH * cell_m, silent_m, rule[0], rule[1], rule[2])
+    reach = _cone_bounds(ranges, marks, judging[2], cell_m, silent_m, track_seen, extent2)
+    c = 0
+    while c < directions.shape[0]:
+        if reach[c, 4] <= 0.0:
+            c += 1  # nothing to walk: a silent beam, or an echo inside the robot
             continue
-        axis = yaw + directions[c]
-        start = axis - half_before[c] - ANGLE_MARGIN_RAD
-        span = half_before[c] + half_after[c] + 2 * ANGLE_MARGIN_RAD
+        last, band_lo2, band_hi2, clear2, show2, reach2 = _wedge(
+            c, reach, directions, half_before, half_after, cell_m
+        )
+        start = yaw + directions[c] - half_before[c] - ANGLE_MARGIN_RAD
+        span = directions[last] - directions[c] + half_after[last] + half_before[c] + 2 * ANGLE_MARGIN_RAD
         pieces = max(1, math.ceil(span / QUARTER_TURN))
         width = span / pieces
         for k in range(pieces):  # overlapping a little: rounding drops no cell
@@ -134,14 +141,12 @@ def _fold_cones(scan, cells, fan, rule, flat, seen_flat):
                     dv = (first_v + along + 0.5) * cell_m - vs[0]
                     d2 = du2 + dv * dv
                     index = line * step_u + along * step_v
-                    if not (
-                        band_lo2 <= d2 <= band_hi2
-                        or (d2 < clear2 and flat[index] > 0)
-                        or (track_seen and d2 < show2 and not seen_flat[index])
+                    if not _may_change(
+                        d2, band_lo2, band_hi2, clear2, show2, flat[index], seen_flat[index], track_seen
                     ):
                         continue
                     # The map's rule for this cell, by its nearest direction: judged only in
-                    # the walk of that direction's cone (which holds every cell it can change).
+                    # the walk of the wedge that holds it (which holds every cell it can change).
                     i, j = (line, along) if step_u == n else (along, line)
                     rel_x = (first_i + i + 0.5) * cell_m - x
                     rel_y = (first_j + j + 0.5) * cell_m - y
@@ -150,15 +155,77 @@ def _fold_cones(scan, cells, fan, rule, flat, seen_flat):
                         nearest, offset = nearest_in_ring(angle, axis0, spacing, directions.shape[0])
                     else:
                         nearest, offset = nearest_by_search(angle, bounds, directions)
-                    if nearest != c:
+                    if not (
+                        c <= nearest <= last
+                        and _may_change_by(d2, reach, nearest, flat[index], seen_flat[index], track_seen)
+                    ):
                         continue
-                    reading, marking = ranges[nearest], marks[nearest]
+                    distance = math.hypot(rel_x, rel_y)
                     value, shown = _judged(
-                        flat[index], math.hypot(rel_x, rel_y), offset, reading, marking, judging
+                        flat[index], distance, offset, ranges[nearest], marks[nearest], judging
                     )
                     flat[index] = value
                     if track_seen and shown:
                         seen_flat[index] = True
+        c = last + 1
+
+
+@njit(cache=True, inline="always")
+def _may_change(d2, band_lo2, band_hi2, clear2, show2, value, seen, track_seen):
+    """Whether a cell `d2` (m^2) from the robot, of certainty `value`, may change under a cone
+    (or a wedge) with these squared bounds (`_cone_bounds`): in the arc band, or nearer and
+    marked (an echo clears it), or nearer and not yet seen (with `seen`)."""
+    return (
+        band_lo2 <= d2 <= band_hi2 or (d2 < clear2 and value > 0) or (track_seen and d2 < show2 and not seen)
+    )
+
+
+@njit(cache=True, inline="always")
+def _may_change_by(d2, reach, k, value, seen, track_seen):
+    """`_may_change` under direction `k`'s cone, its bounds `reach[k]` (`_cone_bounds`)."""
+    return _may_change(d2, reach[k, 0], reach[k, 1], reach[k, 2], reach[k, 3], value, seen, track_seen)
+
+
+@njit(cache=True)
+def _cone_bounds(ranges, marks, arc_m, cell_m, silent_m, track_seen, extent2):
+    """Each direction's squared bounds (m^2, `_cone_reach`): the arc band's low and high, how
+    far it clears marked cells, how far it shows unseen ones, and how far its cone is walked (at
+    most `extent2`; 0: not walked)."""
+    reach = np.empty((ranges.shape[0], 5))
+    for c in range(ranges.shape[0]):
+        band_lo2, band_hi2, clear, show = _cone_reach(
+            ranges[c], marks[c], arc_m, cell_m, silent_m, track_seen
+        )
+        clear2, show2 = clear * clear, show * show
+        reach[c, 0], reach[c, 1], reach[c, 2], reach[c, 3] = band_lo2, band_hi2, clear2, show2
+        reach[c, 4] = min(max(band_hi2, clear2, show2), extent2)
+    return reach
+
+
+@njit(cache=True)
+def _wedge(c, reach, directions, half_before, half_after, cell_m):
+    """The wedge walked from direction `c`: it and the next directions whose cones adjoin it,
+    while it spans at most WEDGE_SPAN_RAD and their walked reaches differ by at most
+    WEDGE_SPREAD_CELLS cells (a laser's cones are far narrower than a cell: walked one by one,
+    each grid line of each cone costs a run of a cell or none). The last direction, and the
+    wedge's bounds (m^2): the lowest band's low, the highest band's high, the farthest clear,
+    show and walk."""
+    low = high = math.sqrt(reach[c, 4])
+    last = c
+    while last + 1 < directions.shape[0]:
+        d = last + 1
+        far = math.sqrt(reach[d, 4]) if reach[d, 4] > 0.0 else -math.inf
+        adjoins = directions[d] - half_before[d] <= directions[last] + half_after[last] + ANGLE_MARGIN_RAD
+        span = directions[d] + half_after[d] - (directions[c] - half_before[c])
+        spread = max(high, far) - min(low, far)
+        if not (adjoins and span <= WEDGE_SPAN_RAD and spread <= WEDGE_SPREAD_CELLS * cell_m):
+            break
+        low, high, last = min(low, far), max(high, far), d
+    lo2, hi2, clear2, show2, reach2 = reach[c, 0], reach[c, 1], reach[c, 2], reach[c, 3], reach[c, 4]
+    for d in range(c + 1, last + 1):
+        lo2, hi2 = min(lo2, reach[d, 0]), max(hi2, reach[d, 1])
+        clear2, show2, reach2 = max(clear2, reach[d, 2]), max(show2, reach[d, 3]), max(reach2, reach[d, 4])
+    return last, lo2, hi2, clear2, show2, reach2
 
 
 @njit(cache=True)
