@@ -188,14 +188,19 @@ def scipy_cost_to_go(cost: np.ndarray, targets: np.ndarray, target_costs: np.nda
     return dijkstra(graph, directed=False, indices=nx * ny)[:-1].reshape(nx, ny)
 
 
-@pytest.mark.parametrize("seed", range(6))
-def test_the_compiled_search_equals_scipys_dijkstra_bit_for_bit(seed):
+@pytest.mark.parametrize(
+    ("seed", "least", "spread", "start_span"),
+    [(seed, 1.0, 4.0, 3.0) for seed in range(6)] + [(7, 0.3, 40.0, 30.0), (9, 2.0, 400.0, 300.0)],
+)
+def test_the_compiled_search_equals_scipys_dijkstra_bit_for_bit(seed, least, spread, start_span):
+    """Step costs from `least` to `least + spread`; targets on the edge start up to `start_span`
+    (m) apart, so the bucket queue wraps round its ring and waits for targets far dearer."""
     rng = np.random.default_rng(seed)
-    cost = 1.0 + 4.0 * rng.random((37, 53)) ** 3
+    cost = least + spread * rng.random((37, 53)) ** 3
     cost[rng.random(cost.shape) < 0.3] = np.inf  # walls and islands, some cells cut off
     edge = np.flatnonzero(np.pad(np.zeros((35, 51), bool), 1, constant_values=True))
     targets = edge if seed % 2 else rng.choice(np.flatnonzero(np.isfinite(cost)), 1)
-    starts = rng.uniform(0.0, 3.0, len(targets)) if seed % 2 else np.zeros(1)
+    starts = rng.uniform(0.0, start_span, len(targets)) if seed % 2 else np.zeros(1)
     got = gridsearch.cost_to_go(cost, targets, starts, 0.05)
     expected = scipy_cost_to_go(cost, targets, starts, 0.05)
     assert np.isfinite(got).sum() > 100 and np.isinf(got).any()
@@ -219,6 +224,13 @@ def test_a_search_stopped_at_the_start_gives_the_same_costs_below_it_and_the_sam
     if np.isfinite(full[start_cell]):
         assert np.isinf(stopped).sum() > np.isinf(full).sum()  # it stopped early
     assert gridsearch.descend(stopped, start_cell, 10_000) == gridsearch.descend(full, start_cell, 10_000)
+
+
+def test_the_search_refuses_step_costs_that_are_not_positive():
+    cost = np.ones((5, 5))
+    cost[2, 2] = 0.0
+    with pytest.raises(ValueError, match="positive"):
+        gridsearch.cost_to_go(cost, np.array([0]), np.zeros(1), 0.05)
 
 
 def test_line_of_sight_checks_linspaces_points_every_half_cell():

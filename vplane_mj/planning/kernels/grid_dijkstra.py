@@ -2,8 +2,12 @@
 cell is joined to the targets at all, compiled (`gridsearch.cost_to_go`, `descend`,
 `way_exists`).
 
-The queue is a binary heap of cells, each cell in it at most once (its key lowered in place
-when a cheaper way reaches it), so the heap stays as small as the search's frontier.
+The queue is a ring of buckets (Dial's), each holding the keys of one span of half the cheapest
+move's cost: a cell in the lowest bucket cannot be made cheaper by any other queued cell (each
+of those costs at least the bucket's low, and a move at least two spans), so its cost is final,
+whatever the order a bucket's cells are settled in. Queueing and settling a cell cost O(1),
+where a binary heap's sift moved an entry up and down a dozen levels of the frontier. A cell
+lowered while queued is queued again; its stale entries are passed over.
 """
 
 from __future__ import annotations
@@ -14,16 +18,14 @@ import numpy as np
 from numba import njit
 
 _STEPS = np.array([[-1, -1], [-1, 0], [-1, 1], [0, -1], [0, 1], [1, -1], [1, 0], [1, 1]])
-_NEVER_QUEUED = -1
-_SETTLED = -2
 
 
 @njit(cache=True)
 def cost_to_go(
     cost: np.ndarray, targets: np.ndarray, target_costs: np.ndarray, cell_m: float, stop: int
 ) -> np.ndarray:
-    """Least cost (m) from every cell of `cost` (nx, ny; step costs, inf blocked) to the
-    `targets` (flat indices of free cells, each starting at its `target_costs`, m, at least
+    """Least cost (m) from every cell of `cost` (nx, ny; step costs, positive, inf blocked) to
+    the `targets` (flat indices of free cells, each starting at its `target_costs`, m, at least
     1e-9); inf where none is reachable. With a `stop` cell (a flat index; -1 for none) the
     search ends once that cell is settled: every cell cheaper than it has its least cost, the
     others keep an upper bound (or inf). A move to one of the 8 neighbours costs its length
@@ -32,83 +34,93 @@ def cost_to_go(
     neighbours of theirs plus the move, whatever the order cells are settled in, so it is the
     same, bit for bit, as any other correct Dijkstra's over the same weights."""
     nx, ny = cost.shape
-    dist = np.full(nx * ny, np.inf)
-    slot = np.full(nx * ny, _NEVER_QUEUED)  # each cell's place in the heap, or a state
-    keys = np.empty(nx * ny)
-    cells = np.empty(nx * ny, dtype=np.int64)
-    size = 0
-    for k in range(targets.shape[0]):
-        start = max(target_costs[k], 1e-9)
-        if start < dist[targets[k]]:
-            dist[targets[k]] = start
-            size = _queue(keys, cells, slot, size, targets[k], start)
+    wide = ny + 2
+    step, least, most = _framed(cost)
+    if not least > 0.0:
+        raise ValueError("step costs must be positive")
     diagonal_m = cell_m * math.sqrt(2)
-    while size:
-        d, u = keys[0], cells[0]
-        slot[u] = _SETTLED
+    width = cell_m * least / 2  # each move costs at least twice a bucket's width
+    rings = math.ceil(diagonal_m * most / width) + 2  # a move's cost spans fewer buckets
+    order = np.argsort(target_costs, kind="mergesort")
+    starts = np.maximum(target_costs[order], 1e-9)
+    firsts = ((targets[order] // ny + 1) * wide + targets[order] % ny + 1).astype(np.int64)
+    stop = -1 if stop < 0 else (stop // ny + 1) * wide + stop % ny + 1
+    dist = np.full(step.shape[0], np.inf)
+    settled = np.zeros(step.shape[0], dtype=np.bool_)
+    head = np.full(rings, -1)  # each bucket's last entry, -1: empty
+    entries = targets.shape[0] + 8 * nx * ny  # a cell is queued by a target or by a neighbour settled
+    after, cells, keys = (
+        np.empty(entries, dtype=np.int64),
+        np.empty(entries, dtype=np.int64),
+        np.empty(entries),
+    )
+    used = size = released = 0
+    current = int(starts[0] / width) if starts.shape[0] else 0
+    while True:
+        while released < starts.shape[0] and int(starts[released] / width) < current + rings:
+            if starts[released] < dist[firsts[released]]:
+                dist[firsts[released]] = starts[released]
+                used = _push(head, after, cells, keys, used, firsts[released], starts[released], width)
+                size += 1
+            released += 1
+        if size == 0:
+            if released == starts.shape[0]:
+                break
+            current = max(current + 1, int(starts[released] / width) - rings + 1)
+            continue
+        e = head[current % rings]
+        if e < 0:
+            current += 1
+            continue
+        head[current % rings], u, d = after[e], cells[e], keys[e]
         size -= 1
-        if size:
-            keys[0], cells[0] = keys[size], cells[size]
-            _sift_down(keys, cells, slot, size)
+        if settled[u] or d > dist[u]:
+            continue  # settled already, or queued again cheaper since
+        settled[u] = True
         if u == stop:
             break
-        i, j = u // ny, u % ny
         for s in range(8):
-            a, b = i + _STEPS[s, 0], j + _STEPS[s, 1]
-            if a < 0 or a >= nx or b < 0 or b >= ny or not math.isfinite(cost[a, b]):
-                continue
-            v = a * ny + b
-            if slot[v] == _SETTLED:
+            di, dj = _STEPS[s, 0], _STEPS[s, 1]
+            v = u + di * wide + dj
+            if not math.isfinite(step[v]) or settled[v]:
                 continue
             length = cell_m
-            if a != i and b != j:  # diagonal: both orthogonal neighbours free, no corner cut
-                if not (math.isfinite(cost[a, j]) and math.isfinite(cost[i, b])):
+            if di != 0 and dj != 0:  # diagonal: both orthogonal neighbours free, no corner cut
+                if not (math.isfinite(step[u + di * wide]) and math.isfinite(step[u + dj])):
                     continue
                 length = diagonal_m
-            candidate = d + length * 0.5 * (cost[i, j] + cost[a, b])
+            candidate = d + length * 0.5 * (step[u] + step[v])
             if candidate < dist[v]:
                 dist[v] = candidate
-                size = _queue(keys, cells, slot, size, v, candidate)
-    return dist.reshape(nx, ny)
+                used = _push(head, after, cells, keys, used, v, candidate, width)
+                size += 1
+    return dist.reshape(nx + 2, wide)[1:-1, 1:-1].copy()
 
 
 @njit(cache=True)
-def _queue(keys, cells, slot, size, cell, key):
-    """Queue `cell` with `key`, or lower its key if it is queued already; the heap's new size."""
-    at = slot[cell]
-    if at < 0:
-        at = size
-        size += 1
-    while at > 0:  # sift up
-        parent = (at - 1) >> 1
-        if keys[parent] <= key:
-            break
-        keys[at], cells[at] = keys[parent], cells[parent]
-        slot[cells[at]] = at
-        at = parent
-    keys[at], cells[at] = key, cell
-    slot[cell] = at
-    return size
+def _framed(cost):
+    """The step costs (nx, ny) framed by a blocked cell each side, flat ((nx + 2) (ny + 2)), so
+    that no move needs a bounds check; and the least and the largest finite step cost."""
+    nx, ny = cost.shape
+    step = np.full((nx + 2) * (ny + 2), np.inf)
+    least, most = np.inf, 0.0
+    for i in range(nx):
+        for j in range(ny):
+            c = cost[i, j]
+            step[(i + 1) * (ny + 2) + j + 1] = c
+            if c < np.inf:
+                least, most = min(least, c), max(most, c)
+    return step, least, most
 
 
-@njit(cache=True)
-def _sift_down(keys, cells, slot, size):
-    """Move the heap's first entry down to its place."""
-    key, cell = keys[0], cells[0]
-    at = 0
-    while True:
-        child = 2 * at + 1
-        if child >= size:
-            break
-        if child + 1 < size and keys[child + 1] < keys[child]:
-            child += 1
-        if key <= keys[child]:
-            break
-        keys[at], cells[at] = keys[child], cells[child]
-        slot[cells[at]] = at
-        at = child
-    keys[at], cells[at] = key, cell
-    slot[cell] = at
+@njit(cache=True, inline="always")
+def _push(head, after, cells, keys, used, cell, key, width):
+    """Queue `cell` at `key` in its bucket (entry `used`, put before the bucket's others); the
+    entries used now."""
+    bucket = int(key / width) % head.shape[0]
+    after[used], cells[used], keys[used] = head[bucket], cell, key
+    head[bucket] = used
+    return used + 1
 
 
 @njit(cache=True)
