@@ -69,6 +69,9 @@ BEND_HORIZON_M = 3.0
 """The way this far ahead (m) bounds the speed by the turns it asks for (motion.py)."""
 TRAP_REACH_M = 2.5
 """Obstacle cells farther than this from the robot are not part of the trap it is in."""
+NO_WAY = np.empty((0, 2))
+NO_WAY.flags.writeable = False
+"""An empty way (K = 0 waypoints): ways are (K, 2) arrays of waypoints (m), never written."""
 
 
 def plane_refused(e1: np.ndarray, e2: np.ndarray, why: str) -> Event:
@@ -149,9 +152,9 @@ class VPlanePlusPlanner(VPlanePlanner):
             track_seen=True,
             silent_free_m=SILENT_FREE_M,
         )
-        self.escape_way: list[np.ndarray] = []  # waypoints (m) to the virtual objective
+        self.escape_way = NO_WAY  # waypoints (K, 2; m) to the virtual objective
         self.following = False
-        self.follow_way: list[np.ndarray] = []
+        self.follow_way = NO_WAY
         self.next_replan_s = 0.0
         self.no_way_since: float | None = None
         self.sight: gridsearch.Window | None = None  # the window of the latest way, for sight lines
@@ -177,7 +180,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             if self.following:
                 # Held up on the way: the map missed something there. Charge for passing that
                 # place again, and look for a way at once.
-                stuck_at = self._next_waypoint(obs.position, self.follow_way, obs.goal)
+                stuck_at, self.follow_way = self._next_waypoint(obs.position, self.follow_way, obs.goal)
                 self.stalls.append(stuck_at)
                 decision.events.append(
                     Event(
@@ -202,17 +205,18 @@ class VPlanePlusPlanner(VPlanePlanner):
             decision.mode = "escaping"
             if self._way_is_blocked(obs.position, self.escape_way):
                 window = self._window(obs.position, self.temp_goal, self.planes, margin=p.search_margin_m)
-                self.escape_way = self._way(window, obs.position, self.temp_goal) or []
-            target = self._next_waypoint(obs.position, self.escape_way, self.temp_goal)
+                self.escape_way = _or_none(self._way(window, obs.position, self.temp_goal))
+            target, self.escape_way = self._next_waypoint(obs.position, self.escape_way, self.temp_goal)
             pull = 2.0 * p.vno_gain * float(np.hypot(*(obs.position - self.temp_goal)))  # eq. 7
-            self._along_the_way(obs, components, target, pull, bool(self.escape_way))
+            self._along_the_way(obs, components, target, pull, len(self.escape_way) > 0)
         elif self.following:
             decision.mode = "following"
             target = self._follow_target(obs, decision)
             if decision.gave_up:
                 return decision
             goal_pull = fields.attractive_force(obs.position, obs.goal, p.attract_gain, p.attract_radius)
-            self._along_the_way(obs, components, target, float(np.hypot(*goal_pull)), bool(self.follow_way))
+            on_a_way = len(self.follow_way) > 0
+            self._along_the_way(obs, components, target, float(np.hypot(*goal_pull)), on_a_way)
         else:
             components.update(self._firas(obs))
             self._update_avoidance(obs, decision)
@@ -303,10 +307,10 @@ class VPlanePlusPlanner(VPlanePlanner):
         if self.governor.idle:
             return Steering(force)
         cells = self._mapped_cells_near(obs.position, self.governor.reach_m)
-        way = self.escape_way if self.temp_goal is not None else self.follow_way if self.following else []
+        way = self.escape_way if self.temp_goal is not None else self.follow_way if self.following else NO_WAY
         speed = math.inf
-        if way:
-            ahead = np.array(way)
+        if len(way):
+            ahead = way
             travelled = np.cumsum(np.hypot(*np.diff(np.vstack((obs.position, ahead)), axis=0).T))
             speed = self.governor.policy.bend_speed(obs.position, obs.yaw, ahead[travelled <= BEND_HORIZON_M])
         points = np.vstack((obs.echo_points(), cells))
@@ -317,14 +321,11 @@ class VPlanePlusPlanner(VPlanePlanner):
         `reach_m` around a point (m)."""
         return self.map.cells(self.params.map_threshold, position, reach_m, skip_swept=True)[0]
 
-    def _way_is_blocked(self, position: np.ndarray, way: list[np.ndarray]) -> bool:
+    def _way_is_blocked(self, position: np.ndarray, way: np.ndarray) -> bool:
         """Whether a mapped obstacle cell now lies within the robot's half width of the way's next
         `BLOCK_LOOKAHEAD_M` (the sonar has seen something new on it): the robot drives along the
         way aligned with it."""
-        if not way:
-            return False
-        points = np.asarray(way)
-        points = points[np.hypot(*(points - position).T) <= BLOCK_LOOKAHEAD_M]
+        points = way[np.hypot(*(way - position).T) <= BLOCK_LOOKAHEAD_M]
         if not len(points):
             return False
         cells = self._mapped_cells_near(position, BLOCK_LOOKAHEAD_M + self.radius)
@@ -389,7 +390,7 @@ class VPlanePlusPlanner(VPlanePlanner):
     def _finish_escape(self, obs: Observation, decision: Decision) -> None:
         """Objective reached: re-activate the target and add the plane to L, unless the map
         then holds no way from here to the goal (the plane would cut the only known way)."""
-        plane, self.temp_goal, self.pending_plane, self.escape_way = self.pending_plane, None, None, []
+        plane, self.temp_goal, self.pending_plane, self.escape_way = self.pending_plane, None, None, NO_WAY
         self.detector.reset()
         decision.escape_completed = True
         if plane is None:
@@ -467,15 +468,15 @@ class VPlanePlusPlanner(VPlanePlanner):
         plane: VirtualPlane | None,
         clearance: float,
         window: gridsearch.Window,
-    ) -> tuple[np.ndarray | None, list[np.ndarray]]:
+    ) -> tuple[np.ndarray | None, np.ndarray]:
         """The paper's objective if the map has seen it free, clear of obstacles and reachable,
         else the nearest such cell outside the trap; with the map's way there. (None, []) when
-        there is none."""
+        there is none (NO_WAY: an empty way)."""
         from vplane_mj.planning.kernels.edt import distance_transform  # numba: loaded by the first call
 
         start = window.free_cell_near(robot, 2 * self.radius)
         if start is None:
-            return None, []
+            return None, NO_WAY
         origin = np.array([np.ravel_multi_index(start, window.cost.shape)])
         costs = gridsearch.cost_to_go(window.cost, origin, np.zeros(1), window.cell_m)
         # Known free with room around it: far enough from mapped obstacles and from every cell
@@ -493,14 +494,14 @@ class VPlanePlusPlanner(VPlanePlanner):
         cell = window.cell_of(candidate)
         if cell is None or not usable[cell]:
             if not usable.any():
-                return None, []
+                return None, NO_WAY
             distance = np.hypot(*np.moveaxis(centres - candidate, -1, 0))
             i, j = np.unravel_index(int(np.argmin(np.where(usable, distance, np.inf))), distance.shape)
             cell = (int(i), int(j))
             candidate = window.centre(cell)
         # A usable cell is reachable from the robot's, so the map has a way there; an empty way
         # (straight to the objective) only if not, as when an escape's way is searched again.
-        return candidate, self._way(window, robot, candidate) or []
+        return candidate, _or_none(self._way(window, robot, candidate))
 
     # -- following the map's way -------------------------------------------------------------
     def _start_following(self, obs: Observation, decision: Decision, why: str) -> None:
@@ -517,9 +518,9 @@ class VPlanePlusPlanner(VPlanePlanner):
         attracted to the goal itself, and gives up after `no_way_patience_s`.
         """
         p = self.params
-        waypoint = self._next_waypoint(obs.position, self.follow_way, obs.goal)
+        waypoint, self.follow_way = self._next_waypoint(obs.position, self.follow_way, obs.goal)
         if obs.time_s < self.next_replan_s:
-            if not self.follow_way or not self._way_is_blocked(obs.position, self.follow_way):
+            if not len(self.follow_way) or not self._way_is_blocked(obs.position, self.follow_way):
                 return waypoint
             decision.events.append(
                 Event(EventKind.WAY_CHANGED, "the way ahead is blocked on the map: searched again")
@@ -527,7 +528,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         self.next_replan_s = obs.time_s + p.replan_period_s
         way = self._way_to_goal(obs, decision)
         if way is None:
-            self.follow_way = []
+            self.follow_way = NO_WAY
             if self.no_way_since is None:
                 self.no_way_since = obs.time_s
                 decision.events.append(Event(EventKind.WAY_CHANGED, "the map holds no way to the goal"))
@@ -543,18 +544,19 @@ class VPlanePlusPlanner(VPlanePlanner):
         if self.no_way_since is not None:
             decision.events.append(Event(EventKind.WAY_CHANGED, "the map shows a way to the goal again"))
         self.no_way_since = None
-        kept = self._way_cost(obs.position, self.follow_way, obs.goal) if self.follow_way else np.inf
+        kept = self._way_cost(obs.position, self.follow_way, obs.goal) if len(self.follow_way) else np.inf
         if kept > KEEP_WAY_RATIO * self._way_cost(obs.position, way, obs.goal):
             self.follow_way = way  # else the current way stays: no flip-flop between similar ways
-        return self._next_waypoint(obs.position, self.follow_way, obs.goal)
+        waypoint, self.follow_way = self._next_waypoint(obs.position, self.follow_way, obs.goal)
+        return waypoint
 
-    def _way_cost(self, position: np.ndarray, way: list[np.ndarray], goal: np.ndarray) -> float:
+    def _way_cost(self, position: np.ndarray, way: np.ndarray, goal: np.ndarray) -> float:
         """What a way to the goal costs from `position`: along it on the map, then from its end to
         the goal in a straight line (a way ends short of the goal where the goal lies off the map)."""
         assert self.sight is not None, "the search that found a way keeps its window as the sight"
-        return self.sight.path_cost(np.array([position, *way])) + float(np.hypot(*(goal - way[-1])))
+        return self.sight.path_cost(np.vstack((position, way))) + float(np.hypot(*(goal - way[-1])))
 
-    def _way_to_goal(self, obs: Observation, decision: Decision) -> list[np.ndarray] | None:
+    def _way_to_goal(self, obs: Observation, decision: Decision) -> np.ndarray | None:
         """The map's way to the goal with the planes as walls; planes that leave no way are
         retired (newest first); without planes, places held up twice are only dear instead of
         walls. None when the map holds no way even so."""
@@ -567,7 +569,9 @@ class VPlanePlusPlanner(VPlanePlanner):
                 )
             )
             way = self._find_way(obs.position, obs.goal, self.planes)
-        return way or self._find_way(obs.position, obs.goal, self.planes, relaxed=True)
+        if way is None or not len(way):  # none, or one that ends where the robot stands
+            way = self._find_way(obs.position, obs.goal, self.planes, relaxed=True)
+        return way
 
     def _find_way(
         self,
@@ -575,7 +579,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         goal: np.ndarray,
         planes: list[VirtualPlane],
         relaxed: bool = False,
-    ) -> list[np.ndarray] | None:
+    ) -> np.ndarray | None:
         """The map's way from the robot to the goal: searched near them first (quick), then over
         the whole map before concluding there is none."""
         for margin in (self.params.search_margin_m, None):
@@ -643,31 +647,38 @@ class VPlanePlusPlanner(VPlanePlanner):
         lethal = self.robot.half_width_m + self.params.path_clearance_m
         return lethal if self.robot.disc else lethal + self.params.turn_margin_m
 
-    def _way(self, window: gridsearch.Window, start: np.ndarray, end: np.ndarray) -> list[np.ndarray] | None:
-        """Waypoints (m) of the map's shortest way from `start` to `end` (beyond the window:
+    def _way(self, window: gridsearch.Window, start: np.ndarray, end: np.ndarray) -> np.ndarray | None:
+        """Waypoints (K, 2; m) of the map's shortest way from `start` to `end` (beyond the window:
         toward it in a straight line from the window's edge); None when there is none."""
         cells = gridsearch.way_to(window, start, end, self.radius)
         if cells is None:
             return None
-        way = list(window.centres_of(cells[1:]))
+        way = window.centres_of(cells[1:])
         if window.cell_of(end) is not None:
-            way.append(np.asarray(end, float))
+            way = np.vstack((way, np.asarray(end, float)))
         self.sight = window
         return way
 
-    def _next_waypoint(self, position: np.ndarray, way: list[np.ndarray], end: np.ndarray) -> np.ndarray:
-        """The farthest point of the way within `waypoint_m` that the robot sees in a straight
-        line on the map; the way's end when the way is empty. The points before the one nearest
-        the robot are dropped from `way`: the robot has passed them."""
-        if not way:
-            return end
+    def _next_waypoint(
+        self, position: np.ndarray, way: np.ndarray, end: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The farthest point of the way (K, 2; m) within `waypoint_m` that the robot sees in a
+        straight line on the map (the way's end when the way is empty), and the way without the
+        points before the one nearest the robot: the robot has passed them."""
+        if not len(way):
+            return end, way
         reach = self.params.waypoint_m
-        distances = np.hypot(*(np.array(way) - position).T)
+        distances = np.hypot(*(way - position).T)
         nearest = int(np.argmin(distances))
-        del way[:nearest]  # the robot has passed these
+        way = way[nearest:]  # the robot has passed the points before
         beyond = np.flatnonzero(distances[nearest + 1 :] > reach)
         within = 1 + (int(beyond[0]) if len(beyond) else len(way) - 1)  # the leading run within reach
         for k in range(within - 1, 0, -1):  # the farthest first
             if self.sight is None or self.sight.line_of_sight(position, way[k]):
-                return way[k]
-        return way[0]
+                return way[k], way
+        return way[0], way
+
+
+def _or_none(way: np.ndarray | None) -> np.ndarray:
+    """The way, or NO_WAY for none."""
+    return NO_WAY if way is None else way
