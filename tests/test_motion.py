@@ -13,6 +13,7 @@ from vplane_mj.planning import motion, scan
 from vplane_mj.planning.body import DriveLimits, HeadingGains, RobotBody
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Observation
+from vplane_mj.planning.vectors import wrap_angle
 from vplane_mj.robots.facts import robot_body
 
 JACKAL = robot_body("jackal")
@@ -249,6 +250,39 @@ def test_the_speed_policy_slows_for_the_ways_bends():
     corner = np.vstack((straight[:4], np.column_stack((np.full(20, 0.4), np.linspace(0.1, 2.0, 20)))))
     assert policy.bend_speed(np.zeros(2), 0.0, straight) == 2.0
     assert policy.bend_speed(np.zeros(2), 0.0, corner) < 1.5
+
+
+def _bend_speed_by_numpy(body, position, yaw, way, horizon_m):
+    """`SpeedPolicy.bend_speed` as numpy writes its rule: the points within `horizon_m` along the
+    way, those beyond the robot's radius along it, each one's turn and the time to turn it."""
+    limits = body.limits
+    travelled = np.cumsum(np.hypot(*np.diff(np.vstack((position, way)), axis=0).T))
+    way, travelled = way[travelled <= horizon_m], travelled[travelled <= horizon_m]
+    beyond = travelled >= body.radius_m
+    if not beyond.any():
+        return limits.max_speed_mps
+    rel = way[beyond] - position
+    turn = np.abs(wrap_angle(np.arctan2(rel[:, 1], rel[:, 0]) - yaw))
+    rate, accel = limits.max_turn_rate_radps, limits.max_turn_accel_radps2
+    time = np.where(
+        turn <= rate * rate / (2 * accel), np.sqrt(2 * turn / accel), turn / rate + rate / (2 * accel)
+    )
+    return float(min(limits.max_speed_mps, (travelled[beyond] / np.maximum(time, 1e-9)).min()))
+
+
+def test_the_compiled_bend_speed_is_numpys_rule_bit_for_bit():
+    rng = np.random.default_rng(5)
+    policy = motion.SpeedPolicy(JACKAL)
+    slowed = 0
+    for _ in range(2000):
+        count = int(rng.integers(0, 60))
+        way = np.cumsum(rng.normal(0.0, 0.08, (count, 2)) + rng.normal(0.0, 0.05, 2), axis=0)
+        position, yaw = rng.normal(0.0, 0.05, 2), float(rng.uniform(-4.0, 4.0))
+        horizon = float(rng.choice([0.5, 3.0, math.inf]))
+        got = policy.bend_speed(position, yaw, way, horizon)
+        assert got == _bend_speed_by_numpy(JACKAL, position, yaw, way, horizon)
+        slowed += got < JACKAL.limits.max_speed_mps
+    assert 200 < slowed < 1900  # bends that slow the robot and ways that do not
 
 
 def test_a_dense_scan_repels_through_its_nearest_echo_per_ring_sector():

@@ -226,6 +226,22 @@ def test_a_search_stopped_at_the_start_gives_the_same_costs_below_it_and_the_sam
     assert gridsearch.descend(stopped, start_cell, 10_000) == gridsearch.descend(full, start_cell, 10_000)
 
 
+def test_the_way_ahead_is_blocked_where_numpys_distances_say():
+    from vplane_mj.planning.kernels import way as way_kernels
+
+    rng = np.random.default_rng(11)
+    found = 0
+    for _ in range(3000):
+        way = np.cumsum(rng.normal(0.0, 0.1, (int(rng.integers(0, 30)), 2)), axis=0)
+        cells = rng.uniform(-1.0, 1.0, (int(rng.integers(0, 40)), 2))
+        near = way[np.hypot(*way.T) <= 0.6]
+        gaps = np.hypot(*(cells[:, None, :] - near[None, :, :]).transpose(2, 0, 1))
+        expected = bool(gaps.size and gaps.min() < 0.2)
+        assert way_kernels.blocked(0.0, 0.0, way, 0.6, cells, 0.2) == expected
+        found += expected
+    assert 300 < found < 2700
+
+
 def test_the_search_refuses_step_costs_that_are_not_positive():
     cost = np.ones((5, 5))
     cost[2, 2] = 0.0

@@ -292,7 +292,9 @@ class SpeedPolicy:
         limits = self.body.limits
         return limits.max_speed_mps**2 / (2 * limits.max_accel_mps2) > SHAPED_STOP_M
 
-    def bend_speed(self, position: np.ndarray, yaw: float, way: np.ndarray) -> float:
+    def bend_speed(
+        self, position: np.ndarray, yaw: float, way: np.ndarray, horizon_m: float = math.inf
+    ) -> float:
         """The largest speed (m/s, at most the top speed) at which the robot at `position`, `yaw`
         turns to face each point of `way` (N, 2; world, m, in order along it) before it has
         travelled the way's length to that point: v <= s / t(theta), s that length, theta the
@@ -300,21 +302,22 @@ class SpeedPolicy:
         the top turn acceleration alpha and limited to the top turn rate w: sqrt(2 theta / alpha)
         up to theta = w^2 / 2 alpha, theta / w + w / 2 alpha beyond. Points
         within the robot's circumscribed radius along the way do not count: the robot steers
-        for points beyond its own outline."""
+        for points beyond its own outline; nor do points beyond `horizon_m` (m) along it
+        (`kernels.way`)."""
+        from vplane_mj.planning.kernels import way as way_kernels  # numba: loaded by the first call
+
         limits = self.body.limits
-        steps = np.diff(np.vstack((position, way)), axis=0)
-        travelled = np.cumsum(np.hypot(steps[:, 0], steps[:, 1]))
-        beyond = travelled >= self.body.radius_m
-        if not beyond.any():
-            return limits.max_speed_mps
-        way, travelled = way[beyond], travelled[beyond]
         rel = way - position
-        turn = np.abs(wrap_angle(np.arctan2(rel[:, 1], rel[:, 0]) - yaw))
-        rate, accel = limits.max_turn_rate_radps, limits.max_turn_accel_radps2
-        time = np.where(
-            turn <= rate * rate / (2 * accel), np.sqrt(2 * turn / accel), turn / rate + rate / (2 * accel)
+        return way_kernels.bend_speed(
+            float(position[0]),
+            float(position[1]),
+            float(yaw),
+            np.ascontiguousarray(way, float),
+            np.arctan2(rel[:, 1], rel[:, 0]),
+            float(horizon_m),
+            float(self.body.radius_m),
+            (limits.max_speed_mps, limits.max_turn_rate_radps, limits.max_turn_accel_radps2),
         )
-        return float(min(limits.max_speed_mps, (travelled / np.maximum(time, 1e-9)).min()))
 
     def magnitude(self, speed_mps: float) -> float:
         """The force magnitude that asks the heading controller for `speed_mps` when aligned."""

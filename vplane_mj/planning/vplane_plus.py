@@ -308,11 +308,11 @@ class VPlanePlusPlanner(VPlanePlanner):
             return Steering(force)
         cells = self._mapped_cells_near(obs.position, self.governor.reach_m)
         way = self.escape_way if self.temp_goal is not None else self.follow_way if self.following else NO_WAY
-        speed = math.inf
-        if len(way):
-            ahead = way
-            travelled = np.cumsum(np.hypot(*np.diff(np.vstack((obs.position, ahead)), axis=0).T))
-            speed = self.governor.policy.bend_speed(obs.position, obs.yaw, ahead[travelled <= BEND_HORIZON_M])
+        speed = (
+            self.governor.policy.bend_speed(obs.position, obs.yaw, way, BEND_HORIZON_M)
+            if len(way)
+            else math.inf
+        )
         points = np.vstack((obs.echo_points(), cells))
         return self.governor.steer(force, obs, points, speed)
 
@@ -325,14 +325,11 @@ class VPlanePlusPlanner(VPlanePlanner):
         """Whether a mapped obstacle cell now lies within the robot's half width of the way's next
         `BLOCK_LOOKAHEAD_M` (the sonar has seen something new on it): the robot drives along the
         way aligned with it."""
-        points = way[np.hypot(*(way - position).T) <= BLOCK_LOOKAHEAD_M]
-        if not len(points):
-            return False
+        from vplane_mj.planning.kernels import way as way_kernels  # numba: loaded by the first call
+
         cells = self._mapped_cells_near(position, BLOCK_LOOKAHEAD_M + self.radius)
-        if not len(cells):
-            return False
-        gaps = np.hypot(*(cells[:, None, :] - points[None, :, :]).transpose(2, 0, 1))
-        return bool(gaps.min() < self.robot.half_width_m)
+        x, y = float(position[0]), float(position[1])
+        return way_kernels.blocked(x, y, way, BLOCK_LOOKAHEAD_M, cells, self.robot.half_width_m)
 
     def _nearest_cell_force(self, position: np.ndarray) -> np.ndarray:
         """FIRAS repulsion (eq. 5) of the nearest mapped obstacle cell within `guard_m`: the map
