@@ -22,11 +22,13 @@ def distance_transform(free: np.ndarray) -> np.ndarray:
         return np.full((nx, ny), np.inf)
     far = nx + ny  # farther than any cell of the grid
     column = np.empty((nx, ny), dtype=np.int64)  # distance along axis 0 to the nearest non-free cell
-    for j in range(ny):
+    for j in range(ny):  # down the columns, then back up, a row at a time (the grid's order)
         column[0, j] = far if free[0, j] else 0
-        for i in range(1, nx):
+    for i in range(1, nx):
+        for j in range(ny):
             column[i, j] = min(column[i - 1, j] + 1, far) if free[i, j] else 0
-        for i in range(nx - 2, -1, -1):
+    for i in range(nx - 2, -1, -1):
+        for j in range(ny):
             if column[i + 1, j] < column[i, j]:
                 column[i, j] = column[i + 1, j] + 1
     out = np.empty((nx, ny))
@@ -37,31 +39,34 @@ def distance_transform(free: np.ndarray) -> np.ndarray:
         count = 0
         apex[0], start[0] = 0, 0
         for u in range(1, ny):
-            while count >= 0 and _height(start[count], apex[count], g) > _height(start[count], u, g):
+            while count >= 0 and _height(start[count], apex[count], g[apex[count]]) > _height(
+                start[count], u, g[u]
+            ):
                 count -= 1
             if count < 0:
                 count = 0
                 apex[0], start[0] = u, 0
             else:
-                w = 1 + _separation(apex[count], u, g)
+                w = 1 + _separation(apex[count], u, g[apex[count]], g[u])
                 if w < ny:
                     count += 1
                     apex[count], start[count] = u, w
         for u in range(ny - 1, -1, -1):
-            out[i, u] = math.sqrt(float(_height(u, apex[count], g)))
+            out[i, u] = math.sqrt(float(_height(u, apex[count], g[apex[count]])))
             if u == start[count]:
                 count -= 1
     return out
 
 
 @njit(cache=True)
-def _height(x, apex, g):
+def _height(x, apex, g_apex):
     """The squared distance (cells^2) from column x of a row to the nearest non-free cell of
-    column `apex` (its distance g[apex] along the column)."""
-    return (x - apex) * (x - apex) + g[apex] * g[apex]
+    column `apex` (its distance `g_apex` along the column)."""
+    return (x - apex) * (x - apex) + g_apex * g_apex
 
 
 @njit(cache=True)
-def _separation(a, b, g):
-    """The last column (a < b) at which the parabola of `a` is at most that of `b`."""
-    return (b * b - a * a + g[b] * g[b] - g[a] * g[a]) // (2 * (b - a))
+def _separation(a, b, g_a, g_b):
+    """The last column (a < b) at which the parabola of `a` (its column's distance `g_a`) is at
+    most that of `b` (`g_b`)."""
+    return (b * b - a * a + g_b * g_b - g_a * g_a) // (2 * (b - a))
