@@ -157,6 +157,45 @@ def test_costs_block_the_disc_and_charge_for_closeness():
     assert np.isfinite(soft).all() and soft[20, 5] > 20  # doubtful: passable at a price
 
 
+def _step_costs_by_numpy(sure, doubtful, cell_m, lethal_m, inflation_m, weight, doubt_cost):
+    """`gridsearch.step_costs`' rule in numpy's element-wise arithmetic, on scipy's distances."""
+    from scipy import ndimage
+
+    cost = np.ones(sure.shape)
+    occupied = sure | doubtful
+    if not occupied.any():
+        return cost
+    d = ndimage.distance_transform_edt(~occupied) * cell_m
+    closeness = np.clip((lethal_m + inflation_m - d) / inflation_m, 0.0, 1.0)
+    cost += weight * closeness**2 + np.where(d < lethal_m, doubt_cost, 0.0)
+    if sure.any():
+        sure_d = d if not doubtful.any() else ndimage.distance_transform_edt(~sure) * cell_m
+        cost[sure_d < lethal_m] = np.inf
+    return cost
+
+
+def test_the_compiled_step_costs_are_numpys_arithmetic_bit_for_bit():
+    rng = np.random.default_rng(1)
+    for _ in range(300):
+        shape = tuple(int(k) for k in rng.integers(1, 50, 2))
+        sure = rng.random(shape) < rng.choice([0.0, 0.01, 0.05, 0.2])
+        doubtful = (rng.random(shape) < rng.choice([0.0, 0.01, 0.05])) & ~sure
+        cell, lethal, inflation = (
+            float(rng.choice([0.05, 0.1])),
+            rng.uniform(0.05, 0.4),
+            rng.uniform(0.05, 0.5),
+        )
+        args = (
+            cell,
+            float(lethal),
+            float(inflation),
+            float(rng.uniform(0, 8)),
+            float(rng.choice([0.0, 20.0])),
+        )
+        got = gridsearch.step_costs(sure, doubtful, *args)
+        np.testing.assert_array_equal(got, _step_costs_by_numpy(sure, doubtful, *args))
+
+
 def scipy_cost_to_go(cost: np.ndarray, targets: np.ndarray, target_costs: np.ndarray, cell_m: float):
     """`gridsearch.cost_to_go` by scipy's Dijkstra over the explicit grid graph: every move
     between free cells, a diagonal only across a free 2 x 2 square, weighted by its length times

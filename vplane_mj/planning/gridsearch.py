@@ -1,6 +1,6 @@
 """Shortest ways over the sonar map: where the robot's disc fits, and the cost to go to a target.
 
-numpy, a compiled distance transform and a compiled Dijkstra. Each cell gets a step cost from its
+Compiled step costs and Dijkstra, numpy between them. Each cell gets a step cost from its
 distance to the nearest obstacle cell (`step_costs`): infinite (blocked) closer than the
 robot's radius plus a clearance, 1 far from obstacles, and rising in between, so ways keep
 their distance where there is room and still pass a narrow gap when it is the only one (a
@@ -40,19 +40,17 @@ def step_costs(
     than that to a `doubtful` one (a way through it is tried only when no other is known, and
     the sonar settles the doubt on the way); 1 + w ((lethal + inflation - d) / inflation)^2
     within `inflation_m` beyond the lethal distance of either kind; 1 farther."""
-    from vplane_mj.planning.kernels.edt import distance_transform  # numba: loaded by the first call
+    from vplane_mj.planning.kernels import step_costs as kernels  # numba: loaded by the first call
 
-    cost = np.ones(sure.shape)
-    occupied = sure | doubtful
-    if not occupied.any():
-        return cost
-    d = distance_transform(~occupied) * cell_m
-    closeness = np.clip((lethal_m + inflation_m - d) / inflation_m, 0.0, 1.0)
-    cost += inflation_weight * closeness**2 + np.where(d < lethal_m, doubt_cost, 0.0)
-    if sure.any():
-        sure_d = d if not doubtful.any() else distance_transform(~sure) * cell_m  # the same cells: the same d
-        cost[sure_d < lethal_m] = np.inf
-    return cost
+    return kernels.step_costs(
+        np.ascontiguousarray(sure, bool),
+        np.ascontiguousarray(doubtful, bool),
+        float(cell_m),
+        float(lethal_m),
+        float(inflation_m),
+        float(inflation_weight),
+        float(doubt_cost),
+    )
 
 
 def clear_step_cost(beyond_lethal_m: float, inflation_m: float, inflation_weight: float) -> float:
