@@ -373,6 +373,29 @@ def test_the_memory_kernel_recalls_as_numpy_does(count, view):
     np.testing.assert_array_equal(kept, want[np.sort(first)])
 
 
+@pytest.mark.parametrize(("yaw", "low", "span"), [(2.9, -2.4, 4.8), (-0.4, 0.3, 0.5), (1.0, -3.0, math.pi)])
+def test_points_on_the_edges_of_the_view_are_judged_by_the_angles_rule(yaw, low, span):
+    """Points on, and a hair's breadth off, each edge of the view (and opposite them): in view
+    exactly when their bearing past `low`, modulo a turn, is at most `span` (the C library's
+    arctangent and Python's modulo, as the kernel takes them there)."""
+    from vplane_mj.planning.kernels import memory
+
+    rng = np.random.default_rng(int(100 * span))
+    hairs = np.array([0.0, 1e-15, -1e-15, 1e-12, -1e-12, 1e-9, -1e-9, 1e-7, -1e-7])
+    edges = yaw + low + np.array([0.0, span, math.pi, span + math.pi])
+    angles = np.concatenate(((edges[:, None] + hairs).ravel(), rng.uniform(-4, 4, 200)))
+    radii = rng.uniform(0.05, 2.5, len(angles))
+    x, y = 0.3, -0.2
+    remembered = np.column_stack((x + radii * np.cos(angles), y + radii * np.sin(angles)))
+    unseen = [not ((math.atan2(py - y, px - x) - yaw - low) % (2 * math.pi) <= span) for px, py in remembered]
+    assert 0 < sum(unseen) < len(unseen)
+    local, _ = memory.recall(np.empty((0, 2)), remembered, x, y, yaw, 3.0, -1, low, span, 0.001)
+    rel, c, s = remembered[unseen] - (x, y), math.cos(yaw), math.sin(yaw)
+    np.testing.assert_array_equal(
+        local, np.column_stack((c * rel[:, 0] + s * rel[:, 1], -s * rel[:, 0] + c * rel[:, 1]))
+    )
+
+
 def test_gaps_are_sized_by_the_robots_width_and_the_default_robot_keeps_its_radius():
     narrow = RobotBody.polygon([[0.4, 0.1], [-0.4, 0.1], [-0.4, -0.1], [0.4, -0.1]])
     assert narrow.half_width_m == pytest.approx(0.1) and narrow.radius_m > 0.4

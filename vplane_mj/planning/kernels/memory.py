@@ -11,6 +11,10 @@ from numba import njit
 
 from vplane_mj.planning.kernels.map_update import remainder_of_turn
 
+SURE_RAD = 1e-9
+"""A point more than this (rad) off both edges of the view lies surely on its side of each: the
+rule's own rounding (of its arctangent and differences of angles) is some 1e-14 rad."""
+
 
 @njit(cache=True)
 def recall(
@@ -33,13 +37,15 @@ def recall(
     -1: a point's bearing (rad, robot frame) is in view when its angle past `low`, modulo a
     turn (`map_update.remainder_of_turn`, numpy's mod bit for bit), is at most `span`."""
     unseen = np.zeros(remembered.shape[0], dtype=np.bool_)
+    edges = (math.cos(yaw + low), math.sin(yaw + low), math.cos(yaw + low + span), math.sin(yaw + low + span))
     for k in range(remembered.shape[0]):
         rel_x, rel_y = remembered[k, 0] - x, remembered[k, 1] - y
-        if math.hypot(rel_x, rel_y) < reach_m:
+        distance = math.hypot(rel_x, rel_y)
+        if distance < reach_m:
             if view == 0:
                 unseen[k] = True
             elif view < 0:
-                unseen[k] = not (remainder_of_turn(math.atan2(rel_y, rel_x) - yaw - low) <= span)
+                unseen[k] = not _in_view(rel_x, rel_y, distance, yaw, low, span, edges)
     known = np.concatenate((points, remembered[unseen]))
     c, s = math.cos(yaw), math.sin(yaw)
     local = np.empty_like(known)
@@ -48,6 +54,25 @@ def recall(
         local[k, 0] = c * rel_x + s * rel_y
         local[k, 1] = -s * rel_x + c * rel_y
     return local, known[_first_in_each_cell(known, cell_m)]
+
+
+@njit(cache=True)
+def _in_view(rel_x, rel_y, distance, yaw, low, span, edges):
+    """Whether the point (`rel_x`, `rel_y`; m from the robot, `distance` away) is in view: its
+    bearing past `low` (rad, robot frame; the robot heading `yaw`), modulo a turn, at most
+    `span`. Decided by which side of the view's two edges (`edges`: the unit vectors of its
+    first and last bearing, world) it lies on, wherever it lies surely off both (more than
+    SURE_RAD); on an edge, by the angles themselves (the rule's own arithmetic: an arctangent
+    costs some twenty products)."""
+    first_x, first_y, last_x, last_y = edges
+    past_first = first_x * rel_y - first_y * rel_x  # > 0: counter-clockwise of the first edge
+    past_last = last_x * rel_y - last_y * rel_x
+    sure = SURE_RAD * distance
+    if abs(past_first) > sure and abs(past_last) > sure:
+        if span > math.pi:  # out of view: in the gap, past the last edge and short of the first
+            return not (past_last > 0.0 and past_first < 0.0)
+        return past_first > 0.0 and past_last < 0.0
+    return remainder_of_turn(math.atan2(rel_y, rel_x) - yaw - low) <= span
 
 
 @njit(cache=True)
