@@ -13,7 +13,7 @@ from vplane_mj.planning import motion, scan
 from vplane_mj.planning.body import DriveLimits, HeadingGains, RobotBody
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Observation
-from vplane_mj.planning.vectors import wrap_angle
+from vplane_mj.planning.vectors import evenly_spaced, wrap_angle
 from vplane_mj.robots.facts import robot_body
 
 JACKAL = robot_body("jackal")
@@ -43,6 +43,24 @@ def test_a_turn_in_place_is_refused_where_a_corner_would_strike_a_post():
     far = np.array([[0.0, 0.5]])
     assert motion.free_turn(JACKAL, far, 1.0, math.pi / 2, 0.03) == pytest.approx(math.pi / 2)
     assert motion.free_turn(DEFAULT, np.array([[0.0, 0.12]]), 1.0, math.pi, 0.03) == math.pi
+
+
+def test_the_free_turn_is_the_last_angle_before_any_point_comes_closer_than_it_may():
+    """`free_turn` against its definition in numpy: the footprint's distances to the points
+    within its swept disc and margin, at each angle of the turn (`outline_distances`)."""
+    rng = np.random.default_rng(2)
+    blocked = 0
+    for _ in range(400):
+        local = rng.uniform(-0.5, 0.5, (int(rng.integers(0, 12)), 2))
+        side, limit, margin = float(rng.choice([-1.0, 1.0])), float(rng.uniform(0.0, math.pi)), 0.03
+        got = motion.free_turn(JACKAL, local, side, limit, margin)
+        near = local[np.hypot(local[:, 0], local[:, 1]) < JACKAL.radius_m + margin]
+        angles = side * evenly_spaced(0.0, limit, max(1, math.ceil(limit / motion.TURN_STEP_RAD)) + 1)
+        distances = motion.outline_distances(JACKAL, near, angles)
+        stops = (distances[1:] < np.minimum(margin, distances[0] - 1e-9)).any(axis=1)
+        assert got == (float(abs(angles[int(np.argmax(stops))])) if stops.any() else limit)
+        blocked += bool(stops.any())
+    assert 50 < blocked < 350
 
 
 def _observation(velocity=(0.0, 0.0), time_s=0.0) -> Observation:

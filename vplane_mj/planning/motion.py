@@ -120,19 +120,18 @@ def free_turn(body: RobotBody, local: np.ndarray, side: float, limit_rad: float,
     (robot frame, m) that it is not already that close to; `limit_rad` for a round robot."""
     if body.disc or limit_rad <= 0.0:
         return max(0.0, limit_rad)
-    near = local[np.hypot(local[:, 0], local[:, 1]) < body.radius_m + margin_m]
-    if not len(near):
-        return limit_rad
+    from vplane_mj.planning.kernels import outline  # numba: loaded by the first call
+
     steps = max(1, math.ceil(limit_rad / TURN_STEP_RAD))
     angles = math.copysign(1.0, side) * evenly_spaced(0.0, limit_rad, steps + 1)
-    distances = outline_distances(body, near, angles)
+    footprint, normals = _outline(body)
     # A point counts against the turn where the turn brings the outline closer than both the
     # margin and the point's distance now (a point already close does not freeze the robot).
-    limit = np.minimum(margin_m, distances[0] - 1e-9)
-    blocked = (distances[1:] < limit).any(axis=1)
-    if not blocked.any():
-        return limit_rad
-    return float(abs(angles[int(np.argmax(blocked))]))  # the last orientation before the first blocked one
+    local = np.ascontiguousarray(local, float).reshape(-1, 2)
+    blocked = outline.first_blocked_turn(
+        footprint, normals, local, body.radius_m + margin_m, angles, margin_m
+    )
+    return limit_rad if blocked < 0 else float(abs(angles[blocked - 1]))  # the last before it
 
 
 def brake_speed(distance: float, accel: float, delay_s: float) -> float:

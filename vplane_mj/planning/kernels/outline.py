@@ -1,5 +1,6 @@
-"""Distances from points to a convex footprint at many poses, and how far a motion of the
-footprint intrudes on them, compiled (`motion.pose_distances`, `motion.intrusion`).
+"""Distances from points to a convex footprint at many poses, how far a motion of the
+footprint intrudes on them and how far it turns before it does, compiled
+(`motion.pose_distances`, `motion.intrusion`, `motion.free_turn`).
 
 A distance is the C library's `hypot`, as numpy's; it costs some twenty times a product, so
 it is taken only where a squared distance cannot decide: a squared distance carries a
@@ -89,6 +90,39 @@ def pose_distances(
             dx, dy = local[n, 0] - poses[m, 0], local[n, 1] - poses[m, 1]
             out[m, n] = _gap(footprint, normals, c * dx + s * dy, -s * dx + c * dy)
     return out
+
+
+@njit(cache=True)
+def first_blocked_turn(
+    footprint: np.ndarray,
+    normals: np.ndarray,
+    local: np.ndarray,
+    near_m: float,
+    angles: np.ndarray,
+    margin_m: float,
+) -> int:
+    """The first of `angles` (rad; the first 0, ascending in size) at which the footprint,
+    turned in place, comes closer to a point of `local` (N, 2) than both `margin_m` and the
+    point's distance at the first angle less 1e-9 m (`motion.free_turn`); -1 at none. Only the
+    points nearer than `near_m` to the origin count."""
+    count = 0
+    near = np.empty(local.shape[0], dtype=np.int64)
+    for n in range(local.shape[0]):
+        if math.hypot(local[n, 0], local[n, 1]) < near_m:
+            near[count] = n
+            count += 1
+    limits = np.empty(count)
+    c, s = math.cos(angles[0]), math.sin(angles[0])
+    for k in range(count):
+        x, y = local[near[k], 0], local[near[k], 1]
+        limits[k] = min(margin_m, _gap(footprint, normals, c * x + s * y, -s * x + c * y) - 1e-9)
+    for m in range(1, angles.shape[0]):
+        c, s = math.cos(angles[m]), math.sin(angles[m])
+        for k in range(count):
+            x, y = local[near[k], 0], local[near[k], 1]
+            if _gap(footprint, normals, c * x + s * y, -s * x + c * y) < limits[k]:
+                return m
+    return -1
 
 
 @njit(cache=True)
