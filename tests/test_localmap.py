@@ -321,6 +321,37 @@ def test_the_ring_arithmetic_and_the_search_give_every_angle_the_same_beam(count
     assert np.abs(ring_offset).max() <= math.pi / count + 1e-9  # the nearest: at most half the spacing
 
 
+@pytest.mark.parametrize("name", ["jackal_laser", "turtlebot_laser"])
+def test_cells_found_by_the_sides_of_the_bounds_are_those_the_angles_give(name, monkeypatch):
+    """A dense fan's cells are given their beam by the side of the bounds they lie on; cells on
+    or a hair's breadth off a bound (yaws chosen to put a cell centre there) by the angles: the
+    grid is the one the angles alone make."""
+    bearings, beam, range_max = SCANS[name]
+    assert beams.BeamFan(bearings, beam).quick.sum() > len(bearings) // 2
+
+    def fold() -> tuple[np.ndarray, np.ndarray]:
+        fan = beams.BeamFan(bearings, beam)
+        rng = np.random.default_rng(7)
+        local = LocalMap(cell_m=0.05, size_m=6.0, **RULES["vplane_plus"])
+        position = np.array([0.3, -0.2])
+        for _ in range(40):
+            position = position + rng.normal(0.0, 0.05, 2)
+            centre = (np.floor(position / 0.05) + rng.integers(-20, 21, 2) + 0.5) * 0.05
+            bound = fan.directions[0] + fan.bounds[rng.integers(fan.count)]
+            hair = rng.choice([0.0, 1e-15, -1e-15, 1e-12, -1e-12, 1e-8])
+            yaw = math.atan2(*(centre - position)[::-1]) - bound + hair  # the centre on that bound
+            ranges = rng.uniform(0.1, range_max, len(bearings))
+            ranges[rng.random(len(bearings)) < 0.2] = np.nan
+            local.update(position, yaw, bearings, ranges, beam)
+        return local.grid.copy(), local.seen.copy()
+
+    sided = fold()
+    monkeypatch.setattr(beams, "QUICK_GAP_RAD", -1.0)  # no direction quick: the angles decide all
+    for got, want in zip(sided, fold(), strict=True):
+        np.testing.assert_array_equal(got, want)
+    assert sided[0].any() and sided[1].any()
+
+
 def test_the_remainder_of_a_turn_is_pythons_modulo_bit_for_bit():
     turn = 2 * math.pi
     rng = np.random.default_rng(11)

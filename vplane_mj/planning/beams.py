@@ -18,6 +18,11 @@ SAME_DIRECTION_RAD = 1e-9
 """Bearings closer than this (rad) are one direction: their beams act as one."""
 RING_TOLERANCE_RAD = 1e-12
 """Directions this close (rad) to an even ring's are that ring (the nearest beam by arithmetic)."""
+QUICK_GAP_RAD = 0.1
+COVER_SLACK_RAD = 1e-10
+"""A direction is `quick` when the gaps to its neighbours are at most QUICK_GAP_RAD and its half
+beam at least half the wider gap less COVER_SLACK_RAD (far below the map's SURE_RAD: a cell that
+surely lies inside the bounds is surely within the beam)."""
 
 
 class BeamFan:
@@ -49,6 +54,13 @@ class BeamFan:
         self.bounds = self.relative + gaps / 2  # where the next direction becomes the nearest
         self.half_before = np.minimum(beam / 2, np.roll(gaps, 1) / 2)
         self.half_after = np.minimum(beam / 2, gaps / 2)
+        self.bound_units = np.column_stack((np.cos(self.bounds), np.sin(self.bounds)))
+        """The unit vectors (count, 2) of the bounds (relative to the first direction)."""
+        widest = np.maximum(gaps, np.roll(gaps, 1))
+        self.quick = (widest <= QUICK_GAP_RAD) & (beam / 2 >= widest / 2 - COVER_SLACK_RAD)
+        """Directions whose beam covers their whole share, between bounds at most QUICK_GAP_RAD
+        apart: a cell between those bounds is the direction's and within its beam, which the
+        map's update decides by the side of the bounds the cell lies on."""
         ring = np.arange(self.count) * (turn / self.count)
         even = self.count == len(self.bearings) and np.max(np.abs(self.relative - ring)) <= RING_TOLERANCE_RAD
         self.spacing = turn / self.count if even else None

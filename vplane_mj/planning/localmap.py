@@ -124,6 +124,8 @@ class LocalMap:
             fan.half_after,
             fan.spacing or 0.0,
             fan.bounds,
+            fan.bound_units,
+            fan.quick,
             fan.readings(ranges),
             mark_range,
             self.silent_free_m,

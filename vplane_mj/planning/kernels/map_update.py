@@ -44,6 +44,9 @@ WEDGE_SPREAD_CELLS = 2.0
 """A wedge of neighbouring cones walked as one spans at most this (rad), and their reaches
 differ by at most this many cells (`_wedge`)."""
 TURN = 2 * math.pi
+SURE_RAD = 1e-9
+"""A cell whose direction lies more than this (rad) off every bound is surely on its side of each:
+the rule's rounding (an arctangent, differences of angles) is some 1e-14 rad."""
 
 
 @njit(cache=True)
@@ -59,6 +62,8 @@ def fold_scan(
     half_after: np.ndarray,
     spacing: float,
     bounds: np.ndarray,
+    bound_units: np.ndarray,
+    quick: np.ndarray,
     ranges: np.ndarray,
     mark_range_m: float,
     silent_free_m: float,
@@ -73,7 +78,9 @@ def fold_scan(
     grid cell (0, 0), cells of `cell_m`. The scan's distinct directions (rad, robot frame,
     ascending) are `directions`, each beam `beam` wide (rad) and its cone clipped to
     `half_before` and `half_after` of its axis; `spacing` (rad) is the even ring's, 0 for any
-    directions, then searched among `bounds`. `ranges[k]` (m, NaN: no echo) is direction k's;
+    directions, then searched among `bounds`; `bound_units` are the bounds' unit vectors and
+    `quick` the directions whose cells are found by the side of the bounds they lie on
+    (`beams.BeamFan`). `ranges[k]` (m, NaN: no echo) is direction k's;
     an echo marks its arc when it is at most `mark_range_m` away. When some direction has no
     echo, its cone shows free for `silent_free_m` (m, with `track_seen`). `rule` is (hit,
     miss, max_certainty).
@@ -92,7 +99,16 @@ def fold_scan(
     _fold_cones(
         (x, y, yaw, cell_m, beam, spacing, silent_m, extent2, track_seen),
         (first_cell[0], first_cell[1], n),
-        (directions, half_before, half_after, bounds, ranges, marks),
+        (
+            directions,
+            half_before,
+            half_after,
+            bounds,
+            ranges,
+            marks,
+            _turned(bound_units, yaw + directions[0]),
+            quick,
+        ),
         (rule[0], rule[1], rule[2]),
         grid.reshape(-1),
         seen.reshape(-1),
@@ -109,7 +125,7 @@ def _fold_cones(scan, cells, fan, rule, flat, seen_flat):
     mask, flat."""
     x, y, yaw, cell_m, beam, spacing, silent_m, extent2, track_seen = scan
     first_i, first_j, n = cells
-    directions, half_before, half_after, bounds, ranges, marks = fan
+    directions, half_before, half_after, bounds, ranges, marks, bound_units, quick = fan
     per_cell = 1.0 / cell_m
     axis0 = yaw + directions[0]
     judging = (beam, cell_m, ARC_HALF_WIDTH * cell_m, silent_m, rule[0], rule[1], rule[2])
@@ -122,6 +138,7 @@ def _fold_cones(scan, cells, fan, rule, flat, seen_flat):
         last, band_lo2, band_hi2, clear2, show2, reach2 = _wedge(
             c, reach, directions, half_before, half_after, cell_m
         )
+        sided = quick[c : last + 1].all()  # its cells' directions found by the bounds' sides
         start = yaw + directions[c] - half_before[c] - ANGLE_MARGIN_RAD
         span = directions[last] - directions[c] + half_after[last] + half_before[c] + 2 * ANGLE_MARGIN_RAD
         pieces = max(1, math.ceil(span / QUARTER_TURN))
@@ -150,11 +167,13 @@ def _fold_cones(scan, cells, fan, rule, flat, seen_flat):
                     i, j = (line, along) if step_u == n else (along, line)
                     rel_x = (first_i + i + 0.5) * cell_m - x
                     rel_y = (first_j + j + 0.5) * cell_m - y
-                    angle = math.atan2(rel_y, rel_x) - axis0
-                    if spacing > 0.0:
-                        nearest, offset = nearest_in_ring(angle, axis0, spacing, directions.shape[0])
-                    else:
-                        nearest, offset = nearest_by_search(angle, bounds, directions)
+                    nearest, offset = _by_sides(rel_x, rel_y, c, last, bound_units) if sided else (-2, 0.0)
+                    if nearest == -2:  # unsure (or not sided): by the angles themselves
+                        angle = math.atan2(rel_y, rel_x) - axis0
+                        if spacing > 0.0:
+                            nearest, offset = nearest_in_ring(angle, axis0, spacing, directions.shape[0])
+                        else:
+                            nearest, offset = nearest_by_search(angle, bounds, directions)
                     if not (
                         c <= nearest <= last
                         and _may_change_by(d2, reach, nearest, flat[index], seen_flat[index], track_seen)
@@ -168,6 +187,40 @@ def _fold_cones(scan, cells, fan, rule, flat, seen_flat):
                     if track_seen and shown:
                         seen_flat[index] = True
         c = last + 1
+
+
+@njit(cache=True, inline="always")
+def _by_sides(rel_x, rel_y, c, last, units):
+    """The nearest direction of the cell at (`rel_x`, `rel_y`) (m from the robot) among the
+    wedge's `c` to `last`, all `quick`, and its angle from that direction's axis where the
+    cell lies within its beam (given as 0): found by the side of the bounds (`units`, world unit
+    vectors) the cell lies on, -1 when it surely lies beyond the wedge's bounds, -2 when it lies
+    within SURE_RAD of a bound (then only the angles decide)."""
+    sure = SURE_RAD * (abs(rel_x) + abs(rel_y))
+    before = c - 1 if c > 0 else units.shape[0] - 1
+    side = units[before, 0] * rel_y - units[before, 1] * rel_x  # > 0: counter-clockwise of it
+    if side < -sure:
+        return -1, 0.0
+    if side <= sure:
+        return -2, 0.0
+    for k in range(c, last + 1):
+        side = units[k, 0] * rel_y - units[k, 1] * rel_x
+        if side < -sure:
+            return k, 0.0
+        if side <= sure:
+            return -2, 0.0
+    return -1, 0.0
+
+
+@njit(cache=True)
+def _turned(units, angle):
+    """The unit vectors (K, 2) turned counter-clockwise by `angle` (rad)."""
+    c, s = math.cos(angle), math.sin(angle)
+    out = np.empty_like(units)
+    for k in range(units.shape[0]):
+        out[k, 0] = c * units[k, 0] - s * units[k, 1]
+        out[k, 1] = s * units[k, 0] + c * units[k, 1]
+    return out
 
 
 @njit(cache=True, inline="always")
