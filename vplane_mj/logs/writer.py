@@ -375,7 +375,7 @@ class McapLog:
             pose=self._scan_pose,
             start_angle=self._scan_angles[0],
             end_angle=self._scan_angles[1],
-            ranges=[r if 0.0 <= r < math.inf else math.nan for r in ranges.tolist()],  # no echo: NaN
+            ranges=np.where((ranges >= 0.0) & (ranges < math.inf), ranges, math.nan).tolist(),  # no echo: NaN
         )
         self._scan_ch.log(scan, log_time=ns)
 
