@@ -46,9 +46,8 @@ def cost_to_go(
     firsts = ((targets[order] // ny + 1) * wide + targets[order] % ny + 1).astype(np.int64)
     stop = -1 if stop < 0 else (stop // ny + 1) * wide + stop % ny + 1
     dist = np.full(step.shape[0], np.inf)
-    settled = np.zeros(step.shape[0], dtype=np.bool_)
     head = np.full(rings, -1)  # each bucket's last entry, -1: empty
-    entries = targets.shape[0] + 8 * nx * ny  # a cell is queued by a target or by a neighbour settled
+    entries = targets.shape[0] + 8 * nx * ny  # a cell is queued by a target, or by a neighbour as it settles
     after, cells, keys = (
         np.empty(entries, dtype=np.int64),
         np.empty(entries, dtype=np.int64),
@@ -74,16 +73,15 @@ def cost_to_go(
             continue
         head[current % rings], u, d = after[e], cells[e], keys[e]
         size -= 1
-        if settled[u] or d > dist[u]:
-            continue  # settled already, or queued again cheaper since
-        settled[u] = True
+        if d > dist[u]:
+            continue  # queued again cheaper since: a stale entry (a cell's last entry settles it)
         if u == stop:
             break
         for s in range(8):
             di, dj = _STEPS[s, 0], _STEPS[s, 1]
             v = u + di * wide + dj
-            if not math.isfinite(step[v]) or settled[v]:
-                continue
+            if not math.isfinite(step[v]):
+                continue  # blocked (a settled neighbour is passed over below: no move lowers it)
             length = cell_m
             if di != 0 and dj != 0:  # diagonal: both orthogonal neighbours free, no corner cut
                 if not (math.isfinite(step[u + di * wide]) and math.isfinite(step[u + dj])):
