@@ -330,14 +330,15 @@ class SpeedPolicy:
         return force * (cap / length) if length > cap else force
 
 
-def _view(obs: Observation) -> tuple[int, float, float]:
-    """The field of view of the scan of `obs`, as `kernels.memory.recall` takes it: the span of
-    its beams' bearings, widened by half a beam each way (1: all round; 0: no beams; else -1,
-    its first bearing (rad, robot frame) and its width (rad))."""
-    if not len(obs.bearings):
+def _view(bearings: np.ndarray, beam_width: float) -> tuple[int, float, float]:
+    """The field of view of a scan's `bearings` (rad, robot frame), each beam `beam_width` wide
+    (rad), as `kernels.memory.recall` takes it: the span of the bearings, widened by half a
+    beam each way (1: all round; 0: no beams; else -1, its first bearing (rad, robot frame) and
+    its width (rad))."""
+    if not len(bearings):
         return 0, 0.0, 0.0
-    half = obs.beam_width / 2
-    low, high = float(np.min(obs.bearings)) - half, float(np.max(obs.bearings)) + half
+    half = beam_width / 2
+    low, high = float(np.min(bearings)) - half, float(np.max(bearings)) + half
     if high - low >= 2 * math.pi:
         return 1, low, 0.0
     return -1, low, high - low
@@ -375,6 +376,8 @@ class Governor:
     those it was given, and those out of the sensor's view still within `reach_m`."""
     policy: SpeedPolicy = field(init=False)
     """The speeds the body may drive at along a way."""
+    _view_key: tuple[np.ndarray, float] | None = field(default=None, init=False, repr=False)
+    _field_of_view: tuple[int, float, float] = field(default=(0, 0.0, 0.0), init=False, repr=False)
 
     def __post_init__(self) -> None:
         self.drive = DriveModel(self.body.limits)
@@ -444,9 +447,17 @@ class Governor:
         points = np.ascontiguousarray(points, float).reshape(-1, 2)
         x, y = float(obs.position[0]), float(obs.position[1])
         local, self.remembered = memory.recall(
-            points, self.remembered, x, y, float(obs.yaw), self.reach_m, *_view(obs), MEMORY_CELL_M
+            points, self.remembered, x, y, float(obs.yaw), self.reach_m, *self._view_of(obs), MEMORY_CELL_M
         )
         return local
+
+    def _view_of(self, obs: Observation) -> tuple[int, float, float]:
+        """The field of view of the scan of `obs` (`_view`), kept while the scan's bearings are
+        the same array (a sensor's, at every tick) and its beam the same."""
+        key = (obs.bearings, obs.beam_width)
+        if self._view_key is None or self._view_key[0] is not key[0] or self._view_key[1] != key[1]:
+            self._view_key, self._field_of_view = key, _view(obs.bearings, obs.beam_width)
+        return self._field_of_view
 
     def _command(
         self, local: np.ndarray, yaw: float, wanted: float, length: float, speed_mps: float, margin: float
