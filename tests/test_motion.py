@@ -63,6 +63,43 @@ def test_the_free_turn_is_the_last_angle_before_any_point_comes_closer_than_it_m
     assert 50 < blocked < 350
 
 
+def _poses_by_numpy(drive: motion.DriveModel, command: tuple[float, float], hold_s: float) -> np.ndarray:
+    """`DriveModel.poses` with numpy's `arange` and `interp` (the compiled one takes numba's)."""
+    from vplane_mj.planning.kernels import drive_model
+
+    limits = drive.limits
+    alpha, lag, brake = limits.max_turn_accel_radps2, limits.turn_lag_s, drive.braking(command)
+    start = drive.speed if abs(drive.speed) > abs(drive.ramp[0]) else drive.ramp[0]
+    faster = abs(command[0]) > abs(start) and command[0] * start >= 0
+    speeds = np.array(
+        [(command[0], hold_s, limits.max_accel_mps2 if faster else brake), (0.0, math.inf, brake)]
+    )
+    turns = np.array([(command[1], hold_s, alpha), (0.0, math.inf, alpha)])
+    v1, w1 = drive_model.ramp_at(start, speeds, hold_s), drive_model.ramp_at(drive.ramp[1], turns, hold_s)
+    end = lag + hold_s + max(abs(v1) / brake, abs(w1) / alpha, abs(drive.slide) / brake)
+    t = np.arange(0.0, end + motion.MOTION_STEP_S, motion.MOTION_STEP_S)
+    late_turns = np.empty(0)
+    if lag > 0 and drive.time_s is not None:
+        times, rates = np.array(drive.past).T
+        late_turns = np.interp(drive.time_s + t[t < lag] - lag, times, rates)
+    return drive_model.predicted_poses(
+        t, start, speeds, drive.ramp[1], turns, lag, late_turns, drive.slide, brake, motion.SWEEP_STEP_M
+    )
+
+
+@pytest.mark.parametrize("body", [JACKAL, DEFAULT])
+def test_the_compiled_prediction_takes_numpys_times_and_past_turn_rates_bit_for_bit(body):
+    rng = np.random.default_rng(8)
+    for _ in range(300):
+        drive = motion.DriveModel(body.limits)
+        for k in range(int(rng.integers(0, 6))):
+            pose = tuple(rng.normal(0.0, 0.3, 3)) if rng.random() < 0.7 else None
+            drive.advance(k * 0.05 + rng.uniform(0.0, 0.01), tuple(rng.normal(0.0, 0.5, 2)), pose)
+            drive.commanded(tuple(rng.normal(0.0, 0.5, 2)))
+        command = (float(rng.normal(0.0, 1.0)), float(rng.normal(0.0, 1.0)))
+        np.testing.assert_array_equal(drive.poses(command, 0.05), _poses_by_numpy(drive, command, 0.05))
+
+
 def _observation(velocity=(0.0, 0.0), time_s=0.0) -> Observation:
     """The robot at the origin facing +x (no scan: the governor is given its points)."""
     return Observation(

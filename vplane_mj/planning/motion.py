@@ -67,8 +67,8 @@ INTRUSION_TOLERANCE_M = 1e-4
 """A predicted motion that intrudes less than this (m) on a point's allowed distance is safe."""
 SWEEP_STEP_M = 0.02
 """A predicted motion is checked at poses about this far apart (m of travel plus rad of turn)."""
-_NO_LATE_TURNS = np.empty(0)
-"""No turn rates to take from the past (a drive without a lag, or before its first tick)."""
+_NO_PAST = (0.0, np.empty(0), np.empty(0))
+"""No ticks to take turn rates from (before the first tick)."""
 
 
 def room_ahead(body: RobotBody, local: np.ndarray, margin_m: float, side_margin_m: float) -> float:
@@ -232,24 +232,22 @@ class DriveModel:
         from vplane_mj.planning.kernels import drive_model  # numba: loaded by the first call
 
         limits = self.limits
-        alpha, lag = limits.max_turn_accel_radps2, limits.turn_lag_s
         brake = self.braking(command)
         # A robot faster than its ramp (a skid-steer braking in a hard turn) slows from its speed.
         start = self.speed if abs(self.speed) > abs(self.ramp[0]) else self.ramp[0]
         faster = abs(command[0]) > abs(start) and command[0] * start >= 0
-        speeds = np.array(
-            [(command[0], hold_s, limits.max_accel_mps2 if faster else brake), (0.0, math.inf, brake)]
-        )
-        turns = np.array([(command[1], hold_s, alpha), (0.0, math.inf, alpha)])
-        v1, w1 = drive_model.ramp_at(start, speeds, hold_s), drive_model.ramp_at(self.ramp[1], turns, hold_s)
-        end = lag + hold_s + max(abs(v1) / brake, abs(w1) / alpha, abs(self.slide) / brake)
-        t = np.arange(0.0, end + MOTION_STEP_S, MOTION_STEP_S)
-        late_turns = _NO_LATE_TURNS
-        if lag > 0 and self.time_s is not None:
+        past = _NO_PAST
+        if self.time_s is not None:
             times, rates = np.array(self.past).T
-            late_turns = np.interp(self.time_s + t[t < lag] - lag, times, rates)
-        return drive_model.predicted_poses(
-            t, start, speeds, self.ramp[1], turns, lag, late_turns, self.slide, brake, SWEEP_STEP_M
+            past = (self.time_s, times, rates)
+        return drive_model.command_poses(
+            (float(command[0]), float(command[1])),
+            float(hold_s),
+            (float(start), float(self.ramp[1]), float(self.slide)),
+            (limits.max_accel_mps2, brake, limits.max_turn_accel_radps2, 1.0 if faster else 0.0),
+            limits.turn_lag_s,
+            past,
+            (MOTION_STEP_S, SWEEP_STEP_M),
         )
 
 

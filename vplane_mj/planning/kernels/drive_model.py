@@ -27,6 +27,41 @@ def ramp_at(start: float, phases: np.ndarray, time_s: float) -> float:
 
 
 @njit(cache=True)
+def command_poses(
+    command: tuple[float, float],
+    hold_s: float,
+    start: tuple[float, float, float],
+    rates: tuple[float, float, float, float],
+    lag_s: float,
+    past: tuple[float, np.ndarray, np.ndarray],
+    steps: tuple[float, float],
+) -> np.ndarray:
+    """`predicted_poses` of `command` (m/s, rad/s) given for `hold_s` (s), then a stop: the
+    robot's speed (m/s) ramps from `start[0]` toward the command for `hold_s` at `rates[0]`
+    (m/s^2; the braking `rates[1]` unless `rates[3]` says it speeds up), then to rest at
+    `rates[1]`; its turn rate ramps from `start[1]` likewise at `rates[2]` (rad/s^2), `lag_s`
+    late, and over the first `lag_s` is the ramp's of the past (`past`: the time now, s, and
+    the past ticks' times and turn rates, interpolated; none without a lag or a past); its
+    slide (`start[2]`, m/s) fades at the braking. Poses every `steps[0]` s, kept about
+    `steps[1]` apart (`motion.DriveModel.poses`)."""
+    accel, brake, alpha, faster = rates
+    speeds = np.empty((2, 3))
+    speeds[0, 0], speeds[0, 1], speeds[0, 2] = command[0], hold_s, accel if faster > 0.0 else brake
+    speeds[1, 0], speeds[1, 1], speeds[1, 2] = 0.0, math.inf, brake
+    turns = np.empty((2, 3))
+    turns[0, 0], turns[0, 1], turns[0, 2] = command[1], hold_s, alpha
+    turns[1, 0], turns[1, 1], turns[1, 2] = 0.0, math.inf, alpha
+    v1, w1 = ramp_at(start[0], speeds, hold_s), ramp_at(start[1], turns, hold_s)
+    end = lag_s + hold_s + max(abs(v1) / brake, abs(w1) / alpha, abs(start[2]) / brake)
+    t = np.arange(0.0, end + steps[0], steps[0])
+    now, times, past_rates = past
+    late_turns = np.empty(0)
+    if lag_s > 0 and times.shape[0] > 0:
+        late_turns = np.interp(now + t[t < lag_s] - lag_s, times, past_rates)
+    return predicted_poses(t, start[0], speeds, start[1], turns, lag_s, late_turns, start[2], brake, steps[1])
+
+
+@njit(cache=True)
 def predicted_poses(
     t: np.ndarray,
     speed: float,
