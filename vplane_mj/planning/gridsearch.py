@@ -107,8 +107,8 @@ class Window:
         """The world point (m) at a cell's centre."""
         return self.corner + (np.asarray(cell, float) + 0.5) * self.cell_m
 
-    def centres_of(self, cells: list[tuple[int, int]]) -> np.ndarray:
-        """The world points (N, 2; m) at the centres of `cells`."""
+    def centres_of(self, cells: np.ndarray | list[tuple[int, int]]) -> np.ndarray:
+        """The world points (N, 2; m) at the centres of `cells` (N, 2: i, j)."""
         return self.corner + (np.asarray(cells, float).reshape(-1, 2) + 0.5) * self.cell_m
 
     def centres(self) -> np.ndarray:
@@ -196,7 +196,7 @@ def cost_to_go(
     from vplane_mj.planning.kernels import grid_dijkstra  # numba: loaded by the first call
 
     targets = np.asarray(targets, dtype=np.int64).ravel()
-    keep = np.isfinite(cost).ravel()[targets]
+    keep = np.isfinite(np.ravel(cost)[targets])
     return grid_dijkstra.cost_to_go(
         np.ascontiguousarray(cost, float),
         targets[keep],
@@ -206,14 +206,12 @@ def cost_to_go(
     )
 
 
-def way_to(
-    window: Window, start: np.ndarray, end: np.ndarray, radius_m: float
-) -> list[tuple[int, int]] | None:
-    """The cells of the window's shortest way from `start` toward `end` (m), the start's first:
-    to the end's cell when the window holds it (made passable within `radius_m` of the end),
-    else to the window's edge, each edge cell starting at its straight distance to the end.
-    The start is the free cell nearest it within 2 `radius_m`; None when there is none, or no
-    way from it."""
+def way_to(window: Window, start: np.ndarray, end: np.ndarray, radius_m: float) -> np.ndarray | None:
+    """The cells (K, 2: i, j) of the window's shortest way from `start` toward `end` (m), the
+    start's first: to the end's cell when the window holds it (made passable within `radius_m`
+    of the end), else to the window's edge, each edge cell starting at its straight distance to
+    the end. The start is the free cell nearest it within 2 `radius_m`; None when there is
+    none, or no way from it (`descend`'s cells)."""
     ends = _ends(window, start, end, radius_m)
     if ends is None:
         return None
@@ -221,7 +219,9 @@ def way_to(
     costs = cost_to_go(window.cost, targets, target_costs, window.cell_m, stop=start_cell)
     if not np.isfinite(costs[start_cell]):
         return None
-    return descend(costs, start_cell, costs.size)
+    from vplane_mj.planning.kernels import grid_dijkstra  # numba: loaded by the first call
+
+    return grid_dijkstra.descend(costs, int(start_cell[0]), int(start_cell[1]), costs.size)
 
 
 def way_exists(window: Window, start: np.ndarray, end: np.ndarray, radius_m: float) -> bool:
