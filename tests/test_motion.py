@@ -35,7 +35,7 @@ def test_a_turn_in_place_is_refused_where_a_corner_would_strike_a_post():
     # inside the 0.333 m its corners sweep. Turning right swings the front-left corner away
     # from it at first... and the rear-left corner into it: both ways are shut soon.
     post = np.array([[0.0, 0.3]])
-    assert motion.outline_distances(JACKAL, post, np.zeros(1))[0, 0] == pytest.approx(0.085)
+    assert pose_distances(JACKAL, post, np.zeros((1, 3)))[0, 0] == pytest.approx(0.085)
     left = motion.free_turn(JACKAL, post, 1.0, math.pi / 2, 0.03)
     right = motion.free_turn(JACKAL, post, -1.0, math.pi / 2, 0.03)
     assert 0 < left <= math.radians(30) and 0 < right <= math.radians(30)
@@ -47,7 +47,7 @@ def test_a_turn_in_place_is_refused_where_a_corner_would_strike_a_post():
 
 def test_the_free_turn_is_the_last_angle_before_any_point_comes_closer_than_it_may():
     """`free_turn` against its definition in numpy: the footprint's distances to the points
-    within its swept disc and margin, at each angle of the turn (`outline_distances`)."""
+    within its swept disc and margin, at each angle of the turn (`pose_distances`)."""
     rng = np.random.default_rng(2)
     blocked = 0
     for _ in range(400):
@@ -56,7 +56,7 @@ def test_the_free_turn_is_the_last_angle_before_any_point_comes_closer_than_it_m
         got = motion.free_turn(JACKAL, local, side, limit, margin)
         near = local[np.hypot(local[:, 0], local[:, 1]) < JACKAL.radius_m + margin]
         angles = side * evenly_spaced(0.0, limit, max(1, math.ceil(limit / motion.TURN_STEP_RAD)) + 1)
-        distances = motion.outline_distances(JACKAL, near, angles)
+        distances = pose_distances(JACKAL, near, np.column_stack((np.zeros((len(angles), 2)), angles)))
         stops = (distances[1:] < np.minimum(margin, distances[0] - 1e-9)).any(axis=1)
         assert got == (float(abs(angles[int(np.argmax(stops))])) if stops.any() else limit)
         blocked += bool(stops.any())
@@ -119,6 +119,26 @@ def _driving(governor: motion.Governor, command: tuple[float, float], seconds: f
     return time_s
 
 
+def pose_distances(body: RobotBody, local: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """Distance (m) from each point of `local` (N, 2; robot frame) to the footprint at each of
+    `poses` (M, 3: x, y in m, yaw in rad): (M, N), 0 inside. The governor's kernels take their
+    distances so (the point moved into the pose's frame, its nearest edge by `hypot`, inside
+    when behind every edge): the oracle of their tests, in numpy."""
+    footprint, normals = motion._outline(body)
+    ex, ey = (np.roll(footprint, -1, axis=0) - footprint).T
+    out = np.empty((len(poses), len(local)))
+    for m, (x, y, yaw) in enumerate(poses):
+        c, s = math.cos(yaw), math.sin(yaw)
+        dx, dy = local[:, 0] - x, local[:, 1] - y
+        px, py = c * dx + s * dy, -s * dx + c * dy
+        rx, ry = px[:, None] - footprint[:, 0], py[:, None] - footprint[:, 1]
+        t = np.clip((rx * ex + ry * ey) / (ex * ex + ey * ey), 0.0, 1.0)
+        gaps = np.hypot(rx - t * ex, ry - t * ey).min(axis=1, initial=np.inf)
+        outside = (rx * normals[:, 0] + ry * normals[:, 1] > 0.0).any(axis=1)
+        out[m] = np.where(outside, gaps, 0.0)
+    return out
+
+
 def brute_force_distance(footprint: np.ndarray, point: np.ndarray) -> float:
     """Distance (m) from `point` to the convex polygon `footprint` (0 inside): the nearest of
     a thousand points along each edge, or 0 where the point is on the inner side of every edge."""
@@ -132,12 +152,12 @@ def brute_force_distance(footprint: np.ndarray, point: np.ndarray) -> float:
 
 
 @pytest.mark.parametrize("profile", ["jackal", "pioneer3dx", "turtlebot3_burger"])
-def test_the_footprints_distance_at_any_pose_is_that_of_the_moved_polygon(profile):
+def test_the_distances_the_governor_is_tested_by_are_those_of_the_moved_polygon(profile):
     body = robot_body(profile)
     rng = np.random.default_rng(3)
     local = rng.uniform(-0.8, 0.8, (40, 2))
     poses = np.column_stack((rng.uniform(-0.3, 0.3, (25, 2)), rng.uniform(-math.pi, math.pi, 25)))
-    got = motion.pose_distances(body, local, poses)
+    got = pose_distances(body, local, poses)
     assert got.shape == (25, 40) and (got == 0.0).any() and (got > 0.0).any()
     for m, (x, y, yaw) in enumerate(poses):
         turn = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]])
@@ -212,7 +232,7 @@ def test_the_intrusion_is_the_largest_over_every_point_and_pose_of_the_distances
         poses = np.vstack((np.zeros((1, 3)), np.cumsum(steps, axis=0)))
         moved = np.hypot(*np.diff(poses[:, :2], axis=0).T) + body.radius_m * np.abs(np.diff(poses[:, 2]))
         margins = 0.03 + motion.PREDICTION_ERROR * np.concatenate(([0.0], np.cumsum(moved)))
-        distances = motion.pose_distances(body, local, poses)
+        distances = pose_distances(body, local, poses)
         expected = max(0.0, float((np.minimum(margins[:, None], distances[0]) - distances).max()))
         got = motion.intrusion(body, local, poses, 0.03)
         assert got == pytest.approx(expected, abs=1e-12)

@@ -82,28 +82,6 @@ def room_ahead(body: RobotBody, local: np.ndarray, margin_m: float, side_margin_
     return max(0.0, float(local[ahead, 0].min()) - body.radius_m - margin_m)
 
 
-def outline_distances(body: RobotBody, local: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """Distance (m) from each point of `local` (N, 2; robot frame) to the footprint turned in
-    place by each of `angles` (M,; rad, counter-clockwise): (M, N), 0 inside the footprint."""
-    angles = np.asarray(angles, float)
-    return pose_distances(body, local, np.column_stack((np.zeros((len(angles), 2)), angles)))
-
-
-def pose_distances(body: RobotBody, local: np.ndarray, poses: np.ndarray) -> np.ndarray:
-    """Distance (m) from each point of `local` (N, 2; robot frame) to the footprint at each of
-    `poses` (M, 3: x, y in m and yaw in rad, in the robot frame): (M, N), 0 inside the footprint
-    (a point is inside when it lies behind every edge; `kernels.outline`)."""
-    from vplane_mj.planning.kernels import outline  # numba: loaded by the first call
-
-    footprint, normals = _outline(body)
-    return outline.pose_distances(
-        footprint,
-        normals,
-        np.ascontiguousarray(local, float).reshape(-1, 2),
-        np.ascontiguousarray(poses, float).reshape(-1, 3),
-    )
-
-
 @functools.lru_cache(maxsize=16)
 def _outline(body: RobotBody) -> tuple[np.ndarray, np.ndarray]:
     """The footprint (k, 2) and each edge's outward unit normal (k, 2; the polygon is

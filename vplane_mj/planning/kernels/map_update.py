@@ -14,16 +14,21 @@ grid costs no more than one at its edge.
 Of the cells of a wedge, a cell is taken when it lies in the arc band of its own beam (the
 nearest direction), or nearer than the band and marked (an echo clears it), or nearer and not
 yet seen (with `seen`); the bounds are wider than the rule by a margin, so rounding never drops
-a cell, and the wedge's (its cones' widest) first spare the search for the nearest direction
-where no cone of the wedge can change the cell. Each cell taken is then judged by the map's
-rule (`vplane_mj.planning.localmap`), in the walk of the wedge that holds its own beam's cone
-alone (the wedges overlap at their margins; its own holds every cell the beam can change), so
-once: its beam is the nearest direction (`nearest_in_ring` for an evenly spaced ring,
-`nearest_by_search` for any directions: one rule, two ways, which agree wherever rounding does
-not decide), and it must lie within half a beam width of that direction's axis; a cell within
-ARC_HALF_WIDTH cell of the range, along its beam, is on the arc and gains `hit`; a cell nearer
-than the range less one cell is in the free cone and loses `miss`. So the grid is what a pass
-over every cell would make of it.
+a cell. The wedge's own bounds (the widest of its cones') are tested first: a cell no cone of
+the wedge can change is passed over before its direction is sought. Each cell taken is then
+judged by the map's rule (`vplane_mj.planning.localmap`), in the walk of the wedge that holds
+its own beam's cone alone (the wedges overlap at their margins; its own holds every cell the
+beam can change), so once: its beam is the nearest direction, and it must lie within half a
+beam width of that direction's axis; a cell within ARC_HALF_WIDTH cell of the range, along its
+beam, is on the arc and gains `hit`; a cell nearer than the range less one cell is in the free
+cone and loses `miss`. So the grid is what a pass over every cell would make of it.
+
+The nearest direction is found by arithmetic for an evenly spaced ring (`nearest_in_ring`), by
+a search among the bounds half-way between neighbouring directions for any directions
+(`nearest_by_search`): one rule, two ways, which agree wherever rounding does not decide. A
+dense fan's directions (`beams.BeamFan.quick`: a laser's, whose beams cover their share) are
+found without an arctangent, by the side of the bounds (their unit vectors, turned once a scan)
+the cell lies on, wherever it lies more than SURE_RAD off each; on a bound, by the angles.
 """
 
 from __future__ import annotations

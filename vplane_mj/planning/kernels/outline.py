@@ -1,6 +1,6 @@
-"""Distances from points to a convex footprint at many poses, how far a motion of the
-footprint intrudes on them and how far it turns before it does, compiled
-(`motion.pose_distances`, `motion.intrusion`, `motion.free_turn`).
+"""How far a motion of a convex footprint intrudes on points, and how far it turns in place
+before it does, compiled (`motion.intrusion`, `motion.free_turn`), from the points' distances
+to the footprint at the motion's poses.
 
 A distance is the C library's `hypot`, as numpy's; it costs some twenty times a product, so
 it is taken only where a squared distance cannot decide: a squared distance carries a
@@ -76,23 +76,6 @@ def _closer(dx: float, dy: float, bound: float) -> bool:
 
 
 @njit(cache=True)
-def pose_distances(
-    footprint: np.ndarray, normals: np.ndarray, local: np.ndarray, poses: np.ndarray
-) -> np.ndarray:
-    """Distance (m) from each point of `local` (N, 2) to the convex `footprint` (k, 2; counter-
-    clockwise, with each edge's outward unit normal in `normals`, k x 2) placed at each of
-    `poses` (M, 3: x, y in m, yaw in rad, all in the frame of `local`): (M, N), 0 inside."""
-    count = local.shape[0]
-    out = np.empty((poses.shape[0], count))
-    for m in range(poses.shape[0]):
-        c, s = math.cos(poses[m, 2]), math.sin(poses[m, 2])
-        for n in range(count):
-            dx, dy = local[n, 0] - poses[m, 0], local[n, 1] - poses[m, 1]
-            out[m, n] = _gap(footprint, normals, c * dx + s * dy, -s * dx + c * dy)
-    return out
-
-
-@njit(cache=True)
 def first_blocked_turn(
     footprint: np.ndarray,
     normals: np.ndarray,
@@ -136,14 +119,15 @@ def intrusion(
     growth: float,
     enough: float,
 ) -> float:
-    """The largest min(margins[m], d0) - d over the points of `local` (N, 2) and `poses` (M, 3,
-    as in `pose_distances`; M >= 1), d a point's distance to the footprint at pose m and d0 at
-    the first pose, and 0 at least (`motion.intrusion`); margins[m] is `margin_m` plus `growth`
-    times the way the outline has swept up to pose m (its travel plus `radius_m`, the
-    footprint's circumscribed radius, times its turn). Only the points within reach of the
-    motion are measured, and a point whose distance to pose m's origin less `radius_m` already
-    keeps it from raising the largest so far is not measured there. Returns as soon as the
-    largest exceeds `enough` (inf: the exact largest)."""
+    """The largest min(margins[m], d0) - d over the points of `local` (N, 2) and `poses` (M >= 1,
+    3: x, y in m, yaw in rad, in the frame of `local`), d a point's distance to the convex
+    `footprint` (k, 2; counter-clockwise, each edge's outward unit normal in `normals`; 0
+    inside) at pose m and d0 at the first pose, and 0 at least (`motion.intrusion`); margins[m]
+    is `margin_m` plus `growth` times the way the outline has swept up to pose m (its travel
+    plus `radius_m`, the footprint's circumscribed radius, times its turn). Only the points
+    within reach of the motion are measured, and a point whose distance to pose m's origin
+    less `radius_m` already keeps it from raising the largest so far is not measured there.
+    Returns as soon as the largest exceeds `enough` (inf: the exact largest)."""
     steps = poses.shape[0]
     margins = np.empty(steps)
     margins[0] = margin_m + growth * 0.0
