@@ -254,7 +254,7 @@ def _ends(
         edge = np.zeros(shape, dtype=bool)
         edge[[0, -1], :] = edge[:, [0, -1]] = True
         targets = np.flatnonzero(edge)
-        centres = window.centres().reshape(-1, 2)[targets]
+        centres = window.centres_of(np.column_stack(np.unravel_index(targets, shape)))
         target_costs = np.hypot(*(centres - end).T)
     start_cell = window.free_cell_near(start, 2 * radius_m)
     if start_cell is None:
