@@ -53,15 +53,8 @@ def step_costs(
     sure_d = d if any_sure else NO_DISTANCES
     if any_sure and any_doubtful:  # the same cells but for the doubtful ones: their own distances
         sure_d = distance_transform(~sure)
-    return kernels.step_costs(
-        d,
-        sure_d,
-        float(cell_m),
-        float(lethal_m),
-        float(inflation_m),
-        float(inflation_weight),
-        float(doubt_cost),
-    )
+    rule = (float(cell_m), float(lethal_m), float(inflation_m), float(inflation_weight), float(doubt_cost))
+    return kernels.step_costs(d, sure_d, rule)
 
 
 def clear_step_cost(beyond_lethal_m: float, inflation_m: float, inflation_weight: float) -> float:

@@ -205,7 +205,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             decision.mode = "escaping"
             if self._way_is_blocked(obs.position, self.escape_way):
                 window = self._window(obs.position, self.temp_goal, self.planes, margin=p.search_margin_m)
-                self.escape_way = _or_none(self._way(window, obs.position, self.temp_goal))
+                self.escape_way = _or_no_way(self._way(window, obs.position, self.temp_goal))
             target, self.escape_way = self._next_waypoint(obs.position, self.escape_way, self.temp_goal)
             pull = 2.0 * p.vno_gain * float(np.hypot(*(obs.position - self.temp_goal)))  # eq. 7
             self._along_the_way(obs, components, target, pull, len(self.escape_way) > 0)
@@ -327,6 +327,8 @@ class VPlanePlusPlanner(VPlanePlanner):
         way aligned with it."""
         from vplane_mj.planning.kernels import way as way_kernels  # numba: loaded by the first call
 
+        if not len(way):
+            return False
         cells = self._mapped_cells_near(position, BLOCK_LOOKAHEAD_M + self.radius)
         x, y = float(position[0]), float(position[1])
         return way_kernels.blocked(x, y, way, BLOCK_LOOKAHEAD_M, cells, self.robot.half_width_m)
@@ -467,8 +469,8 @@ class VPlanePlusPlanner(VPlanePlanner):
         window: gridsearch.Window,
     ) -> tuple[np.ndarray | None, np.ndarray]:
         """The paper's objective if the map has seen it free, clear of obstacles and reachable,
-        else the nearest such cell outside the trap; with the map's way there. (None, []) when
-        there is none (NO_WAY: an empty way)."""
+        else the nearest such cell outside the trap; with the map's way there. (None, NO_WAY) when
+        there is none."""
         from vplane_mj.planning.kernels.edt import distance_transform  # numba: loaded by the first call
 
         start = window.free_cell_near(robot, 2 * self.radius)
@@ -498,7 +500,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             candidate = window.centre(cell)
         # A usable cell is reachable from the robot's, so the map has a way there; an empty way
         # (straight to the objective) only if not, as when an escape's way is searched again.
-        return candidate, _or_none(self._way(window, robot, candidate))
+        return candidate, _or_no_way(self._way(window, robot, candidate))
 
     # -- following the map's way -------------------------------------------------------------
     def _start_following(self, obs: Observation, decision: Decision, why: str) -> None:
@@ -676,6 +678,6 @@ class VPlanePlusPlanner(VPlanePlanner):
         return way[0], way
 
 
-def _or_none(way: np.ndarray | None) -> np.ndarray:
-    """The way, or NO_WAY for none."""
+def _or_no_way(way: np.ndarray | None) -> np.ndarray:
+    """The way, or NO_WAY for none (an empty way)."""
     return NO_WAY if way is None else way

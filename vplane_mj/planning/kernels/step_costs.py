@@ -24,18 +24,14 @@ def obstacles(sure: np.ndarray, doubtful: np.ndarray) -> tuple[np.ndarray, bool,
 
 @njit(cache=True)
 def step_costs(
-    d: np.ndarray,
-    sure_d: np.ndarray,
-    cell_m: float,
-    lethal_m: float,
-    inflation_m: float,
-    inflation_weight: float,
-    doubt_cost: float,
+    d: np.ndarray, sure_d: np.ndarray, rule: tuple[float, float, float, float, float]
 ) -> np.ndarray:
     """`gridsearch.step_costs` (see there for the rule) from the distances (cells; nx, ny) to
     the nearest obstacle cell of either kind, `d`, and to the nearest sure one, `sure_d` (0 x 0:
     there is none), as numpy's element-wise arithmetic gives it, bit for bit: distances (m) are
-    the cells' times `cell_m`."""
+    the cells' times the cell size. `rule` is (cell_m, lethal_m, inflation_m, inflation_weight,
+    doubt_cost)."""
+    cell_m, lethal_m, inflation_m, inflation_weight, doubt_cost = rule
     nx, ny = d.shape
     cost = np.ones((nx, ny))
     reach = lethal_m + inflation_m
