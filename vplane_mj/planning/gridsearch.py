@@ -212,9 +212,7 @@ def way_to(window: Window, start: np.ndarray, end: np.ndarray, radius_m: float) 
     costs = cost_to_go(window.cost, targets, target_costs, window.cell_m, stop=start_cell)
     if not np.isfinite(costs[start_cell]):
         return None
-    from vplane_mj.planning.kernels import grid_dijkstra  # numba: loaded by the first call
-
-    return grid_dijkstra.descend(costs, int(start_cell[0]), int(start_cell[1]), costs.size)
+    return descend(costs, start_cell, costs.size)
 
 
 def way_exists(window: Window, start: np.ndarray, end: np.ndarray, radius_m: float) -> bool:
@@ -255,11 +253,11 @@ def _ends(
     return targets, target_costs, start_cell
 
 
-def descend(costs: np.ndarray, start: tuple[int, int], max_cells: int) -> list[tuple[int, int]]:
-    """The cells from `start` down the cost to the target (steepest descent over 8 neighbours),
-    at most `max_cells` steps; just `start` when it has no finite cost (`kernels.grid_dijkstra`)."""
+def descend(costs: np.ndarray, start: tuple[int, int], max_cells: int) -> np.ndarray:
+    """The cells (K, 2: i, j) from `start` down the cost to the target (steepest descent over 8
+    neighbours), at most `max_cells` steps; just `start` when it has no finite cost
+    (`kernels.grid_dijkstra`)."""
     from vplane_mj.planning.kernels import grid_dijkstra  # numba: loaded by the first call
 
     costs = np.ascontiguousarray(costs, float)
-    cells = grid_dijkstra.descend(costs, int(start[0]), int(start[1]), int(max_cells))
-    return [(int(i), int(j)) for i, j in cells.tolist()]
+    return grid_dijkstra.descend(costs, int(start[0]), int(start[1]), int(max_cells))

@@ -50,8 +50,9 @@ WEDGE_SPREAD_CELLS = 2.0
 differ by at most this many cells (`_wedge`)."""
 TURN = 2 * math.pi
 SURE_RAD = 1e-9
-"""A cell whose direction lies more than this (rad) off every bound is surely on its side of each:
-the rule's rounding (an arctangent, differences of angles) is some 1e-14 rad."""
+"""A point whose direction lies more than this (rad) off a line through the robot is surely on its
+side of it (a bound between beams here, an edge of the view in `memory`): the angles' own
+rounding (an arctangent, differences of angles) is some 1e-14 rad."""
 
 
 @njit(cache=True)
@@ -269,6 +270,7 @@ def _wedge(c, reach, directions, half_before, half_after, cell_m):
     wedge's bounds (m^2): the lowest band's low, the highest band's high, the farthest clear,
     show and walk."""
     low = high = math.sqrt(reach[c, 4])
+    lo2, hi2, clear2, show2, reach2 = reach[c, 0], reach[c, 1], reach[c, 2], reach[c, 3], reach[c, 4]
     last = c
     while last + 1 < directions.shape[0]:
         d = last + 1
@@ -279,8 +281,6 @@ def _wedge(c, reach, directions, half_before, half_after, cell_m):
         if not (adjoins and span <= WEDGE_SPAN_RAD and spread <= WEDGE_SPREAD_CELLS * cell_m):
             break
         low, high, last = min(low, far), max(high, far), d
-    lo2, hi2, clear2, show2, reach2 = reach[c, 0], reach[c, 1], reach[c, 2], reach[c, 3], reach[c, 4]
-    for d in range(c + 1, last + 1):
         lo2, hi2 = min(lo2, reach[d, 0]), max(hi2, reach[d, 1])
         clear2, show2, reach2 = max(clear2, reach[d, 2]), max(show2, reach[d, 3]), max(reach2, reach[d, 4])
     return last, lo2, hi2, clear2, show2, reach2

@@ -9,11 +9,7 @@ import math
 import numpy as np
 from numba import njit
 
-from vplane_mj.planning.kernels.map_update import remainder_of_turn
-
-SURE_RAD = 1e-9
-"""A point more than this (rad) off both edges of the view lies surely on its side of each: the
-rule's own rounding (of its arctangent and differences of angles) is some 1e-14 rad."""
+from vplane_mj.planning.kernels.map_update import SURE_RAD, remainder_of_turn
 
 
 @njit(cache=True)
@@ -62,8 +58,8 @@ def _in_view(rel_x, rel_y, distance, yaw, low, span, edges):
     bearing past `low` (rad, robot frame; the robot heading `yaw`), modulo a turn, at most
     `span`. Decided by which side of the view's two edges (`edges`: the unit vectors of its
     first and last bearing, world) it lies on, wherever it lies surely off both (more than
-    SURE_RAD); on an edge, by the angles themselves (the rule's own arithmetic: an arctangent
-    costs some twenty products)."""
+    `map_update.SURE_RAD`); on an edge, by the angles themselves (an arctangent costs some
+    twenty products)."""
     first_x, first_y, last_x, last_y = edges
     past_first = first_x * rel_y - first_y * rel_x  # > 0: counter-clockwise of the first edge
     past_last = last_x * rel_y - last_y * rel_x
