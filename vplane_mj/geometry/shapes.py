@@ -18,6 +18,9 @@ Vec2 = tuple[float, float]
 
 BORDER_THICKNESS_M = 0.1
 """Thickness of the border walls placed just outside the free arena."""
+BOUND_SLACK_M = 1e-9
+"""What the bounds that choose the pieces a footprint is measured against are widened by, far
+above their rounding (`Footprints.outline_distance`)."""
 
 
 @dataclass(frozen=True)
@@ -211,9 +214,10 @@ class Footprints:
         `outline` (k, 2) is the footprint polygon, counter-clockwise in the robot's frame, about
         an origin inside it; `poses` (N, 3) are x, y (m) and yaw (rad). Only pieces that can be
         the nearest are measured exactly: the outline lies within its circumradius R of the
-        origin, so piece p is at least d_p - R away when the origin is d_p away, and no farther
-        than the nearest d_p. Exact: separating axes for rectangles, the outline's distance to
-        the centre for discs.
+        origin and holds the disc of its inradius r about it, so piece p is at least d_p - R
+        away when the origin is d_p away, and the nearest at most max(d_p - r, 0) away (it
+        overlaps p where the disc does). Exact: separating axes for rectangles (whose overlap
+        along an axis is taken as the depth), the outline's distance to the centre for discs.
         """
         poses = np.atleast_2d(np.asarray(poses, dtype=float))
         result = np.full(len(poses), np.inf)
@@ -222,8 +226,9 @@ class Footprints:
         reach = float(np.max(np.hypot(outline[:, 0], outline[:, 1])))
         rects, discs = self._piece_distances(poses[:, :2])
         nearest = np.minimum(rects.min(axis=1, initial=np.inf), discs.min(axis=1, initial=np.inf))
+        bound = (np.maximum(nearest - _inradius(outline), 0.0) + (reach + BOUND_SLACK_M))[:, None]
         for table, measure in ((rects, self._outline_to_rects), (discs, self._outline_to_discs)):
-            pose_index, piece_index = np.nonzero(table - reach <= nearest[:, None])
+            pose_index, piece_index = np.nonzero(table <= bound)
             if len(pose_index):
                 distances = measure(outline, poses[pose_index], piece_index)
                 np.minimum.at(result, pose_index, distances)
@@ -231,14 +236,14 @@ class Footprints:
 
     def _piece_distances(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Signed distances (m) from each point (N, 2) to each rectangle (N, R) and disc (N, D)."""
-        rel = points[:, None, :] - self._rect_center[None, :, :]
-        lx = rel[..., 0] * self._rect_cos + rel[..., 1] * self._rect_sin
-        ly = -rel[..., 0] * self._rect_sin + rel[..., 1] * self._rect_cos
+        x, y = points[:, 0, None], points[:, 1, None]
+        dx, dy = x - self._rect_center[:, 0], y - self._rect_center[:, 1]
+        lx = dx * self._rect_cos + dy * self._rect_sin
+        ly = -dx * self._rect_sin + dy * self._rect_cos
         qx = np.abs(lx) - self._rect_half[:, 0]
         qy = np.abs(ly) - self._rect_half[:, 1]
         rects = np.hypot(np.maximum(qx, 0.0), np.maximum(qy, 0.0)) + np.minimum(np.maximum(qx, qy), 0.0)
-        rel = points[:, None, :] - self._disc_center[None, :, :]
-        discs = np.hypot(rel[..., 0], rel[..., 1]) - self._disc_radius
+        discs = np.hypot(x - self._disc_center[:, 0], y - self._disc_center[:, 1]) - self._disc_radius
         return rects, discs
 
     def _outline_to_discs(self, outline: np.ndarray, poses: np.ndarray, discs: np.ndarray) -> np.ndarray:
@@ -301,6 +306,15 @@ def _to_body(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
     c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
     dx, dy = points[:, 0] - poses[:, 0], points[:, 1] - poses[:, 1]
     return np.column_stack((c * dx + s * dy, -s * dx + c * dy))
+
+
+def _inradius(polygon: np.ndarray) -> float:
+    """The distance (m) from the origin to the nearest edge line of a convex counter-clockwise
+    polygon (k, 2) about it: the radius of the disc about the origin it holds (0 for an origin
+    outside it)."""
+    edge = np.roll(polygon, -1, axis=0) - polygon
+    inward = edge[:, 1] * polygon[:, 0] - edge[:, 0] * polygon[:, 1]  # edge x (origin - start)
+    return max(0.0, float(np.min(inward / np.hypot(edge[:, 0], edge[:, 1]))))
 
 
 def _polygon_distance(polygon: np.ndarray, points: np.ndarray) -> np.ndarray:
