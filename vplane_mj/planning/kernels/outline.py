@@ -5,8 +5,8 @@ to the footprint at the motion's poses.
 A distance is the C library's `hypot`, as numpy's; it costs some twenty times a product, so
 it is taken only where a squared distance cannot decide: a squared distance carries a
 rounding error of a few parts in 1e16, and a comparison it decides with a margin of SURE (a
-relative 1e-9, and 1e-9 m) comes out as the distance's would (`_closer`, `_surely_beyond`,
-`_gap`): the same numbers as `hypot` everywhere.
+relative 1e-9, and 1e-9 m) comes out as the distance's would (`_surely_beyond`, `_gap`): the
+same numbers as `hypot` everywhere.
 """
 
 from __future__ import annotations
@@ -65,17 +65,6 @@ def _surely_beyond(dx: float, dy: float, bound: float) -> bool:
 
 
 @njit(cache=True)
-def _closer(dx: float, dy: float, bound: float) -> bool:
-    """hypot(dx, dy) < `bound` (m), by the square where it decides surely."""
-    if _surely_beyond(dx, dy, bound):
-        return False
-    limit = bound * (1.0 - SURE) - SURE_M
-    if limit > 0.0 and dx * dx + dy * dy < limit * limit:
-        return True
-    return math.hypot(dx, dy) < bound
-
-
-@njit(cache=True)
 def first_blocked_turn(
     footprint: np.ndarray,
     normals: np.ndarray,
@@ -125,25 +114,28 @@ def intrusion(
     inside) at pose m and d0 at the first pose, and 0 at least (`motion.intrusion`); margins[m]
     is `margin_m` plus `growth` times the way the outline has swept up to pose m (its travel
     plus `radius_m`, the footprint's circumscribed radius, times its turn). Only the points
-    within reach of the motion are measured, and a point whose distance to pose m's origin
-    less `radius_m` already keeps it from raising the largest so far is not measured there.
-    Returns as soon as the largest exceeds `enough` (inf: the exact largest)."""
+    within reach of the motion are measured (those in the box around the poses' origins that
+    holds every point within `radius_m` and the last margin, the largest, of one), and a point whose distance
+    to pose m's origin less `radius_m` already keeps it from raising the largest so far is not
+    measured there. Returns as soon as the largest exceeds `enough` (inf: the exact largest)."""
     steps = poses.shape[0]
     margins = np.empty(steps)
     margins[0] = margin_m + growth * 0.0
     swept = 0.0
-    farthest = math.hypot(poses[0, 0], poses[0, 1])
+    low_x, high_x, low_y, high_y = poses[0, 0], poses[0, 0], poses[0, 1], poses[0, 1]
     for m in range(1, steps):
         way = math.hypot(poses[m, 0] - poses[m - 1, 0], poses[m, 1] - poses[m - 1, 1]) + radius_m * abs(
             poses[m, 2] - poses[m - 1, 2]
         )
         swept = way if m == 1 else swept + way  # a cumulative sum, as numpy's
         margins[m] = margin_m + growth * swept
-        farthest = max(farthest, math.hypot(poses[m, 0], poses[m, 1]))
-    reach = farthest + radius_m + margins[steps - 1]
+        low_x, high_x = min(low_x, poses[m, 0]), max(high_x, poses[m, 0])
+        low_y, high_y = min(low_y, poses[m, 1]), max(high_y, poses[m, 1])
+    reach = (radius_m + margins[steps - 1]) * (1.0 + SURE) + SURE_M
     near = np.empty(local.shape[0], dtype=np.bool_)
     for n in range(local.shape[0]):
-        near[n] = _closer(local[n, 0], local[n, 1], reach)
+        x, y = local[n, 0], local[n, 1]
+        near[n] = low_x - reach <= x <= high_x + reach and low_y - reach <= y <= high_y + reach
     local = local[near]
     count = local.shape[0]
     if count == 0:
