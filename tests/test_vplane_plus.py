@@ -312,6 +312,35 @@ def test_line_of_sight_checks_linspaces_points_every_half_cell():
         assert window.line_of_sight(a, b) == bool(np.isfinite(cost[i[inside], j[inside]]).all())
 
 
+def test_the_next_waypoint_is_the_farthest_in_sight_of_the_run_within_reach_past_the_nearest():
+    """The compiled choice against its definition: the nearest point (the first of equally near
+    ones), the run of points after it within reach, the farthest of them the robot sees in a
+    straight line (the nearest when none); every one seen without a window."""
+    from vplane_mj.planning import vplane_plus
+    from vplane_mj.planning.kernels import way as way_kernels
+
+    rng = np.random.default_rng(11)
+    for trial in range(2000):
+        cost = np.ones((40, 40))
+        cost[rng.random(cost.shape) < 0.05] = np.inf
+        window = gridsearch.Window(cost, np.zeros(2), 0.05, np.zeros(cost.shape, bool))
+        way = np.cumsum(rng.uniform(-0.3, 0.4, (int(rng.integers(1, 12)), 2)), axis=0) + 0.5
+        if trial % 4 == 0:
+            way = np.repeat(way, 2, axis=0)  # equally near points
+        position, reach = rng.uniform(0.0, 2.0, 2), float(rng.uniform(0.2, 1.5))
+        distances = np.hypot(*(way - position).T)
+        nearest = int(np.argmin(distances))
+        last = nearest
+        while last + 1 < len(way) and distances[last + 1] <= reach:
+            last += 1
+        seen = [k for k in range(last, nearest, -1) if window.line_of_sight(position, way[k])]
+        farthest_seen = seen[0] if seen else nearest
+        x, y = float(position[0]), float(position[1])
+        assert way_kernels.next_waypoint(x, y, way, reach, window.packed()) == (nearest, farthest_seen)
+        unseen = (vplane_plus.NO_SIGHT, 0.0, 0.0, 1.0)
+        assert way_kernels.next_waypoint(x, y, way, reach, unseen) == (nearest, last)
+
+
 def test_descent_steps_to_the_first_cheapest_neighbour_until_none_is_cheaper():
     """The compiled descent against its definition, on cost fields with ties and walls."""
     neighbours = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1))

@@ -161,13 +161,16 @@ class Window:
 
     def line_of_sight(self, a: np.ndarray, b: np.ndarray) -> bool:
         """Whether the straight segment between two world points (m) stays on free cells (or
-        leaves the window), sampled every half cell (`kernels.grid.segment_free`)."""
-        from vplane_mj.planning.kernels import grid  # numba: loaded by the first call
+        leaves the window), sampled every half cell (`kernels.way.segment_free`)."""
+        from vplane_mj.planning.kernels import way  # numba: loaded by the first call
 
-        steps = max(2, math.ceil(2 * float(np.hypot(*(b - a))) / self.cell_m) + 1)
-        corner = self.corner
-        a, b = np.asarray(a, float), np.asarray(b, float)
-        return grid.segment_free(self.cost, float(corner[0]), float(corner[1]), self.cell_m, a, b, steps)
+        (ax, ay), (bx, by) = np.asarray(a, float), np.asarray(b, float)
+        return way.segment_free(self.packed(), float(ax), float(ay), float(bx), float(by))
+
+    def packed(self) -> tuple[np.ndarray, float, float, float]:
+        """The window as `kernels.way` reads it: its step costs, its corner's x and y and its
+        cell size (m)."""
+        return self.cost, float(self.corner[0]), float(self.corner[1]), float(self.cell_m)
 
 
 def cost_to_go(

@@ -72,6 +72,8 @@ TRAP_REACH_M = 2.5
 NO_WAY = np.empty((0, 2))
 NO_WAY.flags.writeable = False
 """An empty way (K = 0 waypoints): ways are (K, 2) arrays of waypoints (m), never written."""
+NO_SIGHT = np.empty((0, 0))
+"""The step costs of no window (`kernels.way.next_waypoint`): every waypoint is in sight."""
 
 
 def plane_refused(e1: np.ndarray, e2: np.ndarray, why: str) -> Event:
@@ -664,18 +666,14 @@ class VPlanePlusPlanner(VPlanePlanner):
         """The farthest point of the way (K, 2; m) within `waypoint_m` that the robot sees in a
         straight line on the map (the way's end when the way is empty), and the way without the
         points before the one nearest the robot: the robot has passed them."""
+        from vplane_mj.planning.kernels import way as way_kernels  # numba: loaded by the first call
+
         if not len(way):
             return end, way
-        reach = self.params.waypoint_m
-        distances = np.hypot(*(way - position).T)
-        nearest = int(np.argmin(distances))
-        way = way[nearest:]  # the robot has passed the points before
-        beyond = np.flatnonzero(distances[nearest + 1 :] > reach)
-        within = 1 + (int(beyond[0]) if len(beyond) else len(way) - 1)  # the leading run within reach
-        for k in range(within - 1, 0, -1):  # the farthest first
-            if self.sight is None or self.sight.line_of_sight(position, way[k]):
-                return way[k], way
-        return way[0], way
+        sight = (NO_SIGHT, 0.0, 0.0, 1.0) if self.sight is None else self.sight.packed()
+        x, y = float(position[0]), float(position[1])
+        nearest, chosen = way_kernels.next_waypoint(x, y, way, self.params.waypoint_m, sight)
+        return way[chosen], way[nearest:]  # the robot has passed the points before the nearest
 
 
 def _or_no_way(way: np.ndarray | None) -> np.ndarray:

@@ -1,5 +1,5 @@
-"""Reading the local map's grid, compiled: its obstacle cells near a point, its clusters, whether a
-segment crosses a blocked cell; marking the cells the robot stands on."""
+"""Reading the local map's grid, compiled: its obstacle cells near a point, its clusters; marking
+the cells the robot stands on."""
 
 from __future__ import annotations
 
@@ -155,38 +155,6 @@ def label_regions(mask: np.ndarray) -> np.ndarray:
                         stack[top] = na * cols + nb
                         top += 1
     return labels
-
-
-@njit(cache=True)
-def segment_free(
-    cost: np.ndarray,
-    corner_x: float,
-    corner_y: float,
-    cell_m: float,
-    a: np.ndarray,
-    b: np.ndarray,
-    steps: int,
-) -> bool:
-    """Whether the `steps` (at least 2) evenly spaced points from a to b (m; `np.linspace`'s
-    points, bit for bit) all lie on finite cells of `cost` (cells of `cell_m` from the corner
-    (corner_x, corner_y), m) or outside it."""
-    rows, cols = cost.shape
-    div = steps - 1
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    step_x, step_y = dx / div, dy / div
-    tiny = step_x == 0 or step_y == 0  # linspace then scales by the whole difference
-    for k in range(steps):
-        if k == div:
-            x, y = b[0], b[1]
-        elif tiny:
-            x, y = k / div * dx + a[0], k / div * dy + a[1]
-        else:
-            x, y = k * step_x + a[0], k * step_y + a[1]
-        i = math.floor((x - corner_x) / cell_m)
-        j = math.floor((y - corner_y) / cell_m)
-        if 0 <= i < rows and 0 <= j < cols and not math.isfinite(cost[i, j]):
-            return False
-    return True
 
 
 @njit(cache=True)

@@ -1,5 +1,6 @@
-"""Following a way of waypoints, compiled: the speed its bends allow (`SpeedPolicy.bend_speed`)
-and whether mapped cells block its next stretch (`vplane_plus`'s check of the way ahead)."""
+"""Following a way of waypoints, compiled: the next waypoint the robot sees in a straight line,
+the speed the way's bends allow (`SpeedPolicy.bend_speed`) and whether mapped cells block its
+next stretch (`vplane_plus`'s check of the way ahead)."""
 
 from __future__ import annotations
 
@@ -57,3 +58,53 @@ def blocked(x: float, y: float, way: np.ndarray, reach_m: float, cells: np.ndarr
             if math.hypot(cells[c, 0] - way[k, 0], cells[c, 1] - way[k, 1]) < gap_m:
                 return True
     return False
+
+
+@njit(cache=True)
+def next_waypoint(x: float, y: float, way: np.ndarray, reach_m: float, sight: tuple) -> tuple[int, int]:
+    """For the robot at `x`, `y` (m) on `way` (K >= 1, 2; m): the index of the way's point
+    nearest it (the first of equally near ones), and of the farthest point of the run that
+    follows it within `reach_m` (m) of the robot that it sees in a straight line
+    (`segment_free` on `sight`; costs of 0 x 0: it sees every one), else the nearest's.
+    Distances are the C library's `hypot`, as numpy's."""
+    count = way.shape[0]
+    distances = np.empty(count)
+    nearest = 0
+    for k in range(count):
+        distances[k] = math.hypot(way[k, 0] - x, way[k, 1] - y)
+        if distances[k] < distances[nearest]:
+            nearest = k
+    last = nearest
+    while last + 1 < count and not distances[last + 1] > reach_m:
+        last += 1
+    for k in range(last, nearest, -1):  # the farthest first
+        if segment_free(sight, x, y, way[k, 0], way[k, 1]):
+            return nearest, k
+    return nearest, nearest
+
+
+@njit(cache=True)
+def segment_free(sight: tuple, ax: float, ay: float, bx: float, by: float) -> bool:
+    """Whether the points every half cell from a to b (m; `np.linspace`'s points, bit for bit,
+    max(2, ceil(2 |b - a| / cell_m) + 1) of them) all lie on finite cells of a window's step
+    costs or outside it: `sight` is the costs, the window's corner's x and y and its cell size
+    `cell_m` (m)."""
+    cost, corner_x, corner_y, cell_m = sight
+    rows, cols = cost.shape
+    dx, dy = bx - ax, by - ay
+    steps = max(2, math.ceil(2 * math.hypot(dx, dy) / cell_m) + 1)
+    div = steps - 1
+    step_x, step_y = dx / div, dy / div
+    tiny = step_x == 0 or step_y == 0  # linspace then scales by the whole difference
+    for k in range(steps):
+        if k == div:
+            x, y = bx, by
+        elif tiny:
+            x, y = k / div * dx + ax, k / div * dy + ay
+        else:
+            x, y = k * step_x + ax, k * step_y + ay
+        i = math.floor((x - corner_x) / cell_m)
+        j = math.floor((y - corner_y) / cell_m)
+        if 0 <= i < rows and 0 <= j < cols and not math.isfinite(cost[i, j]):
+            return False
+    return True
