@@ -182,8 +182,8 @@ def test_the_compiled_step_costs_are_numpys_arithmetic_bit_for_bit():
         doubtful = (rng.random(shape) < rng.choice([0.0, 0.01, 0.05])) & ~sure
         cell, lethal, inflation = (
             float(rng.choice([0.05, 0.1])),
-            rng.uniform(0.05, 0.4),
-            rng.uniform(0.05, 0.5),
+            rng.choice([rng.uniform(0.05, 0.4), 0.1 * rng.integers(1, 5)]),  # and whole cells
+            rng.choice([rng.uniform(0.05, 0.5), 0.1 * rng.integers(1, 5), rng.uniform(1.0, 3.0)]),
         )
         args = (
             cell,
@@ -194,6 +194,26 @@ def test_the_compiled_step_costs_are_numpys_arithmetic_bit_for_bit():
         )
         got = gridsearch.step_costs(sure, doubtful, *args)
         np.testing.assert_array_equal(got, _step_costs_by_numpy(sure, doubtful, *args))
+
+
+def test_the_squared_distances_within_the_band_are_a_distance_transforms():
+    """Within the band, the squared distance to the nearest blocked cell, as scipy's transform
+    gives it; beyond, some larger value below the bound."""
+    from scipy import ndimage
+
+    from vplane_mj.planning.kernels.step_costs import near_squares, near_squares_bound
+
+    rng = np.random.default_rng(6)
+    for _ in range(200):
+        shape = tuple(int(k) for k in rng.integers(1, 60, 2))
+        blocked = rng.random(shape) < rng.choice([0.002, 0.01, 0.05, 0.3])
+        blocked.flat[rng.integers(blocked.size)] = True
+        band = int(rng.integers(1, 20))
+        near = near_squares(blocked.view(np.uint8), band)
+        exact = np.rint(ndimage.distance_transform_edt(~blocked) ** 2).astype(int)
+        within = exact <= band * band
+        np.testing.assert_array_equal(near[within], exact[within])
+        assert (near[~within] > band * band).all() and (near < near_squares_bound(band)).all()
 
 
 def descend(costs: np.ndarray, start: tuple[int, int], max_cells: int) -> list[tuple[int, int]]:

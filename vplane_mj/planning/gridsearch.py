@@ -22,8 +22,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-NO_DISTANCES = np.empty((0, 0))
-"""No distances (to sure obstacle cells, where there are none)."""
 INFLATED_STEP_COST = 10.0
 """Step cost of blocked cells made passable (under the robot's own disc, at the goal)."""
 
@@ -43,18 +41,10 @@ def step_costs(
     the sonar settles the doubt on the way); 1 + w ((lethal + inflation - d) / inflation)^2
     within `inflation_m` beyond the lethal distance of either kind; 1 farther."""
     from vplane_mj.planning.kernels import step_costs as kernels  # numba: loaded by the first call
-    from vplane_mj.planning.kernels.edt import distance_transform
 
     sure, doubtful = np.ascontiguousarray(sure, bool), np.ascontiguousarray(doubtful, bool)
-    free, any_sure, any_doubtful = kernels.obstacles(sure, doubtful)
-    if not (any_sure or any_doubtful):
-        return np.ones(sure.shape)
-    d = distance_transform(free)
-    sure_d = d if any_sure else NO_DISTANCES
-    if any_sure and any_doubtful:  # the same cells but for the doubtful ones: their own distances
-        sure_d = distance_transform(~sure)
     rule = (float(cell_m), float(lethal_m), float(inflation_m), float(inflation_weight), float(doubt_cost))
-    return kernels.step_costs(d, sure_d, rule)
+    return kernels.step_costs(sure, doubtful, rule)
 
 
 def clear_step_cost(beyond_lethal_m: float, inflation_m: float, inflation_weight: float) -> float:
