@@ -354,6 +354,7 @@ class Governor:
     """The speeds the body may drive at along a way."""
     _view_key: tuple[np.ndarray, float] | None = field(default=None, init=False, repr=False)
     _field_of_view: tuple[int, float, float] = field(default=(0, 0.0, 0.0), init=False, repr=False)
+    _reach: tuple[float, float] = field(default=(math.nan, 0.0), init=False, repr=False)
 
     def __post_init__(self) -> None:
         self.drive = DriveModel(self.body.limits)
@@ -365,18 +366,19 @@ class Governor:
         circumscribed radius, the longest motion it predicts (one control period at the top
         speed and the braking from it, turning hard), the larger margin and the margin's growth
         along that motion and the longest coast of a turn."""
-        limits, period = self.body.limits, self.drive.period_s
+        period = self.drive.period_s
+        if self._reach[0] == period:  # kept while the control period is the same
+            return self._reach[1]
+        limits = self.body.limits
         top, rate = limits.max_speed_mps, limits.max_turn_rate_radps
         brake = min(limits.max_accel_mps2, limits.braking_in_turn_mps2)
         travel = top * (period + top / (2 * brake))
         turn = rate * (period + limits.turn_lag_s) + rate * rate / (2 * limits.max_turn_accel_radps2)
         swept = travel + self.body.radius_m * turn
-        return (
-            self.body.radius_m
-            + travel
-            + max(self.stop_margin_m, self.turn_margin_m)
-            + PREDICTION_ERROR * swept
-        )
+        margin = max(self.stop_margin_m, self.turn_margin_m)
+        reach = self.body.radius_m + travel + margin + PREDICTION_ERROR * swept
+        self._reach = (period, reach)
+        return reach
 
     @property
     def idle(self) -> bool:

@@ -39,6 +39,7 @@ def cost_to_go(
     if not least > 0.0:
         raise ValueError("step costs must be positive")
     diagonal_m = cell_m * math.sqrt(2)
+    half_cell, half_diagonal = cell_m * 0.5, diagonal_m * 0.5  # a move: its length times the mean
     width = cell_m * least / 2  # each move costs at least twice a bucket's width
     rings = math.ceil(diagonal_m * most / width) + 2  # a move's cost spans fewer buckets
     order = np.argsort(target_costs, kind="mergesort")
@@ -77,17 +78,21 @@ def cost_to_go(
             continue  # queued again cheaper since: a stale entry (a cell's last entry settles it)
         if u == stop:
             break
+        here = step[u]
+        free_up, free_down = math.isfinite(step[u - wide]), math.isfinite(step[u + wide])
+        free_left, free_right = math.isfinite(step[u - 1]), math.isfinite(step[u + 1])
         for s in range(8):
             di, dj = _STEPS[s, 0], _STEPS[s, 1]
-            v = u + di * wide + dj
-            if not math.isfinite(step[v]):
-                continue  # blocked (a settled neighbour is passed over below: no move lowers it)
-            length = cell_m
+            half_length = half_cell
             if di != 0 and dj != 0:  # diagonal: both orthogonal neighbours free, no corner cut
-                if not (math.isfinite(step[u + di * wide]) and math.isfinite(step[u + dj])):
+                if not ((free_up if di < 0 else free_down) and (free_left if dj < 0 else free_right)):
                     continue
-                length = diagonal_m
-            candidate = d + length * 0.5 * (step[u] + step[v])
+                half_length = half_diagonal
+            v = u + di * wide + dj
+            there = step[v]
+            if not math.isfinite(there):
+                continue  # blocked (a settled neighbour is passed over below: no move lowers it)
+            candidate = d + half_length * (here + there)  # half the length, exactly: times 0.5
             if candidate < dist[v]:
                 dist[v] = candidate
                 used = _push(head, after, cells, keys, used, v, candidate, width)

@@ -96,12 +96,15 @@ def _first_in_each_cell(points: np.ndarray, cell_m: float) -> np.ndarray:
     size = 2
     while size < 2 * count:
         size *= 2
+    cells = np.empty(count, dtype=np.int64)
+    for k in range(count):  # a loop of its own, which the compiler runs on many points at once
+        cells[k] = math.floor(points[k, 0] / cell_m) * (1 << 32) + math.floor(points[k, 1] / cell_m)
     keys = np.empty(size, dtype=np.int64)
     taken = np.zeros(size, dtype=np.bool_)
     first = np.empty(count, dtype=np.int64)
     found = 0
     for k in range(count):
-        key = math.floor(points[k, 0] / cell_m) * (1 << 32) + math.floor(points[k, 1] / cell_m)
+        key = cells[k]
         slot = np.int64((np.uint64(key) * np.uint64(0x9E3779B97F4A7C15)) >> np.uint64(32)) & (size - 1)
         while taken[slot] and keys[slot] != key:
             slot = (slot + 1) & (size - 1)
