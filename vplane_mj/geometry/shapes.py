@@ -224,7 +224,7 @@ class Footprints:
         if not len(self.pieces):
             return result
         reach = float(np.max(np.hypot(outline[:, 0], outline[:, 1])))
-        rects, discs = self._piece_distances(poses[:, :2])
+        rects, discs = self._piece_distances(poses[:, :2], _quick_norm)  # bounds: the slack covers rounding
         nearest = np.minimum(rects.min(axis=1, initial=np.inf), discs.min(axis=1, initial=np.inf))
         bound = (np.maximum(nearest - _inradius(outline), 0.0) + (reach + BOUND_SLACK_M))[:, None]
         for table, measure in ((rects, self._outline_to_rects), (discs, self._outline_to_discs)):
@@ -234,16 +234,17 @@ class Footprints:
                 np.minimum.at(result, pose_index, distances)
         return result
 
-    def _piece_distances(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Signed distances (m) from each point (N, 2) to each rectangle (N, R) and disc (N, D)."""
+    def _piece_distances(self, points: np.ndarray, norm=np.hypot) -> tuple[np.ndarray, np.ndarray]:
+        """Signed distances (m) from each point (N, 2) to each rectangle (N, R) and disc (N, D),
+        lengths by `norm` (x, y)."""
         x, y = points[:, 0, None], points[:, 1, None]
         dx, dy = x - self._rect_center[:, 0], y - self._rect_center[:, 1]
         lx = dx * self._rect_cos + dy * self._rect_sin
         ly = -dx * self._rect_sin + dy * self._rect_cos
         qx = np.abs(lx) - self._rect_half[:, 0]
         qy = np.abs(ly) - self._rect_half[:, 1]
-        rects = np.hypot(np.maximum(qx, 0.0), np.maximum(qy, 0.0)) + np.minimum(np.maximum(qx, qy), 0.0)
-        discs = np.hypot(x - self._disc_center[:, 0], y - self._disc_center[:, 1]) - self._disc_radius
+        rects = norm(np.maximum(qx, 0.0), np.maximum(qy, 0.0)) + np.minimum(np.maximum(qx, qy), 0.0)
+        discs = norm(x - self._disc_center[:, 0], y - self._disc_center[:, 1]) - self._disc_radius
         return rects, discs
 
     def _outline_to_discs(self, outline: np.ndarray, poses: np.ndarray, discs: np.ndarray) -> np.ndarray:
@@ -306,6 +307,11 @@ def _to_body(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
     c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
     dx, dy = points[:, 0] - poses[:, 0], points[:, 1] - poses[:, 1]
     return np.column_stack((c * dx + s * dy, -s * dx + c * dy))
+
+
+def _quick_norm(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """sqrt(x^2 + y^2), some times quicker than `np.hypot` and within a few parts in 1e16 of it."""
+    return np.sqrt(x * x + y * y)
 
 
 def _inradius(polygon: np.ndarray) -> float:
