@@ -64,6 +64,14 @@ def _surely_beyond(dx: float, dy: float, bound: float) -> bool:
     return bound > 0.0 and dx * dx + dy * dy > limit * limit
 
 
+@njit(cache=True, inline="always")
+def _beyond_box(x: float, y: float, box: tuple[float, float, float, float], bound: float) -> bool:
+    """Whether the point (x, y) lies more than `bound` (m) and SURE_M beyond the box (x low, x
+    high, y low, y high; m) that holds the footprint, along x or y: then farther than `bound`
+    from the footprint itself, surely (the footprint's distance, `_gap`, is at least that)."""
+    return max(box[0] - x, x - box[1], box[2] - y, y - box[3]) > bound + SURE_M
+
+
 @njit(cache=True)
 def first_blocked_turn(
     footprint: np.ndarray,
@@ -115,9 +123,10 @@ def intrusion(
     is `margin_m` plus `growth` times the way the outline has swept up to pose m (its travel
     plus `radius_m`, the footprint's circumscribed radius, times its turn). Only the points
     within reach of the motion are measured (those in the box around the poses' origins that
-    holds every point within `radius_m` and the last margin, the largest, of one), and a point whose distance
-    to pose m's origin less `radius_m` already keeps it from raising the largest so far is not
-    measured there. Returns as soon as the largest exceeds `enough` (inf: the exact largest)."""
+    holds every point within `radius_m` and the last margin, the largest, of one), and a point
+    whose distance to pose m's origin less `radius_m`, or to the box that holds the footprint
+    at pose m, already keeps it from raising the largest so far is not measured there. Returns
+    as soon as the largest exceeds `enough` (inf: the exact largest)."""
     steps = poses.shape[0]
     margins = np.empty(steps)
     margins[0] = margin_m + growth * 0.0
@@ -140,29 +149,32 @@ def intrusion(
     count = local.shape[0]
     if count == 0:
         return 0.0
+    box = (footprint[:, 0].min(), footprint[:, 0].max(), footprint[:, 1].min(), footprint[:, 1].max())
     # A point surely the largest margin away from the footprint at the first pose (its distance
-    # from that pose's origin less radius_m is) is allowed the margins themselves: its own
-    # distance is not needed.
+    # from that pose's origin less radius_m is, or from the footprint's box) is allowed the
+    # margins themselves: its own distance is not needed.
     first = np.empty(count)
+    widest = margins[steps - 1]
     c, s = math.cos(poses[0, 2]), math.sin(poses[0, 2])
     for n in range(count):
         dx, dy = local[n, 0] - poses[0, 0], local[n, 1] - poses[0, 1]
-        if _surely_beyond(dx, dy, margins[steps - 1] + radius_m):
+        x, y = c * dx + s * dy, -s * dx + c * dy
+        if _surely_beyond(dx, dy, widest + radius_m) or _beyond_box(x, y, box, widest):
             first[n] = math.inf
         else:
-            first[n] = _gap(footprint, normals, c * dx + s * dy, -s * dx + c * dy)
+            first[n] = _gap(footprint, normals, x, y)
     worst = 0.0
     for m in range(1, steps):
         c, s = math.cos(poses[m, 2]), math.sin(poses[m, 2])
         for n in range(count):
             allowed = min(margins[m], first[n])
             dx, dy = local[n, 0] - poses[m, 0], local[n, 1] - poses[m, 1]
-            if (
-                _surely_beyond(dx, dy, allowed - worst + radius_m)
-                or math.hypot(dx, dy) - radius_m >= allowed - worst
-            ):
+            if _surely_beyond(dx, dy, allowed - worst + radius_m):
                 continue  # farther than the circumscribed disc allows: cannot intrude more
-            gap = _gap(footprint, normals, c * dx + s * dy, -s * dx + c * dy)
+            x, y = c * dx + s * dy, -s * dx + c * dy
+            if _beyond_box(x, y, box, allowed - worst):
+                continue  # as far from the footprint's box: cannot intrude more either
+            gap = _gap(footprint, normals, x, y)
             if allowed - gap > worst:
                 worst = allowed - gap
                 if worst > enough:
