@@ -246,7 +246,7 @@ def test_the_intrusion_is_the_largest_over_every_point_and_pose_of_the_distances
 def test_the_kernels_squares_decide_as_hypot_does_bit_for_bit():
     from numba import njit
 
-    from vplane_mj.planning.kernels import memory, outline
+    from vplane_mj.planning.kernels import outline
 
     hypot = njit(lambda dx, dy: math.hypot(dx, dy))  # the compiled kernels' (the C library's)
     rng = np.random.default_rng(2)
@@ -256,7 +256,7 @@ def test_the_kernels_squares_decide_as_hypot_does_bit_for_bit():
     )
     bounds[::50] = -bounds[::50]  # and bounds below zero
     for (dx, dy), bound in zip(offsets, bounds, strict=True):
-        assert memory._closer(dx, dy, bound) == (hypot(dx, dy) < bound)
+        assert outline.closer(dx, dy, bound) == (hypot(dx, dy) < bound)
         assert not outline._surely_beyond(dx, dy, bound) or hypot(dx, dy) > bound
     # The distance to the outline: the least hypot over the edges, the same bits.
     body = robot_body("jackal")

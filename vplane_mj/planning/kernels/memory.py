@@ -10,7 +10,7 @@ import numpy as np
 from numba import njit
 
 from vplane_mj.planning.kernels.map_update import SURE_RAD, remainder_of_turn
-from vplane_mj.planning.kernels.outline import SURE, SURE_M
+from vplane_mj.planning.kernels.outline import closer
 
 
 @njit(cache=True)
@@ -37,7 +37,7 @@ def recall(
     edges = (math.cos(yaw + low), math.sin(yaw + low), math.cos(yaw + low + span), math.sin(yaw + low + span))
     for k in range(remembered.shape[0]):
         rel_x, rel_y = remembered[k, 0] - x, remembered[k, 1] - y
-        if _closer(rel_x, rel_y, reach_m):
+        if closer(rel_x, rel_y, reach_m):
             if view == 0:
                 unseen[k] = True
             elif view < 0:
@@ -50,22 +50,6 @@ def recall(
         local[k, 0] = c * rel_x + s * rel_y
         local[k, 1] = -s * rel_x + c * rel_y
     return local, known[_first_in_each_cell(known, cell_m)]
-
-
-@njit(cache=True, inline="always")
-def _closer(dx: float, dy: float, bound: float) -> bool:
-    """hypot(dx, dy) < `bound` (m), the C library's `hypot` (numpy's) taken only where the square
-    does not decide: a squared distance carries a rounding error of a few parts in 1e16, and a
-    comparison it decides with a margin of `outline.SURE` (relative) and `outline.SURE_M` comes
-    out as the distance's would."""
-    square = dx * dx + dy * dy
-    beyond = bound * (1.0 + SURE) + SURE_M
-    if bound > 0.0 and square > beyond * beyond:
-        return False
-    within = bound * (1.0 - SURE) - SURE_M
-    if within > 0.0 and square < within * within:
-        return True
-    return math.hypot(dx, dy) < bound
 
 
 @njit(cache=True)

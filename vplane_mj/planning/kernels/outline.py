@@ -5,8 +5,8 @@ to the footprint at the motion's poses.
 A distance is the C library's `hypot`, as numpy's; it costs some twenty times a product, so
 it is taken only where a squared distance cannot decide: a squared distance carries a
 rounding error of a few parts in 1e16, and a comparison it decides with a margin of SURE (a
-relative 1e-9, and 1e-9 m) comes out as the distance's would (`_surely_beyond`, `_gap`): the
-same numbers as `hypot` everywhere.
+relative 1e-9, and 1e-9 m) comes out as the distance's would (`_surely_beyond`, `closer`,
+`_gap`): the same numbers as `hypot` everywhere.
 """
 
 from __future__ import annotations
@@ -65,6 +65,22 @@ def _surely_beyond(dx: float, dy: float, bound: float) -> bool:
 
 
 @njit(cache=True, inline="always")
+def closer(dx: float, dy: float, bound: float) -> bool:
+    """hypot(dx, dy) < `bound` (m), the C library's `hypot` (numpy's) taken only where the square
+    does not decide: a squared distance carries a rounding error of a few parts in 1e16, and a
+    comparison it decides with a margin of SURE (relative) and SURE_M comes out as the
+    distance's would."""
+    square = dx * dx + dy * dy
+    beyond = bound * (1.0 + SURE) + SURE_M
+    if bound > 0.0 and square > beyond * beyond:
+        return False
+    within = bound * (1.0 - SURE) - SURE_M
+    if within > 0.0 and square < within * within:
+        return True
+    return math.hypot(dx, dy) < bound
+
+
+@njit(cache=True, inline="always")
 def _beyond_box(x: float, y: float, box: tuple[float, float, float, float], bound: float) -> bool:
     """Whether the point (x, y) lies more than `bound` (m) and SURE_M beyond the box (x low, x
     high, y low, y high; m) that holds the footprint, along x or y: then farther than `bound`
@@ -88,7 +104,7 @@ def first_blocked_turn(
     count = 0
     near = np.empty(local.shape[0], dtype=np.int64)
     for n in range(local.shape[0]):
-        if math.hypot(local[n, 0], local[n, 1]) < near_m:
+        if closer(local[n, 0], local[n, 1], near_m):
             near[count] = n
             count += 1
     limits = np.empty(count)
