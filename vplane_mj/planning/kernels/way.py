@@ -9,6 +9,8 @@ import math
 import numpy as np
 from numba import njit
 
+from vplane_mj.planning.kernels.outline import closer
+
 TURN = 2 * math.pi
 
 
@@ -55,7 +57,7 @@ def blocked(x: float, y: float, way: np.ndarray, reach_m: float, cells: np.ndarr
         if math.hypot(way[k, 0] - x, way[k, 1] - y) > reach_m:
             continue
         for c in range(cells.shape[0]):
-            if math.hypot(cells[c, 0] - way[k, 0], cells[c, 1] - way[k, 1]) < gap_m:
+            if closer(cells[c, 0] - way[k, 0], cells[c, 1] - way[k, 1], gap_m):  # hypot's answer
                 return True
     return False
 
