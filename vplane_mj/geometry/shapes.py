@@ -9,7 +9,7 @@ against them and tests check them against hand-computed points. Pure numpy.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -234,7 +234,9 @@ class Footprints:
                 np.minimum.at(result, pose_index, distances)
         return result
 
-    def _piece_distances(self, points: np.ndarray, norm=np.hypot) -> tuple[np.ndarray, np.ndarray]:
+    def _piece_distances(
+        self, points: np.ndarray, norm: Callable[[np.ndarray, np.ndarray], np.ndarray] = np.hypot
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Signed distances (m) from each point (N, 2) to each rectangle (N, R) and disc (N, D),
         lengths by `norm` (x, y)."""
         x, y = points[:, 0, None], points[:, 1, None]

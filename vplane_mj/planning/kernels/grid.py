@@ -31,7 +31,7 @@ def square(first_cell: np.ndarray, n: int, cell_m: float, x: float, y: float, wi
 @njit(cache=True)
 def _counted(certainty: int, min_certainty: int, skipped: bool) -> bool:
     """Whether a cell of `certainty` is one of `cells_near` (and `nearest_cell`): at or above
-    `min_certainty`, and not skipped."""
+    `min_certainty`, and not skipped (`_row_count` counts them by this test without a branch)."""
     return certainty >= min_certainty and not skipped
 
 
@@ -64,7 +64,7 @@ def cells_near(
     for i in range(lo_i, hi_i):
         row, skipped_row, j = grid[i], skipped[i if skipping else 0], lo_j
         for _ in range(counts[i - lo_i]):  # the row's cells up to its last one gathered
-            while row[j] < min_certainty or skipped_row[j]:
+            while not _counted(row[j], min_certainty, skipped_row[j] == 1):
                 j += 1
             centres[k, 0] = ((i + first_cell[0]) + 0.5) * cell_m
             centres[k, 1] = ((j + first_cell[1]) + 0.5) * cell_m
@@ -82,7 +82,7 @@ def _row_count(row: np.ndarray, skipped: np.ndarray, lo: int, hi: int, min_certa
     cells, skips = row[lo:hi], skipped[lo:hi]  # indices from 0: no wraparound to test
     count = 0
     for j in range(cells.size):
-        count += np.int32(cells[j] >= min_certainty) & np.int32(skips[j] ^ 1)
+        count += (cells[j] >= min_certainty) & (skips[j] == 0)
     return count
 
 

@@ -70,12 +70,10 @@ def closer(dx: float, dy: float, bound: float) -> bool:
     does not decide: a squared distance carries a rounding error of a few parts in 1e16, and a
     comparison it decides with a margin of SURE (relative) and SURE_M comes out as the
     distance's would."""
-    square = dx * dx + dy * dy
-    beyond = bound * (1.0 + SURE) + SURE_M
-    if bound > 0.0 and square > beyond * beyond:
+    if _surely_beyond(dx, dy, bound):
         return False
     within = bound * (1.0 - SURE) - SURE_M
-    if within > 0.0 and square < within * within:
+    if within > 0.0 and dx * dx + dy * dy < within * within:
         return True
     return math.hypot(dx, dy) < bound
 
