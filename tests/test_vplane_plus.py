@@ -316,6 +316,8 @@ def test_the_search_refuses_step_costs_that_are_not_positive():
 def test_line_of_sight_checks_linspaces_points_every_half_cell():
     """The compiled check against its definition: np.linspace's points, each on a free cell or
     outside the window; segments along a row, a column, and of no length among them."""
+    from vplane_mj.planning.kernels import way as way_kernels
+
     rng = np.random.default_rng(3)
     for trial in range(3000):
         cost = np.ones((30, 20))
@@ -329,7 +331,8 @@ def test_line_of_sight_checks_linspaces_points_every_half_cell():
         steps = max(2, math.ceil(2 * float(np.hypot(*(b - a))) / 0.05) + 1)
         i, j = np.floor((np.linspace(a, b, steps) - window.corner) / 0.05).astype(int).T
         inside = (i >= 0) & (i < 30) & (j >= 0) & (j < 20)
-        assert window.line_of_sight(a, b) == bool(np.isfinite(cost[i[inside], j[inside]]).all())
+        seen = way_kernels.segment_free(window.packed(), float(a[0]), float(a[1]), float(b[0]), float(b[1]))
+        assert seen == bool(np.isfinite(cost[i[inside], j[inside]]).all())
 
 
 def test_the_next_waypoint_is_the_farthest_in_sight_of_the_run_within_reach_past_the_nearest():
@@ -353,12 +356,12 @@ def test_the_next_waypoint_is_the_farthest_in_sight_of_the_run_within_reach_past
         last = nearest
         while last + 1 < len(way) and distances[last + 1] <= reach:
             last += 1
-        seen = [k for k in range(last, nearest, -1) if window.line_of_sight(position, way[k])]
-        farthest_seen = seen[0] if seen else nearest
         x, y = float(position[0]), float(position[1])
-        assert way_kernels.next_waypoint(x, y, way, reach, window.packed()) == (nearest, farthest_seen)
-        unseen = (vplane_plus.NO_SIGHT, 0.0, 0.0, 1.0)
-        assert way_kernels.next_waypoint(x, y, way, reach, unseen) == (nearest, last)
+        sight = window.packed()
+        seen = [k for k in range(last, nearest, -1) if way_kernels.segment_free(sight, x, y, *way[k])]
+        farthest_seen = seen[0] if seen else nearest
+        assert way_kernels.next_waypoint(x, y, way, reach, sight) == (nearest, farthest_seen)
+        assert way_kernels.next_waypoint(x, y, way, reach, vplane_plus.NO_SIGHT) == (nearest, last)
 
 
 def test_descent_steps_to_the_first_cheapest_neighbour_until_none_is_cheaper():

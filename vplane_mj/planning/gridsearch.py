@@ -149,17 +149,9 @@ class Window:
         lengths = np.hypot(*np.diff(points, axis=0).T)
         return float(np.sum(lengths * 0.5 * (step[:-1] + step[1:])))
 
-    def line_of_sight(self, a: np.ndarray, b: np.ndarray) -> bool:
-        """Whether the straight segment between two world points (m) stays on free cells (or
-        leaves the window), sampled every half cell (`kernels.way.segment_free`)."""
-        from vplane_mj.planning.kernels import way  # numba: loaded by the first call
-
-        (ax, ay), (bx, by) = np.asarray(a, float), np.asarray(b, float)
-        return way.segment_free(self.packed(), float(ax), float(ay), float(bx), float(by))
-
     def packed(self) -> tuple[np.ndarray, float, float, float]:
-        """The window as `kernels.way` reads it: its step costs, its corner's x and y and its
-        cell size (m)."""
+        """The window as `kernels.way` reads it (its sight lines, `segment_free`): its step
+        costs, its corner's x and y and its cell size (m)."""
         return self.cost, float(self.corner[0]), float(self.corner[1]), float(self.cell_m)
 
 

@@ -352,9 +352,12 @@ class Governor:
     those it was given, and those out of the sensor's view still within `reach_m`."""
     policy: SpeedPolicy = field(init=False)
     """The speeds the body may drive at along a way."""
-    _view_key: tuple[np.ndarray, float] | None = field(default=None, init=False, repr=False)
-    _field_of_view: tuple[int, float, float] = field(default=(0, 0.0, 0.0), init=False, repr=False)
+    _view: tuple[np.ndarray | None, float, tuple[int, float, float]] = field(
+        default=(None, math.nan, (0, 0.0, 0.0)), init=False, repr=False
+    )
+    """The last scan's bearings and beam width, and its field of view (`_view_of`)."""
     _reach: tuple[float, float] = field(default=(math.nan, 0.0), init=False, repr=False)
+    """The control period the reach was last found for, and that reach (`reach_m`)."""
 
     def __post_init__(self) -> None:
         self.drive = DriveModel(self.body.limits)
@@ -432,10 +435,11 @@ class Governor:
     def _view_of(self, obs: Observation) -> tuple[int, float, float]:
         """The field of view of the scan of `obs` (`_view`), kept while the scan's bearings are
         the same array (a sensor's, at every tick) and its beam the same."""
-        key = (obs.bearings, obs.beam_width)
-        if self._view_key is None or self._view_key[0] is not key[0] or self._view_key[1] != key[1]:
-            self._view_key, self._field_of_view = key, _view(obs.bearings, obs.beam_width)
-        return self._field_of_view
+        bearings, beam_width, view = self._view
+        if bearings is not obs.bearings or beam_width != obs.beam_width:
+            view = _view(obs.bearings, obs.beam_width)
+            self._view = (obs.bearings, obs.beam_width, view)
+        return view
 
     def _command(
         self, local: np.ndarray, yaw: float, wanted: float, length: float, speed_mps: float, margin: float

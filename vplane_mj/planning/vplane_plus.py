@@ -72,8 +72,9 @@ TRAP_REACH_M = 2.5
 NO_WAY = np.empty((0, 2))
 NO_WAY.flags.writeable = False
 """An empty way (K = 0 waypoints): ways are (K, 2) arrays of waypoints (m), never written."""
-NO_SIGHT = np.empty((0, 0))
-"""The step costs of no window (`kernels.way.next_waypoint`): every waypoint is in sight."""
+NO_SIGHT = (np.empty((0, 0)), 0.0, 0.0, 1.0)
+"""No window to look through (`kernels.way.next_waypoint`, as `Window.packed`): every waypoint
+is in sight."""
 
 
 def plane_refused(e1: np.ndarray, e2: np.ndarray, why: str) -> Event:
@@ -670,7 +671,7 @@ class VPlanePlusPlanner(VPlanePlanner):
 
         if not len(way):
             return end, way
-        sight = (NO_SIGHT, 0.0, 0.0, 1.0) if self.sight is None else self.sight.packed()
+        sight = NO_SIGHT if self.sight is None else self.sight.packed()
         x, y = float(position[0]), float(position[1])
         nearest, chosen = way_kernels.next_waypoint(x, y, way, self.params.waypoint_m, sight)
         return way[chosen], way[nearest:]  # the robot has passed the points before the nearest

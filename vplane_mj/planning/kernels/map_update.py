@@ -202,20 +202,33 @@ def _by_sides(rel_x, rel_y, c, last, units):
     cell lies within its beam (given as 0): found by the side of the bounds (`units`, world unit
     vectors) the cell lies on, -1 when it surely lies beyond the wedge's bounds, -2 when it lies
     within SURE_RAD of a bound (then only the angles decide)."""
-    sure = SURE_RAD * (abs(rel_x) + abs(rel_y))
+    sure = sure_off_line(rel_x, rel_y)
     before = c - 1 if c > 0 else units.shape[0] - 1
-    side = units[before, 0] * rel_y - units[before, 1] * rel_x  # > 0: counter-clockwise of it
-    if side < -sure:
-        return -1, 0.0
-    if side <= sure:
-        return -2, 0.0
+    side = side_of(units[before, 0], units[before, 1], rel_x, rel_y, sure)
+    if side <= 0:
+        return (-1 if side < 0 else -2), 0.0
     for k in range(c, last + 1):
-        side = units[k, 0] * rel_y - units[k, 1] * rel_x
-        if side < -sure:
-            return k, 0.0
-        if side <= sure:
-            return -2, 0.0
+        side = side_of(units[k, 0], units[k, 1], rel_x, rel_y, sure)
+        if side <= 0:
+            return (k if side < 0 else -2), 0.0
     return -1, 0.0
+
+
+@njit(cache=True, inline="always")
+def sure_off_line(x: float, y: float) -> float:
+    """How far (in the units of `side_of`'s cross product) the point (x, y) (m from the robot)
+    must lie off a line through the robot to lie surely on one side: SURE_RAD times a bound on
+    its distance."""
+    return SURE_RAD * (abs(x) + abs(y))
+
+
+@njit(cache=True, inline="always")
+def side_of(ux: float, uy: float, x: float, y: float, sure: float) -> int:
+    """Which side of the line through the robot along the unit vector (ux, uy) the point (x, y)
+    (m from the robot) lies on: 1 counter-clockwise of it, -1 clockwise, 0 within `sure`
+    (`sure_off_line`) of it, where only the angles decide."""
+    side = ux * y - uy * x
+    return 1 if side > sure else -1 if side < -sure else 0
 
 
 @njit(cache=True)

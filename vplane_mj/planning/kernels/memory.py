@@ -9,7 +9,7 @@ import math
 import numpy as np
 from numba import njit
 
-from vplane_mj.planning.kernels.map_update import SURE_RAD, remainder_of_turn
+from vplane_mj.planning.kernels.map_update import remainder_of_turn, side_of, sure_off_line
 from vplane_mj.planning.kernels.outline import closer
 
 
@@ -41,7 +41,7 @@ def recall(
             if view == 0:
                 unseen[k] = True
             elif view < 0:
-                unseen[k] = not _in_view(rel_x, rel_y, abs(rel_x) + abs(rel_y), yaw, low, span, edges)
+                unseen[k] = not _in_view(rel_x, rel_y, yaw, low, span, edges)
     known = np.concatenate((points, remembered[unseen]))
     c, s = math.cos(yaw), math.sin(yaw)
     local = np.empty_like(known)
@@ -53,21 +53,20 @@ def recall(
 
 
 @njit(cache=True)
-def _in_view(rel_x, rel_y, distance, yaw, low, span, edges):
-    """Whether the point (`rel_x`, `rel_y`; m from the robot, at most `distance` away) is in view: its
-    bearing past `low` (rad, robot frame; the robot heading `yaw`), modulo a turn, at most
-    `span`. Decided by which side of the view's two edges (`edges`: the unit vectors of its
-    first and last bearing, world) it lies on, wherever it lies surely off both (more than
-    `map_update.SURE_RAD`); on an edge, by the angles themselves (an arctangent costs some
-    twenty products)."""
+def _in_view(rel_x, rel_y, yaw, low, span, edges):
+    """Whether the point (`rel_x`, `rel_y`; m from the robot) is in view: its bearing past `low`
+    (rad, robot frame; the robot heading `yaw`), modulo a turn, at most `span`. Decided by which
+    side of the view's two edges (`edges`: the unit vectors of its first and last bearing,
+    world) it lies on, wherever it lies surely off both (`map_update.side_of`); on an edge, by
+    the angles themselves (an arctangent costs some twenty products)."""
     first_x, first_y, last_x, last_y = edges
-    past_first = first_x * rel_y - first_y * rel_x  # > 0: counter-clockwise of the first edge
-    past_last = last_x * rel_y - last_y * rel_x
-    sure = SURE_RAD * distance
-    if abs(past_first) > sure and abs(past_last) > sure:
+    sure = sure_off_line(rel_x, rel_y)
+    past_first = side_of(first_x, first_y, rel_x, rel_y, sure)  # 1: counter-clockwise of it
+    past_last = side_of(last_x, last_y, rel_x, rel_y, sure)
+    if past_first != 0 and past_last != 0:
         if span > math.pi:  # out of view: in the gap, past the last edge and short of the first
-            return not (past_last > 0.0 and past_first < 0.0)
-        return past_first > 0.0 and past_last < 0.0
+            return not (past_last > 0 and past_first < 0)
+        return past_first > 0 and past_last < 0
     return remainder_of_turn(math.atan2(rel_y, rel_x) - yaw - low) <= span
 
 
