@@ -198,6 +198,26 @@ class Footprints:
     def __len__(self) -> int:
         return len(self.pieces)
 
+    @classmethod
+    def packed_rects(cls, centers: np.ndarray, packed: np.ndarray) -> Footprints:
+        """Rectangles at `centers` (R, 2; m) of `packed` (R, 4: half x, half y, cos and sin of
+        yaw), without making a `Rect` of each (their `pieces` stay empty)."""
+        footprints = cls(())
+        footprints._rect_center = np.asarray(centers, float)
+        footprints._rect_half = np.asarray(packed[:, :2], float)
+        footprints._rect_cos, footprints._rect_sin = packed[:, 2].copy(), packed[:, 3].copy()
+        return footprints
+
+    def _paired_point_distances(self, points: np.ndarray) -> np.ndarray:
+        """Signed distance (m) from point k (R, 2) to rectangle k alone (the arithmetic of
+        `_piece_distances`)."""
+        dx, dy = points[:, 0] - self._rect_center[:, 0], points[:, 1] - self._rect_center[:, 1]
+        lx = dx * self._rect_cos + dy * self._rect_sin
+        ly = -dx * self._rect_sin + dy * self._rect_cos
+        qx = np.abs(lx) - self._rect_half[:, 0]
+        qy = np.abs(ly) - self._rect_half[:, 1]
+        return np.hypot(np.maximum(qx, 0.0), np.maximum(qy, 0.0)) + np.minimum(np.maximum(qx, qy), 0.0)
+
     def distance(self, points: np.ndarray) -> np.ndarray:
         """Signed distance (m) from each point (N, 2) to the union; negative inside.
 
@@ -302,6 +322,41 @@ class Footprints:
         )
         parted = np.minimum(vertex_to_rect, corner_to_outline.reshape(-1, 4).min(axis=1))
         return np.where(depth < 0.0, parted, -depth)
+
+
+def moving_distances(
+    discs: np.ndarray,
+    rects: np.ndarray,
+    places: np.ndarray,
+    poses: np.ndarray,
+    outline: np.ndarray | None = None,
+) -> np.ndarray:
+    """Signed distance (m) at each pose (N, 3: x, y, yaw; or (N, 2) points) to the nearest of
+    pieces that move: `discs` (D, 3: x, y, radius) and `rects` (R, 6: x, y, half x, half y, cos
+    and sin of yaw; packed as the laser packs them), where `places` (N, D + R, 2; m) says their
+    centres stood at each pose, discs first. From the point, or with `outline` (k, 2; the
+    robot's convex counter-clockwise footprint in its frame) from the outline, negative when
+    it overlaps (then minus the overlap's depth, as `Footprints.outline_distance`)."""
+    poses = np.atleast_2d(np.asarray(poses, float))
+    count, found = len(poses), np.full(len(poses), np.inf)
+    d = len(discs)
+    if d:
+        centres = places[:, :d].reshape(-1, 2)
+        if outline is None:
+            gaps = np.hypot(*(centres - np.repeat(poses[:, :2], d, 0)).T)
+        else:
+            gaps = _polygon_distance(outline, _to_body(centres, np.repeat(poses, d, 0)))
+        found = np.minimum(found, (gaps.reshape(count, d) - discs[:, 2]).min(axis=1))
+    r = len(rects)
+    if r:
+        repeated = np.repeat(poses, r, 0)
+        placed = Footprints.packed_rects(places[:, d:].reshape(-1, 2), np.tile(rects[:, 2:], (count, 1)))
+        if outline is None:
+            gaps = placed._paired_point_distances(repeated[:, :2])
+        else:
+            gaps = placed._outline_to_rects(outline, repeated, np.arange(len(repeated)))
+        found = np.minimum(found, gaps.reshape(count, r).min(axis=1))
+    return found
 
 
 def _to_body(points: np.ndarray, poses: np.ndarray) -> np.ndarray:

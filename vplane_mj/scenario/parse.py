@@ -32,7 +32,8 @@ def _freeze(value: Any) -> Any:
 def _build_scenario(doc: dict[str, Any], source: str, recorded: bool) -> Scenario:
     """Validate a parsed document section by section, then the start and goal placement."""
     top = read_top(doc)
-    world = read_world(doc)
+    run = read_run(doc)
+    world = read_world(doc, run.seed)
     robot = read_robot(doc)
     planner, params = read_planner(doc, recorded)
     scenario = Scenario(
@@ -44,7 +45,7 @@ def _build_scenario(doc: dict[str, Any], source: str, recorded: bool) -> Scenari
         planner=planner,
         planner_params=params,
         sensors=read_sensors(doc, robot.profile),
-        run=read_run(doc),
+        run=run,
         raw=_freeze(doc),
     )
     check_placement(world, robot)

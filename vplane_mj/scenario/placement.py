@@ -1,4 +1,5 @@
-"""Where the robot may start and end: inside the arena, its footprint clear of walls and obstacles.
+"""Where the robot may start and end: inside the arena, its footprint clear of walls and obstacles
+(moving ones where they are at the run's start).
 
 A round robot (the default profile) is its disc of the model's radius, as it always was; a
 robot with an outline polygon (`vplane_mj.robots.profiles`) is that polygon: at the start in its
@@ -13,7 +14,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from vplane_mj.geometry.shapes import scene_footprints
+from vplane_mj.geometry.shapes import Obstacle, scene_footprints
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario.fields import Invalid
@@ -43,16 +44,31 @@ def _check_border_gap(key: str, point: tuple[float, float], size: tuple[float, f
         raise Invalid(key, reason)
 
 
+def _named_obstacles(world: WorldSpec) -> list[tuple[str, Obstacle]]:
+    """Every obstacle with the name messages give it, a moving one where it is at the run's
+    start (after its phase)."""
+    named = [
+        (f"obstacle world.obstacles[{index}]", obstacle)
+        for index, obstacle in zip(world.static_indices(), world.obstacles, strict=True)
+    ]
+    named += [
+        (f"moving obstacle world.obstacles[{moving.index}] (where it is at the run's start)", moving.shape)
+        for moving in world.moving
+    ]
+    return named
+
+
 def _check_obstacle_gaps(points: Mapping[str, tuple[float, float]], world: WorldSpec, radius: float) -> None:
     """A round robot's disc at each point stays off every obstacle."""
-    if not world.obstacles:
+    named = _named_obstacles(world)
+    if not named:
         return
     xy = np.array(list(points.values()), dtype=float)
-    gaps = np.array([scene_footprints([ob]).distance(xy) for ob in world.obstacles])
+    gaps = np.array([scene_footprints([ob]).distance(xy) for _, ob in named])
     for column, key in enumerate(points):
         nearest = int(np.argmin(gaps[:, column]))
         gap = float(gaps[nearest, column])
-        where = f"obstacle world.obstacles[{nearest}]"
+        where = named[nearest][0]
         if gap < 0:
             raise Invalid(key, f"lies inside {where}")
         if gap < radius:
@@ -65,9 +81,7 @@ def _check_outline(
 ) -> None:
     """The robot's outline at the point, in at least one of `headings` (rad), overlaps no
     obstacle and no border wall."""
-    things = [
-        (f"obstacle world.obstacles[{i}]", scene_footprints([ob])) for i, ob in enumerate(world.obstacles)
-    ]
+    things = [(name, scene_footprints([ob])) for name, ob in _named_obstacles(world)]
     if world.border:
         things.append(("the border wall", scene_footprints([], world.size)))
     if not things:

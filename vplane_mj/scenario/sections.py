@@ -1,10 +1,11 @@
 """Each table of a scenario file read into its dataclass (docs/interface.md section 1).
 
 Besides each key's own rule (`keys.py`), a section checks what spans keys: the format
-and name, an obstacle's shape, the planner's parameters against its table, a motor bias
-within the torque limit of the profile's model, the sensor's keys against its kind and its
-defaults from the robot's profile, dead sonars within the ring, a laser's range limits in
-order, a control period of at least one physics step.
+and name, an obstacle's shape (and a moving one's motion, `motion.py`), the planner's
+parameters against its table, a motor bias within the torque limit of the profile's model,
+the sensor's keys against its kind and its defaults from the robot's profile, dead sonars
+within the ring, a laser's range limits in order, a control period of at least one physics
+step.
 """
 
 from __future__ import annotations
@@ -15,7 +16,8 @@ from types import MappingProxyType
 from typing import Any
 
 from vplane_mj.errors import did_you_mean
-from vplane_mj.geometry.shapes import Obstacle
+from vplane_mj.geometry.motion import Moving
+from vplane_mj.geometry.shapes import Box, Cylinder, Obstacle
 from vplane_mj.planning import registry
 from vplane_mj.planning.params import ParamError
 from vplane_mj.planning.plugins import is_import_spec
@@ -34,6 +36,7 @@ from vplane_mj.scenario.keys import (
     GENERIC_SENSORS,
     KIND_KEYS,
     MAX_NAME_LENGTH,
+    MAX_OBSTACLE_M,
     MAX_SONAR_RANGE_M,
     NAME_PATTERN,
     OBSTACLE_KINDS,
@@ -45,6 +48,7 @@ from vplane_mj.scenario.keys import (
     TOP_FIELDS,
     WORLD_FIELDS,
 )
+from vplane_mj.scenario.motion import MOVING_KINDS, read_motion
 from vplane_mj.scenario.spec import RobotSpec, RunSpec, SensorSpec, WorldSpec
 
 
@@ -69,8 +73,9 @@ def read_top(doc: Mapping[str, Any]) -> dict[str, Any]:
     return top
 
 
-def _read_obstacle(item: Any, path: str) -> Obstacle:
-    """One `[[world.obstacles]]` table as a shapes dataclass."""
+def _read_obstacle(item: Any, path: str, seed: int, index: int) -> Obstacle | Moving:
+    """One `[[world.obstacles]]` table as a shapes dataclass, or a `Moving` one when it has a
+    `motion` table (its shape then stands where the motion puts it at the run's start)."""
     if not isinstance(item, dict):
         raise Invalid(path, f"must be a table, got {type_name(item)}")
     if "kind" not in item:
@@ -81,25 +86,48 @@ def _read_obstacle(item: Any, path: str) -> Obstacle:
         hint = did_you_mean(kind_name, OBSTACLE_KINDS)
         reason = f"unknown obstacle kind {kind_name!r} (known: {', '.join(OBSTACLE_KINDS)}){hint}"
         raise Invalid(join_key(path, "kind"), reason)
-    shape = kind.shape(**read_fields(item, path, kind.fields, extra=("kind",)))
-    if kind.check:
-        kind.check(shape, path)
-    return shape
+    if "motion" not in item:
+        shape = kind.shape(**read_fields(item, path, kind.fields, extra=("kind",)))
+        if kind.check:
+            kind.check(shape, path)
+        return shape
+    if kind_name not in MOVING_KINDS:
+        reason = f"only a {' or a '.join(MOVING_KINDS)} can move, not a {kind_name!r}"
+        raise Invalid(join_key(path, "motion"), reason)
+    if "center" in item:
+        reason = "a moving obstacle has no center: its motion's keyframes place it (give one or the other)"
+        raise Invalid(join_key(path, "center"), reason)
+    fields = {key: field for key, field in kind.fields.items() if key != "center"}
+    values = read_fields(item, path, fields, extra=("kind", "motion"))
+    motion = read_motion(item["motion"], join_key(path, "motion"), seed, index, MAX_OBSTACLE_M)
+    start = motion.position(0.0)
+    shape = kind.shape(center=(float(start[0]), float(start[1])), **values)
+    assert isinstance(shape, Cylinder | Box), "MOVING_KINDS build cylinders and boxes"
+    return Moving(shape, motion, index)
 
 
-def _read_obstacles(world: Mapping[str, Any]) -> tuple[Obstacle, ...]:
-    """All `[[world.obstacles]]`, in order."""
+def _read_obstacles(world: Mapping[str, Any], seed: int) -> tuple[list[Obstacle], list[Moving]]:
+    """All `[[world.obstacles]]`, in order: the static ones and the moving ones."""
     items = world.get("obstacles", [])
     if not isinstance(items, list):
         raise Invalid("world.obstacles", f"must be an array of tables, got {type_name(items)}")
-    return tuple(_read_obstacle(item, f"world.obstacles[{i}]") for i, item in enumerate(items))
+    static: list[Obstacle] = []
+    moving: list[Moving] = []
+    for index, item in enumerate(items):
+        obstacle = _read_obstacle(item, f"world.obstacles[{index}]", seed, index)
+        if isinstance(obstacle, Moving):
+            moving.append(obstacle)
+        else:
+            static.append(obstacle)
+    return static, moving
 
 
-def read_world(doc: Mapping[str, Any]) -> WorldSpec:
-    """The `[world]` table."""
+def read_world(doc: Mapping[str, Any], seed: int = 0) -> WorldSpec:
+    """The `[world]` table; the random phases of moving obstacles drawn from the run's `seed`."""
     table = sub_table(doc, "world", required=True)
     values = read_fields(table, "world", WORLD_FIELDS, extra=("obstacles",))
-    return WorldSpec(**values, obstacles=_read_obstacles(table))
+    static, moving = _read_obstacles(table, seed)
+    return WorldSpec(**values, obstacles=tuple(static), moving=tuple(moving))
 
 
 def _facing(start: tuple[float, float], goal: tuple[float, float]) -> float:

@@ -15,16 +15,26 @@ from typing import Any
 import tomli_w
 
 from vplane_mj.files import write_atomically
+from vplane_mj.geometry.motion import Moving
 from vplane_mj.geometry.shapes import Obstacle
 
 
 @dataclass(frozen=True)
 class WorldSpec:
-    """The free arena [0, W] x [0, H] (m), whether border walls surround it, the obstacles."""
+    """The free arena [0, W] x [0, H] (m), whether border walls surround it, the static
+    obstacles, and the moving ones (`geometry.motion.Moving`: each keeps its index among the
+    file's `[[world.obstacles]]`; the static ones take the other indices, in order)."""
 
     size: tuple[float, float]
     border: bool = True
     obstacles: tuple[Obstacle, ...] = ()
+    moving: tuple[Moving, ...] = ()
+
+    def static_indices(self) -> tuple[int, ...]:
+        """Each static obstacle's index among the file's `[[world.obstacles]]`, in order."""
+        taken = {moving.index for moving in self.moving}
+        count = len(self.obstacles) + len(self.moving)
+        return tuple(index for index in range(count) if index not in taken)
 
 
 @dataclass(frozen=True)

@@ -12,6 +12,7 @@ from vplane_mj.robots.facts import BASE_BODY, WHEEL_JOINTS, WHEEL_MOTORS, robot_
 from vplane_mj.robots.profiles import PROFILES
 from vplane_mj.scenario import Scenario
 from vplane_mj.sim.control import CommandRamp, WheelPI, wheel_targets
+from vplane_mj.sim.moving import MovingObstacles
 from vplane_mj.sim.odometry import WheelOdometry
 from vplane_mj.sim.world import BUMP_SENSOR, OBSTACLES_BODY, ROBOT_PREFIX
 
@@ -42,7 +43,12 @@ class Drive:
     """
 
     def __init__(
-        self, model: mujoco.MjModel, data: mujoco.MjData, control_hz: float, profile: str = "default"
+        self,
+        model: mujoco.MjModel,
+        data: mujoco.MjData,
+        control_hz: float,
+        profile: str = "default",
+        moving: MovingObstacles | None = None,
     ):
         self.model, self.data = model, data
         robot = PROFILES[profile]
@@ -66,6 +72,8 @@ class Drive:
         self.wheels = [WheelPI(self.gains.wheel_kp, self.gains.wheel_ki, limit) for _ in self.motors]
         self.torques: list[tuple[float, float]] = []
         self.steps = 0
+        self.moving = moving if moving is not None and moving.count else None
+        """The world's moving obstacles, placed before every physics step; None without any."""
         self._warnings = data.warning.number  # counts per warning kind, a view into mjData
         self._no_warnings = bytes(self._warnings.nbytes)
 
@@ -95,16 +103,22 @@ class Drive:
         """The wheels' encoder angles (rad), left and right."""
         return float(self.data.qpos[self.wheel_qpos[0]]), float(self.data.qpos[self.wheel_qpos[1]])
 
-    def run_tick(self, command: tuple[float, float], after_step) -> tuple[np.ndarray, float]:
+    def run_tick(
+        self, command: tuple[float, float], after_step
+    ) -> tuple[np.ndarray, float, np.ndarray | None]:
         """Drive one control tick; return base_link's x, y (m) and yaw (rad) after every motor
-        period (chunks, 3), and the length (m) of the path through them from the pose before
-        the tick (each step's straight length, added in order)."""
+        period (chunks, 3), the length (m) of the path through them from the pose before the
+        tick (each step's straight length, added in order), and where the moving obstacles
+        stood at those poses (chunks, count, 2; m), None without any (`moving`, whose mocap
+        bodies are placed before every physics step)."""
         target_left, target_right = self._wheel_targets(command)
         (left_pi, right_pi), (left_dof, right_dof) = self.wheels, self.wheel_dofs
         left_motor, right_motor = self.motors
         model, data, steps, dt = self.model, self.data, self.motor_steps, self.motor_dt
         qvel, ctrl, xpos, xmat, torques = data.qvel, data.ctrl, self.xpos, self.xmat, self.torques
+        moving = self.moving
         trace = []
+        places = []
         x0, y0 = float(xpos[0]), float(xpos[1])
         length = 0.0
         for _ in range(self.chunks_per_tick):
@@ -115,14 +129,20 @@ class Drive:
             ctrl[left_motor] = left
             ctrl[right_motor] = right
             torques.append((left, right))
-            mujoco.mj_step(model, data, steps)
+            if moving is None:
+                mujoco.mj_step(model, data, steps)
+            else:
+                for _ in range(steps):
+                    moving.place(data.time)
+                    mujoco.mj_step(model, data)
+                places.append(moving.xy.copy())
             x, y = float(xpos[0]), float(xpos[1])
             trace.append((x, y, math.atan2(xmat[3], xmat[0])))
             length += math.hypot(x - x0, y - y0)
             x0, y0 = x, y
             after_step()
         self.steps += self.motor_steps * self.chunks_per_tick
-        return np.array(trace), length
+        return np.array(trace), length, np.array(places) if moving is not None else None
 
     def _wheel_targets(self, command: tuple[float, float]) -> tuple[float, float]:
         """Left and right wheel speeds (rad/s) for a body speed (m/s) and turn rate (rad/s)."""
@@ -196,23 +216,36 @@ class CollisionCounter:
     contacts scanned in Python for the point of impact.
     """
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData):
-        self.found = data.sensordata[model.sensor_adr[model.sensor(BUMP_SENSOR).id] :][:1]
-        self._obstacles = model.body(OBSTACLES_BODY).id
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, moving: int = 0):
+        first = model.sensor_adr[model.sensor(BUMP_SENSOR).id]
+        self.found = data.sensordata[first:][: 1 + moving]
+        """The contact sensors' readings: the static obstacles', then each of the `moving`
+        obstacles' (`vplane_mj.sim.world.BUMP_SENSOR`)."""
+        names = [
+            OBSTACLES_BODY,
+            *(model.body(i).name for i in range(model.nbody) if model.body_mocapid[i] >= 0),
+        ]
+        self._obstacles = {model.body(name).id for name in names}
         self._geom_body = model.geom_bodyid
         self._base = model.body(ROBOT_PREFIX + BASE_BODY).id
         self.touching = False
         self.points: list[tuple[float, float]] = []
 
+    def in_contact(self) -> bool:
+        """Whether the robot touches an obstacle now (after the last physics step)."""
+        found = self.found
+        return bool(found[0] > 0) if len(found) == 1 else bool(found.any())
+
     def update(self, data: mujoco.MjData) -> tuple[float, float] | None:
         """Return the contact point when a new episode starts, else None."""
-        touching = self.found[0] > 0
+        touching = self.in_contact()
         started = touching and not self.touching
         self.touching = touching
         if not started:
             return None
+        body = self._geom_body
         for contact in data.contact[: data.ncon]:
-            if self._obstacles in (self._geom_body[contact.geom[0]], self._geom_body[contact.geom[1]]):
+            if body[contact.geom[0]] in self._obstacles or body[contact.geom[1]] in self._obstacles:
                 point = (float(contact.pos[0]), float(contact.pos[1]))
                 break
         else:  # unreachable while the sensor and the contact list agree; keep the robot's place

@@ -23,7 +23,7 @@ Importing this module imports numba; its kernel compiles on first use and is cac
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from numba import njit
@@ -57,10 +57,18 @@ class RayCaster:
         self._fan = np.zeros((2, 0))
 
     def cast(
-        self, origin: tuple[float, float], first_angle: float, step: float, beams: int, range_max: float
+        self,
+        origin: tuple[float, float],
+        first_angle: float,
+        step: float,
+        beams: int,
+        range_max: float,
+        moving: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> np.ndarray:
         """Ranges (beams,) in m from `origin` of the beams at `first_angle + k * step` (rad, world
         frame, k = 0 .. beams - 1) to the nearest piece; inf where nothing lies within `range_max`.
+        `moving`: pieces besides the world's, where they stand for this cast (discs and
+        rectangles packed as `discs` and `rects`: the moving obstacles).
 
         The beams span less than a full turn: `(beams - 1) * step < 2 pi`, `step > 0`.
         """
@@ -73,9 +81,11 @@ class RayCaster:
             raise ValueError(f"range_max must be positive, got {range_max}")
         ranges = np.empty(beams)
         fan = self._fan_offsets(float(step), int(beams))
-        _cast_fan(
-            self.discs, self.rects, ox, oy, float(first_angle), float(step), fan, float(range_max), ranges
-        )
+        discs, rects = self.discs, self.rects
+        if moving is not None:
+            discs = np.concatenate((discs, moving[0])) if len(discs) else moving[0]
+            rects = np.concatenate((rects, moving[1])) if len(rects) else moving[1]
+        _cast_fan(discs, rects, ox, oy, float(first_angle), float(step), fan, float(range_max), ranges)
         return ranges
 
     def _fan_offsets(self, step: float, beams: int) -> np.ndarray:
@@ -219,7 +229,8 @@ class LaserScanner:
 
     Below 360 degrees the first and last beams lie at -fov/2 and +fov/2; at 360 degrees the
     beams are 360/beams degrees apart all round, so no beam is repeated at +-180 degrees.
-    `rate_hz` is the scan rate, held for the run loop (the scan itself takes no time).
+    `rate_hz` is the scan rate, held for the run loop (the scan itself takes no time). `moving`
+    gives the moving obstacles' pieces where they stand when a scan is cast.
 
     Faults, drawn from `rng` (the same seed gives the same scans): Gaussian noise of
     `noise_std` (m) on every return, then the range rules on the noisy range, then `dropout`,
@@ -239,6 +250,7 @@ class LaserScanner:
         rng: np.random.Generator,
         noise_std: float = 0.0,
         dropout: float = 0.0,
+        moving: Callable[[], tuple[np.ndarray, np.ndarray]] | None = None,
     ):
         checks = (
             (0.0 < fov_deg <= 360.0, f"fov_deg must lie in (0, 360], got {fov_deg}"),
@@ -266,6 +278,9 @@ class LaserScanner:
         self.rng = rng
         self.noise_std = noise_std
         self.dropout = dropout
+        self.moving = moving
+        """Where the moving obstacles stand at the moment of a cast (`RayCaster.cast`'s
+        `moving`), None in a world without any."""
         self.bearings, self.angle_step = laser_bearings(fov_deg, self.beams)
         """Each beam's bearing (rad) in the robot's frame, counter-clockwise from the heading, and
         the angle (rad) between neighbouring beams."""
@@ -279,7 +294,14 @@ class LaserScanner:
         """Ranges (beams,) in m from the robot's centre at (x, y) (m) heading `yaw` (rad); NaN
         where there is no return: nothing within range_max, a return closer than range_min
         (after the noise), or a lost return."""
-        ranges = self.caster.cast((x, y), yaw + self.bearings[0], self.angle_step, self.beams, self.range_max)
+        ranges = self.caster.cast(
+            (x, y),
+            yaw + self.bearings[0],
+            self.angle_step,
+            self.beams,
+            self.range_max,
+            None if self.moving is None else self.moving(),
+        )
         if self.noise_std > 0.0:
             ranges += self.rng.normal(0.0, self.noise_std, self.beams)
         ranges[~((ranges >= self.range_min) & (ranges <= self.range_max))] = np.nan

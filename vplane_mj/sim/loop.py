@@ -34,6 +34,7 @@ from vplane_mj.sim.control import heading_command, within_limits
 from vplane_mj.sim.drive import BELIEF_PATIENCE_S, CollisionCounter, Drive, Localiser
 from vplane_mj.sim.failure import RunFailure, failure_of
 from vplane_mj.sim.metrics import motion_quality, path_quality, robot_clearance, trajectory_digest
+from vplane_mj.sim.moving import MovingObstacles
 from vplane_mj.sim.sensors import range_sensor
 from vplane_mj.sim.summary import Outcome, RunSummary
 from vplane_mj.sim.world import build_model
@@ -57,6 +58,9 @@ class Tick:
     command: tuple[float, float]
     believed_pose: tuple[float, float, float] | None = None
     """The pose the planner used, when it comes from odometry rather than the simulator."""
+    obstacles: np.ndarray | None = None
+    """Where the moving obstacles stood (count, 2; m), in the order of the scenario's
+    `world.moving`; None in a world without any."""
 
 
 class Observer(Protocol):
@@ -82,6 +86,9 @@ class Track:
     collision_points: list[tuple[float, float]] = field(default_factory=list)
     objectives: list[tuple[float, float]] = field(default_factory=list)
     planes: list[tuple[tuple[float, float], tuple[float, float]]] = field(default_factory=list)
+    obstacle_places: np.ndarray | None = None
+    """Where the moving obstacles stood at each of `positions` (ticks, count, 2; m), in the
+    order of the scenario's `world.moving`; None in a world without any."""
 
 
 @dataclass(frozen=True)
@@ -111,6 +118,9 @@ class RunResult:
     """Every virtual new objective the planner placed, in order."""
     planes: list[tuple[tuple[float, float], tuple[float, float]]] = field(default_factory=list)
     """Every virtual plane the planner created, as (e1, e2)."""
+    obstacle_places: np.ndarray | None = None
+    """Where the moving obstacles stood at each control tick (ticks, count, 2; m), in the order
+    of the scenario's `world.moving`; None in a world without any."""
 
     def track(self) -> Track:
         """What a render of this run shows."""
@@ -121,6 +131,7 @@ class RunResult:
             self.collision_points,
             self.objectives,
             self.planes,
+            self.obstacle_places,
         )
 
 
@@ -145,10 +156,13 @@ class Run:
             physics = build_model(scenario, rangefinders=False), None
         self.model = physics[0]
         self.data = physics[1] if physics[1] is not None else mujoco.MjData(self.model)
+        self.moving = (
+            MovingObstacles(self.model, self.data, scenario.world) if scenario.world.moving else None
+        )
         mujoco.mj_forward(self.model, self.data)
         profile = scenario.robot.profile
-        self.drive = Drive(self.model, self.data, scenario.run.control_hz, profile)
-        self.sensor = range_sensor(scenario, self.data)
+        self.drive = Drive(self.model, self.data, scenario.run.control_hz, profile, self.moving)
+        self.sensor = range_sensor(scenario, self.data, self.moving)
         self.localiser = Localiser(self.drive, scenario)
         self.body = robot_body(profile, scenario.sensors.kind)
         self.radius = self.drive.geometry["radius_m"]
@@ -163,14 +177,20 @@ class Run:
             raise
         except Exception as exc:  # the planner's constructor: the run ends at once as `error`
             self.planner, failed = None, exc
-        self.clearance = robot_clearance(scenario, self.body, self.radius)
-        self.collisions = CollisionCounter(self.model, self.data)
+        self.clearance = robot_clearance(
+            scenario, self.body, self.radius, None if self.moving is None else self.moving.pieces()
+        )
+        self.collisions = CollisionCounter(self.model, self.data, len(scenario.world.moving))
         self.goal = np.asarray(scenario.robot.goal, float)
         self.tolerance = scenario.robot.goal_tolerance
         self.ranges = np.full(len(self.sensor.bearings), np.nan)
         self.next_scan_s = 0.0
         self.position = self.drive.xpos[:2].copy()
-        self.clearance.add(np.array([[*self.position, self.drive.yaw()]]))
+        start = self.obstacles()
+        self.clearance.add(
+            np.array([[*self.position, self.drive.yaw()]]),
+            None if start is None else self._places(start[None]),
+        )
         self.times: list[float] = []
         self.positions: list[np.ndarray] = []
         self.modes: list[str] = []
@@ -178,6 +198,7 @@ class Run:
         self.planner_cpu: list[float] = []
         self.objectives: list[tuple[float, float]] = []
         self.planes: list[tuple[tuple[float, float], tuple[float, float]]] = []
+        self.places: list[np.ndarray] = []  # the moving obstacles' places at each recorded tick
         self.path_length = 0.0
         self.local_minima = self.escapes = 0
         self.time_to_goal: float | None = None
@@ -364,24 +385,44 @@ class Run:
         self.times.append(self.data.time)
         self.positions.append(self.position)
         self.modes.append(decision.mode)
+        places = self.obstacles()
+        if places is not None:
+            self.places.append(places)
         if self.observers:
             belief = self.localiser.belief(believed_xy, believed_yaw)
             speed = self.drive.planar_speed()
             tick = Tick(
-                self.data.time, self.position, self.yaw, speed, self.ranges, decision, self.command, belief
+                self.data.time,
+                self.position,
+                self.yaw,
+                speed,
+                self.ranges,
+                decision,
+                self.command,
+                belief,
+                places,
             )
             for observer in self.observers:
                 observer.on_tick(tick)
 
     def _act(self) -> None:
         """Drive the wheels for one control tick; measure the path, clearance and collisions."""
-        trace, length = self.drive.run_tick(self.command, self._check_contacts)
-        self.clearance.add(trace)
+        trace, length, places = self.drive.run_tick(self.command, self._check_contacts)
+        self.clearance.add(trace, None if places is None else self._places(places))
         self.path_length += length
         self.position = trace[-1, :2]
 
+    def obstacles(self) -> np.ndarray | None:
+        """Where the moving obstacles stand now (count, 2; m; a copy), in the order of the
+        scenario's `world.moving`; None in a world without any."""
+        return None if self.moving is None else self.moving.xy.copy()
+
+    def _places(self, places: np.ndarray | None) -> np.ndarray | None:
+        """Moving obstacles' places (..., count, 2) in the order the clearance packs them."""
+        return None if places is None or self.moving is None else places[..., self.moving.packed_order, :]
+
     def _check_contacts(self) -> None:
-        if self.collisions.found[0] > 0 or self.collisions.touching:
+        if self.collisions.touching or self.collisions.in_contact():
             contact = self.collisions.update(self.data)
             if contact is not None:
                 text = f"collision at ({contact[0]:.2f}, {contact[1]:.2f})"
@@ -410,7 +451,14 @@ class Run:
             final = Decision(force=np.zeros(2), mode="finished")
             speed = self.drive.planar_speed()
             tick = Tick(
-                self.data.time, self.position, self.drive.yaw(), speed, self.ranges, final, (0.0, 0.0)
+                self.data.time,
+                self.position,
+                self.drive.yaw(),
+                speed,
+                self.ranges,
+                final,
+                (0.0, 0.0),
+                obstacles=self.obstacles(),
             )
             for observer in self.observers:
                 observer.on_tick(tick)
@@ -429,6 +477,9 @@ class Run:
             collision_points=self.collisions.points,
             objectives=self.objectives,
             planes=self.planes,
+            obstacle_places=None
+            if self.moving is None
+            else np.array(self.places).reshape(-1, self.moving.count, 2),
         )
 
     def summary(self) -> RunSummary:
@@ -456,6 +507,8 @@ class Run:
             collisions=len(self.collisions.points),
             min_clearance_m=None if math.isinf(clearance.robot_minimum) else clearance.robot_minimum,
             mean_clearance_m=None if math.isinf(clearance.robot_mean) else clearance.robot_mean,
+            moving_obstacles=len(scenario.world.moving),
+            min_clearance_moving_m=None if self.moving is None else clearance.robot_moving_minimum,
             **motion_quality(np.array(self.yaws), self.path_length),
             planner_cpu_ms_mean=1e3 * float(np.mean(cpu)) if cpu else None,
             planner_cpu_ms_max=1e3 * float(np.max(cpu)) if cpu else None,

@@ -25,17 +25,28 @@ class Clearance:
     """Smallest and mean distance (m) to any obstacle or border, batched over poses (x, y in m,
     yaw in rad): from base_link's centre, or with `outline` (the robot's footprint polygon in
     base_link, m) from the outline (negative: it overlaps). The robot's own clearance
-    (`robot_minimum`, `robot_mean`) is that less `from_centre_m`, a round robot's radius."""
+    (`robot_minimum`, `robot_mean`) is that less `from_centre_m`, a round robot's radius.
+
+    With `moving` (the moving obstacles' pieces as `shapes.moving_distances` takes them),
+    each pose comes with where those stood then, and counts them too; `moving_minimum` is the
+    smallest over them alone."""
 
     def __init__(
-        self, footprints: shapes.Footprints, outline: np.ndarray | None = None, from_centre_m: float = 0.0
+        self,
+        footprints: shapes.Footprints,
+        outline: np.ndarray | None = None,
+        from_centre_m: float = 0.0,
+        moving: tuple[np.ndarray, np.ndarray] | None = None,
     ):
         self._footprints = footprints
         self._outline = outline
         self._from_centre = from_centre_m
+        self._moving = moving
         self._pending: list[np.ndarray] = []
+        self._pending_places: list[np.ndarray] = []
         self._pending_count = 0
         self.minimum = math.inf
+        self.moving_minimum = math.inf
         self._total = 0.0
         self._count = 0
 
@@ -53,35 +64,55 @@ class Clearance:
         """The robot's mean clearance (m; inf before any pose or without obstacles)."""
         return self.mean - self._from_centre
 
-    def add(self, poses: np.ndarray) -> None:
-        """Poses (N, 3) of the robot, or positions (N, 2) of a robot measured from its centre."""
+    @property
+    def robot_moving_minimum(self) -> float:
+        """The robot's smallest clearance to the moving obstacles (m; inf without any)."""
+        return self.moving_minimum - self._from_centre
+
+    def add(self, poses: np.ndarray, places: np.ndarray | None = None) -> None:
+        """Poses (N, 3) of the robot, or positions (N, 2) of a robot measured from its centre;
+        with moving obstacles, where their centres stood at each (N, count, 2; m)."""
         self._pending.append(poses)
+        if self._moving is not None:
+            assert places is not None, "a world with moving obstacles: poses come with their places"
+            self._pending_places.append(places)
         self._pending_count += len(poses)
         if self._pending_count >= CLEARANCE_BATCH:
             self.flush()
 
     def flush(self) -> None:
-        if self._pending and len(self._footprints):
+        if self._pending and (len(self._footprints) or self._moving is not None):
             poses = np.vstack(self._pending)
-            if self._outline is None:
-                distances = self._footprints.distance(poses[:, :2])
-            else:
-                distances = self._footprints.outline_distance(self._outline, poses)
+            distances = np.full(len(poses), np.inf)
+            if len(self._footprints):
+                if self._outline is None:
+                    distances = self._footprints.distance(poses[:, :2])
+                else:
+                    distances = self._footprints.outline_distance(self._outline, poses)
+            if self._moving is not None:
+                places = np.concatenate(self._pending_places)
+                moving = shapes.moving_distances(*self._moving, places, poses, self._outline)
+                self.moving_minimum = min(self.moving_minimum, float(moving.min()))
+                distances = np.minimum(distances, moving)
             self.minimum = min(self.minimum, float(distances.min()))
             self._total += float(distances.sum())
             self._count += len(distances)
         self._pending.clear()
+        self._pending_places.clear()
         self._pending_count = 0
 
 
-def robot_clearance(scenario: Scenario, body: RobotBody, radius_m: float) -> Clearance:
-    """The clearance of the scenario's robot among its obstacles and border: from its footprint
+def robot_clearance(
+    scenario: Scenario, body: RobotBody, radius_m: float, moving: tuple[np.ndarray, np.ndarray] | None = None
+) -> Clearance:
+    """The clearance of the scenario's robot among its obstacles and border, and its `moving`
+    obstacles' pieces (packed as `shapes.moving_distances` takes them): from its footprint
     polygon, or for a round robot from its centre less `radius_m` (m)."""
     world = scenario.world
     footprints = shapes.scene_footprints(world.obstacles, world.size if world.border else None)
     if body.disc:
-        return Clearance(footprints, None, radius_m)
-    return Clearance(footprints, body.footprint)
+        return Clearance(footprints, None, radius_m, moving)
+    return Clearance(footprints, body.footprint, moving=moving)
 
 
 class MotionQuality(TypedDict):

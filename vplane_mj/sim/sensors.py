@@ -16,6 +16,7 @@ import numpy as np
 
 from vplane_mj.geometry import shapes
 from vplane_mj.scenario import Scenario
+from vplane_mj.sim.moving import MovingObstacles
 from vplane_mj.sim.sonar import SonarRays, SonarRing
 from vplane_mj.sim.world import ROBOT_PREFIX, SonarLayout, build_model
 
@@ -67,8 +68,9 @@ class Sonars:
         return self.ring.read(self.rays.cast())
 
 
-def laser(scenario: Scenario, rng: np.random.Generator) -> RangeSensor:
-    """The scenario's laser, cast against its obstacles and border (imports numba)."""
+def laser(scenario: Scenario, rng: np.random.Generator, moving: MovingObstacles | None = None) -> RangeSensor:
+    """The scenario's laser, cast against its obstacles and border, and its `moving` obstacles
+    where they stand at each scan (imports numba)."""
     from vplane_mj.sim.laser import LaserScanner, RayCaster
 
     world, spec = scenario.world, scenario.sensors
@@ -83,6 +85,7 @@ def laser(scenario: Scenario, rng: np.random.Generator) -> RangeSensor:
         rng=rng,
         noise_std=spec.noise_std,
         dropout=spec.dropout,
+        moving=moving.pieces if moving is not None and moving.count else None,
     )
 
 
@@ -95,9 +98,13 @@ def scan_bearings(scenario: Scenario) -> np.ndarray:
     return SonarLayout.from_spec(scenario.sensors, scenario.robot.profile).bearings
 
 
-def range_sensor(scenario: Scenario, data: mujoco.MjData) -> RangeSensor:
-    """The scenario's sensor, its faults drawn from a generator seeded with the run's seed."""
+def range_sensor(
+    scenario: Scenario, data: mujoco.MjData, moving: MovingObstacles | None = None
+) -> RangeSensor:
+    """The scenario's sensor, its faults drawn from a generator seeded with the run's seed. A
+    laser sees the `moving` obstacles where they stand at each scan; sonars see them as MuJoCo
+    placed them for the last physics step."""
     rng = np.random.default_rng(scenario.run.seed)
     if scenario.sensors.kind == "laser":
-        return laser(scenario, rng)
+        return laser(scenario, rng, moving)
     return Sonars(scenario, data, rng)

@@ -49,6 +49,8 @@ class RunSummary:
     collisions: int = 0
     min_clearance_m: float | None = None
     mean_clearance_m: float | None = None
+    moving_obstacles: int = 0
+    min_clearance_moving_m: float | None = None
     smoothness_rad_per_m: float | None = None
     oscillation_per_m: float | None = None
     planner_cpu_ms_mean: float | None = None

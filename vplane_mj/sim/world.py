@@ -1,8 +1,10 @@
 """Build the MuJoCo world of a scenario with MjSpec: arena, border, obstacles, robot, sonar.
 
 The robot is its profile's model (`vplane_mj.robots.profiles`, models/*.xml). Element names are
-predictable: obstacle geoms are `obstacle<i>_<part>` (parts per kind in PART_NAMES) and
-border walls `border_<side>`, all in the static body `obstacles`; sonar ray sites are
+predictable: obstacle geoms are `obstacle<i>_<part>` (parts per kind in PART_NAMES, i the
+obstacle's index in the file) and border walls `border_<side>`, all in the static body
+`obstacles`, but for a moving obstacle's geom `obstacle<i>_body`, alone in a mocap body
+`moving<i>` that the run sets at every physics step (`vplane_mj.sim.moving`); sonar ray sites are
 `robot/sonar<k>_ray<j>`, in order, so their poses are contiguous, and so are the readings of
 the rangefinders of the same names. The cameras are `top` (above the arena) and `robot/chase`
 (behind the robot); the site `goal` marks the goal (a disc of the goal tolerance on the floor,
@@ -12,6 +14,7 @@ seen by cameras only: sites neither collide nor stop rays). A laser is not a MuJ
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -29,7 +32,11 @@ ROBOT_PREFIX = "robot/"
 OBSTACLES_BODY = "obstacles"
 """The static body that holds every obstacle and border geom."""
 BUMP_SENSOR = "bump"
-"""Contact sensor: number of contacts between the robot's subtree and the obstacles body."""
+"""Contact sensor: number of contacts between the robot's subtree and the obstacles body; each
+moving obstacle's body has one of its own, `bump_moving<i>`, right after it (their readings
+are contiguous)."""
+MOVING_PREFIX = "moving"
+"""A moving obstacle's mocap body is `moving<i>`, i its index in the file."""
 PART_NAMES: dict[type, tuple[str, ...]] = {
     shapes.Box: ("body",),
     shapes.Wall: ("wall",),
@@ -108,20 +115,30 @@ def build_spec(scenario: Scenario, rangefinders: bool = True) -> mujoco.MjSpec:
     if scenario.world.border:
         for side, rect in zip(BORDER_SIDES, shapes.border_footprint(scenario.world.size), strict=True):
             _add_piece(statics, f"border_{side}", rect, "border")
-    for index, obstacle in enumerate(scenario.world.obstacles):
+    world = scenario.world
+    for index, obstacle in zip(world.static_indices(), world.obstacles, strict=True):
         parts = PART_NAMES[type(obstacle)]
         for part, piece in zip(parts, obstacle.footprint(), strict=True):
             _add_piece(statics, f"obstacle{index}_{part}", piece, "obstacle")
+    for moving in world.moving:
+        x, y = moving.shape.center  # where it stands at the run's start; its geom about the body's origin
+        (piece,) = dataclasses.replace(moving.shape, center=(0.0, 0.0)).footprint()
+        body = arena.worldbody.add_body(name=f"{MOVING_PREFIX}{moving.index}", mocap=True, pos=[x, y, 0.0])
+        _add_piece(body, f"obstacle{moving.index}_body", piece, "obstacle")
     # Counts robot-obstacle contacts inside MuJoCo, so the run loop reads one number per check.
-    arena.add_sensor(
-        name=BUMP_SENSOR,
-        type=mujoco.mjtSensor.mjSENS_CONTACT,
-        objtype=mujoco.mjtObj.mjOBJ_XBODY,  # the subtree of base_link
-        objname=ROBOT_PREFIX + BASE_BODY,
-        reftype=mujoco.mjtObj.mjOBJ_BODY,
-        refname=OBSTACLES_BODY,
-        intprm=[1, 1, 1],  # data "found", reduce "mindist", one contact
-    )
+    for name, body_name in (
+        (BUMP_SENSOR, OBSTACLES_BODY),
+        *((f"{BUMP_SENSOR}_{MOVING_PREFIX}{m.index}", f"{MOVING_PREFIX}{m.index}") for m in world.moving),
+    ):
+        arena.add_sensor(
+            name=name,
+            type=mujoco.mjtSensor.mjSENS_CONTACT,
+            objtype=mujoco.mjtObj.mjOBJ_XBODY,  # the subtree of base_link
+            objname=ROBOT_PREFIX + BASE_BODY,
+            reftype=mujoco.mjtObj.mjOBJ_BODY,
+            refname=body_name,
+            intprm=[1, 1, 1],  # data "found", reduce "mindist", one contact
+        )
 
     robot = mujoco.MjSpec.from_file(str(model_path(PROFILES[scenario.robot.profile].model_file)))
     if scenario.sensors.kind == "sonar":
