@@ -18,6 +18,7 @@ from vplane_mj.files import DEFAULT_OUT, prepare_out_dir, write_atomically
 from vplane_mj.planning.plugins import PlannerError
 from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
 from vplane_mj.terminal import Interrupted, signals_raise_interrupted
+from vplane_mj.worlds.dynabarn_layout import DIFFICULTIES
 from vplane_mj.worlds.families import FAMILIES
 
 if TYPE_CHECKING:
@@ -167,7 +168,7 @@ def _add_bench(commands) -> None:
 def _add_world_commands(commands) -> None:
     """`vplane-mj generate`, `import`, `check` and `mjcf`: scenario files and worlds."""
     gen = commands.add_parser("generate", help="write seeded scenario files of a family")
-    gen.add_argument("family", metavar="FAMILY", help=f"one of: {', '.join(sorted(FAMILIES))}")
+    gen.add_argument("family", metavar="FAMILY", help=f"one of: {', '.join(sorted([*FAMILIES, 'dynabarn']))}")
     gen.add_argument("--count", type=int, default=10)
     gen.add_argument("--seed", type=int, default=0)
     gen.add_argument("--out", type=Path, required=True, metavar="DIR")
@@ -175,6 +176,11 @@ def _add_world_commands(commands) -> None:
         "--protocol",
         action="store_true",
         help="barn only: the BARN challenge's layout (4.2 x 14 m, the Jackal), passable for the Jackal",
+    )
+    gen.add_argument(
+        "--difficulty",
+        choices=DIFFICULTIES,
+        help="dynabarn only: one of DynaBARN's thirds (default: the count split into easy, medium, hard)",
     )
     gen.set_defaults(handler=_generate, draws=False)
 
@@ -338,13 +344,19 @@ def _generate(args: argparse.Namespace) -> int:
         raise VPlaneError(f"--seed: must be at least 0, got {args.seed}")
     if args.protocol and args.family != "barn":
         raise VPlaneError(f"--protocol: only the barn family has the challenge's layout, not {args.family}")
-    out_dir = prepare_out_dir(args.out)
-    if args.protocol:
+    if args.difficulty and args.family != "dynabarn":
+        raise VPlaneError(f"--difficulty: only the dynabarn family has difficulty thirds, not {args.family}")
+    if args.family == "dynabarn":
+        from vplane_mj.worlds.dynabarn_generate import generate_dynabarn
+
+        cases = generate_dynabarn(args.count, args.seed, args.difficulty)
+    elif args.protocol:
         from vplane_mj.worlds.barn_protocol import generate_protocol
 
         cases = generate_protocol(args.count, args.seed)
     else:
         cases = generate(args.family, args.count, args.seed)
+    out_dir = prepare_out_dir(args.out)
     for case in cases:
         path = write_atomically(out_dir / f"{case.name}.toml", partial(Path.write_text, data=case.toml()))
         print(f"wrote {path}")
