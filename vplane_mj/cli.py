@@ -185,9 +185,20 @@ def _add_world_commands(commands) -> None:
     gen.set_defaults(handler=_generate, draws=False)
 
     imports = commands.add_parser("import", help="convert worlds of another simulator into scenario files")
-    imports.add_argument("source", choices=["barn"], metavar="SOURCE", help="barn: BARN's Gazebo worlds")
+    imports.add_argument(
+        "source",
+        choices=["barn", "dynabarn"],
+        metavar="SOURCE",
+        help="barn: BARN's Gazebo worlds; dynabarn: DynaBARN's, with the plugins that move their obstacles",
+    )
     imports.add_argument(
         "paths", nargs="+", type=Path, metavar="PATH", help="a world file, or a directory of world_N.world"
+    )
+    imports.add_argument(
+        "--plugins",
+        type=Path,
+        metavar="DIR",
+        help="dynabarn only: where the worlds' plugins are (default: plugins/ beside each world, or it)",
     )
     imports.add_argument("--out", type=Path, required=True, metavar="DIR")
     imports.set_defaults(handler=_import, draws=False)
@@ -364,16 +375,25 @@ def _generate(args: argparse.Namespace) -> int:
 
 
 def _import(args: argparse.Namespace) -> int:
-    """Convert BARN's world files into scenario files of the challenge's layout: every file is
-    read and converted before anything is written."""
-    from vplane_mj.worlds.barn_import import import_worlds, report_line
+    """Convert BARN's or DynaBARN's world files into scenario files of their layout: every file
+    (and every plugin) is read and converted before anything is written."""
+    lines: list[str]
+    if args.source == "dynabarn":
+        from vplane_mj.worlds import dynabarn_import
 
-    imported = import_worlds(args.paths)
+        moving = dynabarn_import.import_worlds(args.paths, args.plugins)
+        cases, lines = [world.case for world in moving], [dynabarn_import.report_line(w) for w in moving]
+    else:
+        if args.plugins is not None:
+            raise VPlaneError("--plugins: only DynaBARN's worlds load plugins (import dynabarn)")
+        from vplane_mj.worlds import barn_import
+
+        static = barn_import.import_worlds(args.paths)
+        cases, lines = [world.case for world in static], [barn_import.report_line(w) for w in static]
     out_dir = prepare_out_dir(args.out)
-    for world in imported:
-        print(report_line(world))
-        toml = world.case.toml()
-        path = write_atomically(out_dir / f"{world.case.name}.toml", partial(Path.write_text, data=toml))
+    for case, line in zip(cases, lines, strict=True):
+        print(line)
+        path = write_atomically(out_dir / f"{case.name}.toml", partial(Path.write_text, data=case.toml()))
         print(f"wrote {path}")
     return 0
 
