@@ -38,7 +38,7 @@ class ApfPlanner(Planner):
     def step(self, obs: Observation) -> Decision:
         components = self.params.firas_components(obs)
         total = components["attractive"] + components["repulsive"]
-        steering = self.governor.steer(total, obs, obs.echo_points())
+        steering = self.governor.steer(total, obs, obs.static_echo_points())
         decision = Decision(
             force=steering.force, mode="normal", components=components, command=steering.command
         )

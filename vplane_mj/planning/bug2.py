@@ -226,7 +226,7 @@ class Bug2Planner(Planner):
             return Decision(force=np.zeros(2), mode="gave_up", events=events, gave_up=True)
         components = self._go_to_goal(obs) if self.mode == "go_to_goal" else self._follow(obs)
         force = np.sum(list(components.values()), axis=0)
-        steering = self.governor.steer(force, obs, obs.echo_points())
+        steering = self.governor.steer(force, obs, obs.static_echo_points())
         return Decision(
             force=steering.force,
             mode=self.mode,

@@ -281,7 +281,7 @@ class DwaPlanner(Planner):
 
     def step(self, obs: Observation) -> Decision:
         p = self.params
-        self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
+        self.map.update(obs.position, obs.yaw, obs.bearings, obs.static_ranges(), obs.beam_width)
         speeds, turns = self.window(obs)
         dist = self.free_distance(obs, speeds, turns)
         admissible = self.stopping_length(speeds, turns) <= dist
@@ -416,7 +416,7 @@ class DwaPlanner(Planner):
         occupied = self.map.grid >= self.params.map_threshold
         if not scan.is_dense(obs):
             return occupied, origin, np.empty((0, 2))
-        echoes = obs.echo_points()
+        echoes = obs.static_echo_points()
         cells = np.floor(echoes / self.map.cell_m).astype(int) - origin
         unmapped = np.all((cells >= 0) & (cells < self.map.n), axis=1)
         unmapped[unmapped] = ~occupied[cells[unmapped, 0], cells[unmapped, 1]]

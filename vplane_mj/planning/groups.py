@@ -5,7 +5,7 @@ A planner's parameters combine them by inheritance (bases listed last group firs
 local-minimum detector), `MinimumParams` (the detector and the patience of a planner without
 an escape), `LocalMapParams` (the sonar certainty grid), `SonarMapParams` (the grid and its
 polar histogram) and `MotionParams` (the margins of the governor that drives a force on the
-robot's body).
+robot's body, and its check against moving obstacles).
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ import numpy as np
 
 from vplane_mj.planning import fields, scan
 from vplane_mj.planning.body import RobotBody
+from vplane_mj.planning.evasion import Evasion
 from vplane_mj.planning.localmap import LocalMap
 from vplane_mj.planning.minima import LocalMinimumDetector
 from vplane_mj.planning.motion import Governor
@@ -59,11 +60,21 @@ class MotionParams(PlannerParams):
     turn_margin_m: float = param(
         0.03, "m", "turns and predicted motions keep the footprint this far from obstacles", ge=0, le=1.0
     )
+    evade_horizon_s: float = param(
+        3.0, "s", "how long a command's motion is checked against the moving tracks", gt=0, le=10.0
+    )
+    evade_margin_m: float = param(
+        0.15, "m", "the footprint keeps this far from a moving track's predicted disc", ge=0, le=2.0
+    )
+    evade_growth_mps: float = param(
+        0.15, "m/s", "a moving track's predicted disc grows this much per second ahead", ge=0, le=2.0
+    )
 
     def governor(self, body: RobotBody) -> Governor:
         """A governor of forces for `body` with these margins (one per planner: it follows
-        the planner's commands)."""
-        return Governor(body, self.stop_margin_m, self.turn_margin_m)
+        the planner's commands), that evades moving tracks (evasion.py)."""
+        evasion = Evasion(body, self.evade_horizon_s, self.evade_margin_m, self.evade_growth_mps)
+        return Governor(body, self.stop_margin_m, self.turn_margin_m, evasion)
 
 
 @dataclass(frozen=True)

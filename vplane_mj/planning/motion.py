@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from vplane_mj.planning.body import DriveLimits, RobotBody
+from vplane_mj.planning.evasion import Evasion
 from vplane_mj.planning.types import Observation
 from vplane_mj.planning.vectors import evenly_spaced, wrap_angle
 
@@ -342,6 +343,8 @@ class Governor:
     body: RobotBody
     stop_margin_m: float
     turn_margin_m: float
+    evasion: Evasion | None = None
+    """The check of commands against the moving tracks in time; None: no such check."""
     drive: DriveModel = field(init=False)
     """The drive as `steer`'s commands move it."""
     maneuver: str | None = field(default=None, init=False)
@@ -409,6 +412,8 @@ class Governor:
         direction, command = self._command(local, obs.yaw, wanted, length, speed_mps, self.turn_margin_m)
         if command is None:
             command = self._creep(local, obs.yaw, wanted) or (0.0, 0.0)
+        if self.evasion is not None and obs.tracks:
+            command = self._evade(command, obs, local, wanted)
         self.drive.commanded(command)
         shown = (
             np.array([math.cos(wanted), math.sin(wanted)])
@@ -461,6 +466,35 @@ class Governor:
             heading = yaw if direction is None else direction
             command = self._forward(local, yaw, heading, length, speed_mps, margin)
         return direction, command
+
+    def _evade(
+        self, command: tuple[float, float], obs: Observation, local: np.ndarray, wanted: float
+    ) -> tuple[float, float]:
+        """`command`, or when a moving track meets its motion within the evasion's horizon, the
+        first command of the best of the evasion's candidate motions (`Evasion.ranking`, about
+        `wanted`, rad, world) that the static points of `local` allow (`_safe`); the best of
+        them all when none does."""
+        evasion = self.evasion
+        assert evasion is not None
+        threat = evasion.threat(obs.position, obs.tracks, obs.time_s)
+        if not threat:
+            evasion.kept = None
+            return command
+        pose = (float(obs.position[0]), float(obs.position[1]), float(obs.yaw))
+        candidates = evasion.candidates(wanted, command[0], float(obs.yaw))
+        risks = evasion.risks(candidates, pose, self.drive.ramp, threat, wanted)
+        if math.isinf(risks[0, 0]):
+            evasion.kept = None
+            return command
+        ranking = evasion.ranking(candidates, risks)
+        chosen = ranking[0]
+        for index in ranking:
+            candidate = (float(risks[index, 3]), float(risks[index, 4]))
+            if not self._moves(candidate) or self._safe(candidate, local, self.turn_margin_m):
+                chosen = index
+                break
+        evasion.kept = float(candidates[chosen, 0]) if candidates[chosen, 1] > 0 else None
+        return float(risks[chosen, 3]), float(risks[chosen, 4])
 
     def _creep(self, local: np.ndarray, yaw: float, wanted: float) -> tuple[float, float] | None:
         """For a robot that no motion keeps the turn margin: straight on at the back-off speed or

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from vplane_mj.planning.events import Event
+from vplane_mj.planning.perception.tracker import Track
 
 
 @dataclass(frozen=True)
@@ -20,6 +21,11 @@ class Observation:
     each beam's width, the same for all: an echo lies somewhere within it (a laser's is its
     angle step). `velocity` is the robot's speed along its heading (m/s, negative when
     reversing) and turn rate (rad/s), as its wheel encoders measure them.
+
+    `tracks` are the obstacles the run's tracker follows from the scans and the pose alone
+    (`perception.tracker`: each one's estimated disc and velocity, in the same frame as
+    `position`), and `moving_echoes` (beams,) marks the echoes of the tracks that move (None:
+    none is known to); `static_ranges` leaves those out.
     """
 
     time_s: float
@@ -31,13 +37,37 @@ class Observation:
     ranges: np.ndarray
     beam_width: float
     velocity: tuple[float, float] = (0.0, 0.0)
+    tracks: tuple[Track, ...] = ()
+    moving_echoes: np.ndarray | None = None
+
+    def static_ranges(self) -> np.ndarray:
+        """`ranges` without the echoes of moving tracks (NaN there): what a map of the obstacles
+        that stand still takes in. The ranges themselves when no echo is of a moving track."""
+        ranges = self.__dict__.get("_static_ranges")
+        if ranges is None:
+            ranges = self.ranges
+            if self.moving_echoes is not None and self.moving_echoes.any():
+                ranges = np.where(self.moving_echoes, np.nan, self.ranges)
+                ranges.flags.writeable = False
+            self.__dict__["_static_ranges"] = ranges
+        return ranges
 
     def echo_points(self) -> np.ndarray:
         """World-frame points (N, 2) of the echoes, each on its beam's axis; no-echo readings are dropped.
 
         Computed once per observation and shared by every caller, so it is read-only.
         """
-        points = self.__dict__.get("_echo_points")
+        return self._points("_echo_points", self.ranges)
+
+    def static_echo_points(self) -> np.ndarray:
+        """`echo_points` of `static_ranges`: the echoes of what is not known to move (read-only)."""
+        if self.static_ranges() is self.ranges:
+            return self.echo_points()
+        return self._points("_static_echo_points", self.static_ranges())
+
+    def _points(self, key: str, ranges: np.ndarray) -> np.ndarray:
+        """The world-frame points of `ranges`' echoes, cached under `key`."""
+        points = self.__dict__.get(key)
         if points is None:
             from vplane_mj.planning.kernels import points as compiled  # numba: loaded by the first call
 
@@ -45,10 +75,10 @@ class Observation:
                 np.asarray(self.position, float),
                 float(self.yaw),
                 np.asarray(self.bearings, float),
-                np.asarray(self.ranges, float),
+                np.asarray(ranges, float),
             )
             points.flags.writeable = False
-            self.__dict__["_echo_points"] = points  # a frozen dataclass: cache outside its fields
+            self.__dict__[key] = points  # a frozen dataclass: cache outside its fields
         return points
 
     def distance_to_goal(self) -> float:

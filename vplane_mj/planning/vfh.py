@@ -69,7 +69,7 @@ class VfhPlanner(Planner):
 
     def step(self, obs: Observation) -> Decision:
         p = self.params
-        self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
+        self.map.update(obs.position, obs.yaw, obs.bearings, obs.static_ranges(), obs.beam_width)
         enlarge = self.robot.half_width_m + p.clearance_m
         window = min(p.window_m, obs.distance_to_goal() + enlarge)  # nothing beyond the goal blocks it
         h, _ = histogram.map_histogram(
@@ -96,7 +96,7 @@ class VfhPlanner(Planner):
         if self.governor.idle:
             return Steering(force)
         cells, _ = self.map.cells(self.params.map_threshold, obs.position, self.governor.reach_m)
-        return self.governor.steer(force, obs, np.vstack((obs.echo_points(), cells)))
+        return self.governor.steer(force, obs, np.vstack((obs.static_echo_points(), cells)))
 
     def _choose(self, valleys: list[histogram.Valley], goal: float, heading: float) -> float | None:
         """The VFH+ candidate direction of least cost, or None when every sector is blocked."""

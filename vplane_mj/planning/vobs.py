@@ -84,7 +84,7 @@ class VobsPlanner(Planner):
             self.virtual = [v for v in self.virtual if v not in expired]
         points = np.array([position for _, position in self.virtual]).reshape(-1, 2)
         components["virtual"] = fields.repulsive_force(obs.position, points, p.vobs_gain, p.vobs_influence_m)
-        steering = self.governor.steer(sum(components.values(), np.zeros(2)), obs, obs.echo_points())
+        steering = self.governor.steer(sum(components.values(), np.zeros(2)), obs, obs.static_echo_points())
         decision.force, decision.command = steering.force, steering.command
         decision.mode = "escaping" if len(self.virtual) else "normal"
         decision.planes = []

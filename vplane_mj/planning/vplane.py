@@ -130,8 +130,8 @@ class VPlanePlanner(Planner):
     # -- the loop -------------------------------------------------------------------------
     def step(self, obs: Observation) -> Decision:
         p = self.params
-        self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
-        self.echoes.append(obs.echo_points())
+        self.map.update(obs.position, obs.yaw, obs.bearings, obs.static_ranges(), obs.beam_width)
+        self.echoes.append(obs.static_echo_points())
         decision = Decision(force=np.zeros(2), mode="normal")
         if self.planes:
             self._retire_planes(obs, decision)
@@ -178,7 +178,7 @@ class VPlanePlanner(Planner):
         if self.governor.idle:
             return Steering(force)
         cells, _ = self.map.cells(self.params.map_threshold, obs.position, self.governor.reach_m)
-        return self.governor.steer(force, obs, np.vstack((obs.echo_points(), cells)))
+        return self.governor.steer(force, obs, np.vstack((obs.static_echo_points(), cells)))
 
     # -- Algorithm 2: escaping ---------------------------------------------------------------
     def _start_escape(self, obs: Observation, decision: Decision) -> bool:

@@ -168,7 +168,7 @@ class VPlanePlusPlanner(VPlanePlanner):
     def step(self, obs: Observation) -> Decision:
         p = self.params
         if self._moved_since_last_scan(obs):
-            self.map.update(obs.position, obs.yaw, obs.bearings, obs.ranges, obs.beam_width)
+            self.map.update(obs.position, obs.yaw, obs.bearings, obs.static_ranges(), obs.beam_width)
             self.map.sweep(obs.position, self.robot.inner_radius_m)  # under the robot at any heading
         decision = Decision(force=np.zeros(2), mode="normal")
         if not self.following and self.last_scan_pose is not None and scan.is_dense(obs):
@@ -316,7 +316,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             if len(way)
             else math.inf
         )
-        points = np.vstack((obs.echo_points(), cells))
+        points = np.vstack((obs.static_echo_points(), cells))
         return self.governor.steer(force, obs, points, speed)
 
     def _mapped_cells_near(self, position: np.ndarray, reach_m: float) -> np.ndarray:

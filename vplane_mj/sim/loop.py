@@ -26,6 +26,8 @@ import numpy as np
 from vplane_mj import __version__
 from vplane_mj.errors import VPlaneError
 from vplane_mj.planning.events import Event, EventKind, point
+from vplane_mj.planning.perception.tracker import Track as TrackedObstacle
+from vplane_mj.planning.perception.tracker import Tracker
 from vplane_mj.planning.registry import make_planner
 from vplane_mj.planning.types import Decision, Observation
 from vplane_mj.robots.facts import robot_body
@@ -61,6 +63,9 @@ class Tick:
     obstacles: np.ndarray | None = None
     """Where the moving obstacles stood (count, 2; m), in the order of the scenario's
     `world.moving`; None in a world without any."""
+    tracks: tuple[TrackedObstacle, ...] = ()
+    """The obstacles the planner's tracker follows from its scans (`planning.perception`),
+    in the planner's frame."""
 
 
 class Observer(Protocol):
@@ -185,6 +190,9 @@ class Run:
         self.tolerance = scenario.robot.goal_tolerance
         self.ranges = np.full(len(self.sensor.bearings), np.nan)
         self.next_scan_s = 0.0
+        self.tracker = Tracker()
+        self.tracks: tuple[TrackedObstacle, ...] = ()
+        self.moving_echoes: np.ndarray | None = None
         self.position = self.drive.xpos[:2].copy()
         start = self.obstacles()
         self.clearance.add(
@@ -278,6 +286,8 @@ class Run:
             self.ranges,
             self.sensor.beam_width,
             self.drive.wheel_velocity(),
+            self.tracks,
+            self.moving_echoes,
         )
         return self._observation
 
@@ -343,16 +353,23 @@ class Run:
 
     # -- the stages of a tick ---------------------------------------------------------------
     def _sense(self) -> tuple[np.ndarray, float]:
-        """Read the range sensor (when a reading is due at its rate) and the pose the planner uses:
-        that pose (position in m, yaw in rad), also kept for the rest of the tick."""
+        """Read the range sensor (when a reading is due at its rate), the pose the planner uses,
+        and fold a new reading into the tracker at that pose: the pose (position in m, yaw in
+        rad), also kept for the rest of the tick."""
         time_s = self.data.time
         self.yaw = self.drive.yaw()
-        if time_s >= self.next_scan_s - 1e-9:
+        scanned = time_s >= self.next_scan_s - 1e-9
+        if scanned:
             self.ranges = self.sensor.read(float(self.position[0]), float(self.position[1]), self.yaw)
             while self.next_scan_s <= time_s + 1e-9:
                 self.next_scan_s += 1.0 / self.sensor.rate_hz
         self.yaws.append(self.yaw)
         self._belief = self.localiser.pose(self.position, self.yaw)
+        if scanned:
+            xy, yaw = self._belief
+            self.tracks = self.tracker.update(time_s, xy, yaw, self.sensor.bearings, self.ranges)
+            moving = self.tracker.moving_beams
+            self.moving_echoes = moving if moving.any() else None
         return self._belief
 
     def _take(self, decision: Decision) -> None:
@@ -401,6 +418,7 @@ class Run:
                 self.command,
                 belief,
                 places,
+                self.tracks,
             )
             for observer in self.observers:
                 observer.on_tick(tick)

@@ -1,0 +1,163 @@
+"""Moving obstacles met in time: which command keeps a robot clear of the tracked obstacles.
+
+The governor (motion.py) checks a command's motion against obstacle points that stand still;
+a moving obstacle needs a check in time instead: where will it be when the robot gets there?
+`Evasion` takes the tracks of the planner's tracker (`perception.tracker`) that move, and
+checks commands held for `horizon_s` against their constant-velocity predictions
+(`kernels.evasion.command_risks`): the robot's footprint against each track's disc at every
+time step, the disc grown by the track's position doubt and by `growth_mps` per second of
+prediction (obstacles turn; their paths are not straight). This is the time-indexed collision
+check of the velocity-obstacle family (Fiorini and Shiller 1998, "Motion Planning in Dynamic
+Environments Using Velocity Obstacles"; sampled as the dynamic window samples commands, Fox,
+Burgard and Thrun 1997, with the obstacles' motion, as Seder and Petrovic 2007).
+
+A candidate is a motion: a heading to turn to and a speed to drive along it (or to back off
+at), followed as the heading controller follows a force. The command asked for stays when its
+motion meets no moving track within the horizon. Otherwise the candidates (headings about the
+direction asked for, at several speeds, standing, backing) are ranked: those that stay clear
+over the whole horizon by how far they take the robot the way it was asked to go (and a little
+by the room they keep and by keeping the last evasion's heading); when none does, by how late
+they meet a track. Standing still is no refuge from an obstacle that comes on. Only a robot
+that some moving track can reach within the horizon is checked: in a world that stands still
+nothing changes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from vplane_mj.planning.body import RobotBody
+from vplane_mj.planning.perception.tracker import Track
+
+STEP_S = 0.1
+"""Time step (s) of the check along a candidate's motion."""
+HEADING_OFFSETS_DEG = (0, -10, 10, -20, 20, -35, 35, -50, 50, -70, 70, -90, 90)
+"""The candidates' headings, about the direction asked for and about the robot's heading (deg)."""
+SPEED_SHARES = (1.0, 0.7, 0.45, 0.2)
+"""The candidates' speeds along their headings, as shares of the top speed."""
+BACK_SHARES = (0.3,)
+"""The candidates that back off without turning, their speeds as shares of the top speed."""
+HIT_WEIGHT = 3.0
+"""What meeting a track at once costs, against a whole horizon's progress at the top speed (1):
+HIT_WEIGHT (1 - t / horizon)^2 for a meeting at t, so a meeting far ahead, which later ticks can
+still avoid, costs little."""
+ROOM_WEIGHT = 0.2
+"""What room up to ROOM_CAP_M over the horizon earns, against a whole horizon's progress."""
+NEAR_S = 1.0
+"""The first seconds (s) of a motion, whose room is what a robot already in danger saves."""
+DEPTH_WEIGHT = 4.0
+"""What each metre of a predicted overlap within NEAR_S costs."""
+ROOM_CAP_M = 1.0
+"""Room beyond this (m) earns nothing more."""
+KEEP_BONUS = 0.1
+"""What keeping the last evasion's heading (within KEEP_RAD) earns: no dithering between equals."""
+KEEP_RAD = math.radians(12.0)
+
+
+@dataclass(frozen=True)
+class Threat:
+    """The moving tracks that can reach the robot within the horizon, packed for the kernel:
+    (N, 6) x, y (m), vx, vy (m/s), radius (m) and its growth (m/s)."""
+
+    tracks: np.ndarray
+
+    def __bool__(self) -> bool:
+        return len(self.tracks) > 0
+
+
+@dataclass
+class Evasion:
+    """The check of motions against moving tracks for one robot body (module docstring)."""
+
+    body: RobotBody
+    horizon_s: float
+    margin_m: float
+    growth_mps: float
+    kept: float | None = None
+    """The heading (rad, world) of the last evasion, None when the last tick needed none."""
+
+    def threat(self, position: np.ndarray, tracks: tuple[Track, ...], time_s: float) -> Threat:
+        """The moving tracks that could come within the margin of the robot at `position` (m)
+        within the horizon from `time_s` (s), whatever it does (each closing at its speed plus
+        the robot's top); each where it is predicted at `time_s`."""
+        top = self.body.limits.max_speed_mps
+        rows = []
+        for track in tracks:
+            if not track.moving:
+                continue
+            x, y = track.predicted(time_s)
+            speed = math.hypot(track.velocity[0], track.velocity[1])
+            growth = self.growth_mps + track.velocity_std_mps
+            size = track.radius_m + track.position_std_m
+            reach = (top + speed + growth) * self.horizon_s + self.body.radius_m + self.margin_m + size
+            if math.hypot(x - position[0], y - position[1]) < reach:
+                rows.append((x, y, track.velocity[0], track.velocity[1], size, growth))
+        return Threat(np.array(rows, dtype=float).reshape(-1, 6))
+
+    def candidates(self, wanted: float, speed: float, yaw: float) -> np.ndarray:
+        """The motions to rank (C, 2: heading in rad, world; speed in m/s): the one asked for
+        (`wanted`, rad; `speed`, m/s) first, then HEADING_OFFSETS_DEG about it and about the
+        robot's heading `yaw` (rad) at SPEED_SHARES of the top speed, the last evasion's heading
+        likewise, standing, and backing off (BACK_SHARES)."""
+        top = self.body.limits.max_speed_mps
+        headings = [base + math.radians(offset) for base in (wanted, yaw) for offset in HEADING_OFFSETS_DEG]
+        if self.kept is not None:
+            headings.append(self.kept)
+        rows = [(wanted, speed)]
+        rows += [(heading, share * top) for heading in headings for share in SPEED_SHARES]
+        rows += [(yaw, 0.0)]
+        rows += [(yaw, -share * top) for share in BACK_SHARES]
+        return np.array(rows, dtype=float)
+
+    def risks(
+        self, candidates: np.ndarray, pose: tuple[float, float, float], state: tuple[float, float],
+        threat: Threat, toward: float,
+    ) -> np.ndarray:  # fmt: skip
+        """(C, 6) per candidate: the first time (s) a track comes within the margin (inf: none),
+        the least room (m) over the horizon, the advance (m) along `toward` (rad, world) until
+        then, the first command (m/s, rad/s), and the least room within NEAR_S
+        (`kernels.evasion.candidate_risks`)."""
+        from vplane_mj.planning.kernels import evasion  # numba: loaded by the first call
+
+        limits = self.body.limits
+        return evasion.candidate_risks(
+            np.ascontiguousarray(candidates, float),
+            pose,
+            state,
+            (
+                limits.max_speed_mps,
+                limits.max_turn_rate_radps,
+                limits.max_accel_mps2,
+                limits.braking_in_turn_mps2,
+                limits.max_turn_accel_radps2,
+                self.body.gains.turn_gain,
+            ),
+            (self.horizon_s, STEP_S),
+            np.ascontiguousarray(self.body.footprint, float),
+            float(self.body.radius_m),
+            threat.tracks,
+            float(self.margin_m),
+            float(toward),
+            NEAR_S,
+        )
+
+    def ranking(self, candidates: np.ndarray, risks: np.ndarray) -> np.ndarray:
+        """The candidates' indices, best first, by their score: the advance over the horizon as
+        a share of the top speed's, plus ROOM_WEIGHT of the room kept (up to ROOM_CAP_M), plus
+        KEEP_BONUS near the last evasion's heading, less HIT_WEIGHT (1 - t / horizon)^2 for
+        meeting a track at t and DEPTH_WEIGHT times the overlap predicted within NEAR_S."""
+        top = self.body.limits.max_speed_mps * self.horizon_s
+        soon = 1.0 - np.minimum(risks[:, 0], self.horizon_s) / self.horizon_s
+        score = (
+            risks[:, 2] / top
+            + ROOM_WEIGHT * np.clip(risks[:, 1], 0.0, ROOM_CAP_M) / ROOM_CAP_M
+            - HIT_WEIGHT * soon * soon
+            - DEPTH_WEIGHT * np.maximum(0.0, -risks[:, 5])
+        )
+        if self.kept is not None:
+            near = np.abs((candidates[:, 0] - self.kept + math.pi) % (2 * math.pi) - math.pi) < KEEP_RAD
+            score += KEEP_BONUS * (near & (candidates[:, 1] > 0))
+        return np.argsort(-score, kind="stable")

@@ -1,0 +1,129 @@
+"""Motions checked against moving obstacles in time, compiled (`planning.evasion`).
+
+A candidate is a heading (rad, world) and a speed (m/s, negative: backing without turning):
+the robot turns toward the heading as the heading controller turns it (turn rate k_w e, limited,
+ramped) while its speed ramps toward the candidate's times max(0, cos e), e the heading error,
+for the horizon. At every time step its footprint is set against each tracked obstacle's disc
+where its constant-velocity prediction puts it then, the disc grown with time for the
+prediction's doubt. What comes back per candidate: the first time (s) a disc comes within the
+margin of the footprint (inf: none within the horizon), the least gap (m) over the horizon
+(footprint to disc, less the growth; negative: they overlap), the advance (m) along a given
+direction, and the command (m/s, rad/s) of the motion's first step.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def _toward(value: float, target: float, step: float) -> float:
+    """`value` moved toward `target` by at most `step`."""
+    return value + min(max(target - value, -step), step)
+
+
+@njit(cache=True)
+def _wrap(angle: float) -> float:
+    """`angle` (rad) wrapped into [-pi, pi)."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@njit(cache=True)
+def _outline_gap(outline: np.ndarray, px: float, py: float) -> float:
+    """Signed distance (m) from the point (px, py) (robot frame) to the convex counter-clockwise
+    `outline` (k, 2): negative inside."""
+    k = outline.shape[0]
+    best = math.inf
+    outside = False
+    for i in range(k):
+        ax, ay = outline[i, 0], outline[i, 1]
+        bx, by = outline[(i + 1) % k, 0], outline[(i + 1) % k, 1]
+        ex, ey = bx - ax, by - ay
+        rx, ry = px - ax, py - ay
+        if ex * ry - ey * rx < 0.0:
+            outside = True
+        t = min(max((rx * ex + ry * ey) / (ex * ex + ey * ey), 0.0), 1.0)
+        dx, dy = rx - t * ex, ry - t * ey
+        best = min(best, math.sqrt(dx * dx + dy * dy))
+    return best if outside else -best
+
+
+@njit(cache=True)
+def candidate_risks(
+    candidates: np.ndarray,
+    pose: tuple[float, float, float],
+    state: tuple[float, float],
+    limits: tuple[float, float, float, float, float, float],
+    timing: tuple[float, float],
+    outline: np.ndarray,
+    reach_m: float,
+    tracks: np.ndarray,
+    margin_m: float,
+    toward: float,
+    near_s: float,
+) -> np.ndarray:
+    """(C, 6) per candidate of `candidates` (C, 2: heading in rad, world; speed in m/s) followed
+    for `timing[0]` s from the robot's `pose` (x, y in m, yaw in rad; world) and its speed and
+    turn rate `state`, checked every `timing[1]` s, within `limits` (top speed m/s, top turn
+    rate rad/s, acceleration m/s^2, braking m/s^2, turn acceleration rad/s^2, and the heading
+    controller's turn gain k_w, 1/s): the first time (s) a track's disc comes within
+    `margin_m` of the footprint `outline` (k, 2; robot frame, within `reach_m` of the origin),
+    inf for none; the least gap (m); the advance (m) along the direction `toward` (rad, world)
+    up to that time (or the horizon); the first step's speed (m/s) and turn rate (rad/s); and
+    the least gap (m) within the first `near_s` s. `tracks` (N, 6): x, y (m), vx, vy (m/s),
+    radius (m) and its growth (m/s)."""
+    horizon, dt = timing
+    top_speed, top_turn, accel, brake, alpha, gain = limits
+    steps = math.ceil(horizon / dt - 1e-9)
+    result = np.empty((candidates.shape[0], 6))
+    x0, y0, yaw0 = pose
+    ux, uy = math.cos(toward), math.sin(toward)
+    for c in range(candidates.shape[0]):
+        heading, speed = candidates[c, 0], candidates[c, 1]
+        v, w = state
+        x, y, yaw = x0, y0, yaw0
+        hit, least, near, advance = math.inf, math.inf, math.inf, 0.0
+        first_v, first_w = 0.0, 0.0
+        for s in range(1, steps + 1):
+            t = s * dt
+            if speed < 0.0:
+                v_cmd, w_cmd = speed, 0.0
+            else:
+                error = _wrap(heading - yaw)
+                v_cmd = speed * max(0.0, math.cos(error))
+                w_cmd = min(max(gain * error, -top_turn), top_turn)
+                # No faster a turn than one that stops when the heading is reached.
+                stop = math.sqrt(2.0 * alpha * abs(error))
+                w_cmd = min(max(w_cmd, -stop), stop)
+            if s == 1:
+                first_v, first_w = v_cmd, w_cmd
+            rate = accel if abs(v_cmd) > abs(v) and v_cmd * v >= 0.0 else brake
+            v_next = _toward(v, min(max(v_cmd, -top_speed), top_speed), rate * dt)
+            w_next = _toward(w, w_cmd, alpha * dt)
+            turned = 0.5 * (w + w_next) * dt
+            mid = yaw + 0.5 * turned
+            step = 0.5 * (v + v_next) * dt
+            x, y, yaw = x + step * math.cos(mid), y + step * math.sin(mid), yaw + turned
+            v, w = v_next, w_next
+            cos_yaw, sin_yaw = math.cos(yaw), math.sin(yaw)
+            for n in range(tracks.shape[0]):
+                ox = tracks[n, 0] + tracks[n, 2] * t - x
+                oy = tracks[n, 1] + tracks[n, 3] * t - y
+                size = tracks[n, 4] + tracks[n, 5] * t
+                bound = math.sqrt(ox * ox + oy * oy) - reach_m - size  # a bound below the gap
+                if bound >= least and bound >= margin_m:
+                    continue
+                gap = _outline_gap(outline, cos_yaw * ox + sin_yaw * oy, -sin_yaw * ox + cos_yaw * oy) - size
+                least = min(least, gap)
+                if t <= near_s + 1e-9:
+                    near = min(near, gap)
+                if gap < margin_m and t < hit:
+                    hit = t
+            if hit == math.inf:
+                advance = (x - x0) * ux + (y - y0) * uy
+        result[c, 0], result[c, 1], result[c, 2] = hit, least, advance
+        result[c, 3], result[c, 4], result[c, 5] = first_v, first_w, near
+    return result
