@@ -1,5 +1,5 @@
-"""Reading a run's MCAP log back: its metadata, poses, modes and events, also from a file whose
-writer was killed (every complete chunk is kept)."""
+"""Reading a run's MCAP log back: its metadata, poses, modes, events and moving obstacles, also
+from a file whose writer was killed (every complete chunk is kept)."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from mcap.exceptions import EndOfFile
 from mcap.stream_reader import StreamReader
 from mcap_protobuf.decoder import DecoderFactory
 
-from vplane_mj.logs.writer import EVENTS_DATA_TOPIC, SUMMARY_METADATA_NAME
+from vplane_mj.logs.writer import EVENTS_DATA_TOPIC, MOVING_TOPIC, SUMMARY_METADATA_NAME
 from vplane_mj.planning.events import EVENT_POINTS, EventKind
 
 
@@ -57,7 +57,10 @@ class LogContents:
     (N, 2) and `yaws` (N,): the `/robot/pose` messages; `modes`: planner mode per
     `/metrics` message; `events`: the events of `/run/events`, in order; `topics`: topic
     -> (schema name, message count) over every message read; `complete`: whether the
-    file ended with its footer (False for a file whose writer was killed).
+    file ended with its footer (False for a file whose writer was killed);
+    `obstacle_times_ns` (M,) and `obstacle_places` (M, count, 2; m): the `/world/moving`
+    messages, where the moving obstacles stood, in each message's order of entities (the
+    scenario's `world.moving`); none in a world without any.
     """
 
     metadata: dict[str, dict[str, str]]
@@ -69,6 +72,16 @@ class LogContents:
     topics: dict[str, tuple[str, int]]
     complete: bool = True
     message_encodings: dict[str, str] = field(default_factory=dict)
+    obstacle_times_ns: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.int64))
+    obstacle_places: np.ndarray = field(default_factory=lambda: np.empty((0, 0, 2)))
+
+    def obstacles_at_poses(self) -> np.ndarray | None:
+        """Where the moving obstacles stood at each pose of `times_ns` (N, count, 2; m): the last
+        `/world/moving` message at or before it (the first before the first); None without any."""
+        if len(self.obstacle_times_ns) == 0:
+            return None
+        latest = np.searchsorted(self.obstacle_times_ns, self.times_ns, side="right") - 1
+        return self.obstacle_places[np.maximum(latest, 0)]
 
     @property
     def summary(self) -> dict | None:
@@ -186,6 +199,8 @@ def read_log(path: Path) -> LogContents:
     poses: list[tuple[float, float, float]] = []
     modes: list[str] = []
     events: list[LoggedEvent] = []
+    obstacle_times: list[int] = []
+    obstacle_places: list[list[tuple[float, float]]] = []
     for schema, channel, record in scan.messages():
         topic = channel.topic
         entry = counts.setdefault(topic, [schema.name if schema is not None else "", 0])
@@ -198,6 +213,9 @@ def read_log(path: Path) -> LogContents:
             poses.append((pose.position.x, pose.position.y, 2 * math.atan2(q.z, q.w)))
         elif topic == "/metrics":
             modes.append(str(decoders.decode(schema, channel, record.data).get("mode", "")))
+        elif topic == MOVING_TOPIC:
+            obstacle_times.append(record.log_time)
+            obstacle_places.append(entity_centres(decoders.decode(schema, channel, record.data)))
         elif topic == EVENTS_DATA_TOPIC:
             events.append(
                 LoggedEvent.from_json(record.log_time, decoders.decode(schema, channel, record.data))
@@ -213,4 +231,18 @@ def read_log(path: Path) -> LogContents:
         topics={topic: (name, count) for topic, (name, count) in counts.items()},
         complete=scan.complete,
         message_encodings=encodings,
+        obstacle_times_ns=np.array(obstacle_times, dtype=np.int64),
+        obstacle_places=np.array(obstacle_places, dtype=float).reshape(len(obstacle_times), -1, 2)
+        if obstacle_times
+        else np.empty((0, 0, 2)),
     )
+
+
+def entity_centres(update: Any) -> list[tuple[float, float]]:
+    """The centre (x, y; m) of each entity of a decoded SceneUpdate, in order: its first cylinder's
+    or cube's (a moving obstacle is one piece)."""
+    centres = []
+    for entity in update.entities:
+        position = (entity.cylinders or entity.cubes)[0].pose.position
+        centres.append((position.x, position.y))
+    return centres

@@ -1,17 +1,22 @@
 """A run recomputed from its MCAP log alone: the scenario, the summary and the render's track.
 
 The outcome and the counts come from the kinds of the logged events (`/run/events`), the
-path and clearance from the poses: no event text is parsed.
+path and clearance from the poses, and where the moving obstacles stood from `/world/moving`
+(the places the run itself saw at each tick, not recomputed from their motions): no event
+text is parsed.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 from vplane_mj.errors import VPlaneError
+from vplane_mj.geometry import shapes
+from vplane_mj.geometry.motion import Moving
 from vplane_mj.logs.reader import LogContents, iter_messages, read_log
 from vplane_mj.logs.writer import METADATA_NAME
 from vplane_mj.planning.events import EventKind
@@ -40,6 +45,7 @@ COMPARED_KEYS = (
     "path_length_m",
     "collisions",
     "min_clearance_m",
+    "min_clearance_moving_m",
     "local_minima",
     "escapes",
     "message",
@@ -69,7 +75,8 @@ def summarize(contents: LogContents, scenario: Scenario) -> dict:
     """The run summary recomputed from the poses and events of a log.
 
     Path length and clearance come from the poses at the control rate (20 Hz), the
-    run's own summary from the 100 Hz motor rate, so they agree to about a millimetre.
+    run's own summary from the 100 Hz motor rate, so they agree to about a millimetre (a few
+    near moving obstacles, which move between ticks too).
     """
     info = contents.metadata[METADATA_NAME]
     radius = float(info["robot_radius_m"])
@@ -79,7 +86,7 @@ def summarize(contents: LogContents, scenario: Scenario) -> dict:
     outcome = INTERRUPTED if ending is None else str(ENDINGS[ending.kind])
     collisions = sum(event.kind is EventKind.COLLISION for event in events)
     steps = np.diff(contents.positions, axis=0)
-    clearance = pose_clearance(scenario, contents, radius)
+    clearance, moving = pose_clearance(scenario, contents, radius)
     reached = outcome == Outcome.REACHED
     return {
         "scenario": scenario.name,
@@ -93,6 +100,7 @@ def summarize(contents: LogContents, scenario: Scenario) -> dict:
         "path_length_m": float(np.sum(np.hypot(steps[:, 0], steps[:, 1]))),
         "collisions": collisions,
         "min_clearance_m": None if math.isinf(clearance) else clearance,
+        "min_clearance_moving_m": moving,
         "local_minima": sum(event.kind is EventKind.LOCAL_MINIMUM for event in events),
         "escapes": sum(event.kind is EventKind.ESCAPE_FINISHED for event in events),
         "message": "" if ending is None or outcome in (Outcome.REACHED, Outcome.TIMEOUT) else ending.text,
@@ -100,13 +108,40 @@ def summarize(contents: LogContents, scenario: Scenario) -> dict:
     }
 
 
-def pose_clearance(scenario: Scenario, contents: LogContents, radius_m: float) -> float:
+def pose_clearance(scenario: Scenario, contents: LogContents, radius_m: float) -> tuple[float, float | None]:
     """The robot's smallest clearance (m) over the logged poses, measured as the run measures it
-    (`robot_clearance`); inf without obstacles."""
-    clearance = robot_clearance(scenario, robot_body(scenario.robot.profile, scenario.sensors.kind), radius_m)
-    clearance.add(np.column_stack((contents.positions, contents.yaws)))
+    (`robot_clearance`; inf without obstacles), and that to the moving obstacles alone where
+    they stood at those poses (None without any)."""
+    body = robot_body(scenario.robot.profile, scenario.sensors.kind)
+    clearance = robot_clearance(scenario, body, radius_m)
+    poses = np.column_stack((contents.positions, contents.yaws))
+    clearance.add(poses)
     clearance.flush()
-    return clearance.robot_minimum
+    places = contents.obstacles_at_poses()
+    if not scenario.world.moving or places is None:
+        return clearance.robot_minimum, None
+    gaps = obstacle_distances(scenario.world.moving, poses, places, None if body.disc else body.footprint)
+    moving = float(gaps.min()) - (radius_m if body.disc else 0.0)
+    return min(clearance.robot_minimum, moving), moving
+
+
+def obstacle_distances(
+    moving: Sequence[Moving], poses: np.ndarray, places: np.ndarray, outline: np.ndarray | None = None
+) -> np.ndarray:
+    """Signed distance (m; N, count) from each pose (N, 3: x, y, yaw; or N, 2 points) to each
+    moving obstacle standing where `places` (N, count, 2; m) says: from the point, or with
+    `outline` (the robot's footprint in its frame, m) from the outline, as the run measures it
+    (`shapes.moving_distances`)."""
+    columns = []
+    for k, obstacle in enumerate(moving):
+        (piece,) = obstacle.shape.footprint()
+        discs, rects = np.empty((0, 3)), np.empty((0, 6))
+        if isinstance(piece, shapes.Disc):
+            discs = np.array([[0.0, 0.0, piece.radius]])
+        else:
+            rects = np.array([[0.0, 0.0, *piece.half, math.cos(piece.yaw), math.sin(piece.yaw)]])
+        columns.append(shapes.moving_distances(discs, rects, places[:, k : k + 1], poses, outline))
+    return np.column_stack(columns)
 
 
 def disagreements(recomputed: dict, stored: dict, tolerance_m: float = 0.01) -> list[str]:
@@ -124,7 +159,8 @@ def disagreements(recomputed: dict, stored: dict, tolerance_m: float = 0.01) -> 
 
 
 def track_from_log(path: Path, contents: LogContents) -> Track:
-    """What a render shows, from the log: path, modes, final pose, virtual objects, collisions."""
+    """What a render shows, from the log: path, modes, final pose, virtual objects, collisions,
+    and where the moving obstacles stood at each pose (from `/world/moving`)."""
     objectives = [
         e.data["objective"]
         for e in contents.events
@@ -145,4 +181,6 @@ def track_from_log(path: Path, contents: LogContents) -> Track:
         else ["normal"] * len(contents.positions)
     )
     final = (float(contents.positions[-1, 0]), float(contents.positions[-1, 1]), float(contents.yaws[-1]))
-    return Track(contents.positions, modes, final, collisions, objectives, planes)
+    return Track(
+        contents.positions, modes, final, collisions, objectives, planes, contents.obstacles_at_poses()
+    )

@@ -4,17 +4,23 @@ Every entity is in frame `world` (the robot's body in `base_link`, frame-locked 
 with `/tf`). Force arrows start at the robot's centre and point along the force; their
 length is `ARROW_M_PER_UNIT` per unit of force, clipped to `ARROW_MAX_M`. Virtual planes are
 thin translucent walls with their centre line; the virtual objective a sphere on a post;
-the path one line strip.
+the path one line strip. Moving obstacles look like the static ones, wherever they stand; the
+planner's tracks are discs of their radius, coloured by whether they move, with their velocity
+as an arrow and their id as a label.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Iterable, Sequence
+from typing import NamedTuple, Protocol
 
 import numpy as np
 from foxglove import messages as fm
 
 from vplane_mj.geometry import shapes
+from vplane_mj.geometry.motion import Moving
 from vplane_mj.planning.body import RobotBody
 from vplane_mj.scenario import Scenario
 from vplane_mj.sim.world import OBSTACLE_HEIGHT_M
@@ -57,7 +63,15 @@ _COLOURS = {
     "robot": (0.20, 0.24, 0.32, 0.9),
     "heading": (1.00, 1.00, 1.00, 1.0),
     "outline": (1.00, 0.55, 0.10, 1.0),
+    "track_moving": (0.90, 0.15, 0.55, 1.0),
+    "track_static": (0.20, 0.60, 0.85, 1.0),
 }
+TRACK_FILL_ALPHA = 0.3
+"""Opacity of a track's disc (its outline and label are opaque)."""
+TRACK_ARROW_S = 1.0
+"""A moving track's velocity arrow reaches where it would be after this long (s)."""
+TRACK_OUTLINE_POINTS = 32
+"""Points of a track's outline."""
 
 
 IDENTITY = fm.Quaternion(x=0.0, y=0.0, z=0.0, w=1.0)
@@ -107,7 +121,7 @@ def world_entities(scenario: Scenario, body: RobotBody) -> list[fm.SceneEntity]:
             ],
         )
     ]
-    for index, obstacle in enumerate(world.obstacles):
+    for index, obstacle in zip(world.static_indices(), world.obstacles, strict=True):
         entities.append(_pieces_entity(f"obstacle_{index}", obstacle.footprint(), _COLOURS["obstacle"], when))
     if world.border:
         entities.append(
@@ -328,3 +342,124 @@ def path_entity(when: fm.Timestamp, points: list[tuple[float, float]]) -> fm.Sce
         color=_colour(_COLOURS["path"]),
     )
     return fm.SceneEntity(timestamp=when, frame_id=WORLD_FRAME, id=PATH_ID, lines=[line])
+
+
+def moving_entities(when: fm.Timestamp, moving: Sequence[Moving], places: np.ndarray) -> list[fm.SceneEntity]:
+    """The moving obstacles standing at `places` (count, 2; m, in `moving`'s order), drawn as the
+    static ones, each the entity `obstacle_<i>` of its index i in the file."""
+    return [
+        _pieces_entity(
+            f"obstacle_{obstacle.index}",
+            dataclasses.replace(obstacle.shape, center=(float(x), float(y))).footprint(),
+            _COLOURS["obstacle"],
+            when,
+        )
+        for obstacle, (x, y) in zip(moving, places, strict=True)
+    ]
+
+
+class TrackedObstacle(Protocol):
+    """What the log reads of an obstacle the planner's tracker follows (`Tick.tracks`)."""
+
+    @property
+    def track_id(self) -> int: ...
+
+    @property
+    def position(self) -> np.ndarray: ...
+
+    @property
+    def velocity(self) -> np.ndarray: ...
+
+    @property
+    def radius_m(self) -> float: ...
+
+    @property
+    def moving(self) -> bool: ...
+
+
+class TrackMark(NamedTuple):
+    """A tracked obstacle as drawn: its id, centre (m), velocity (m/s), radius (m), and whether
+    it moves."""
+
+    track_id: int
+    x: float
+    y: float
+    vx: float
+    vy: float
+    radius_m: float
+    moving: bool
+
+    @property
+    def entity_id(self) -> str:
+        return f"track_{self.track_id}"
+
+
+def track_marks(tracks: Iterable[TrackedObstacle]) -> tuple[TrackMark, ...]:
+    """The tracks as numbers, taken when the tick comes (a tracker may reuse its objects); a track
+    without a finite centre and radius is left out."""
+    marks = []
+    for track in tracks:
+        x, y = (float(v) for v in track.position[:2])
+        vx, vy = (float(v) for v in track.velocity[:2])
+        radius = float(track.radius_m)
+        if math.isfinite(x) and math.isfinite(y) and math.isfinite(radius):
+            marks.append(TrackMark(int(track.track_id), x, y, vx, vy, max(radius, 0.0), bool(track.moving)))
+    return tuple(marks)
+
+
+def track_entity(when: fm.Timestamp, mark: TrackMark) -> fm.SceneEntity:
+    """A track: a translucent disc of its radius with its outline, its id as a label above it and,
+    when it moves, an arrow from its centre to where it will be in TRACK_ARROW_S."""
+    rgba = _COLOURS["track_moving" if mark.moving else "track_static"]
+    colour = _colour(rgba)
+    z = 0.03
+    angles = np.linspace(0.0, 2 * math.pi, TRACK_OUTLINE_POINTS, endpoint=False)
+    ring = [
+        fm.Point3(x=mark.x + mark.radius_m * math.cos(a), y=mark.y + mark.radius_m * math.sin(a), z=z)
+        for a in angles
+    ]
+    arrow = _velocity_arrow(mark, colour) if mark.moving else None
+    return fm.SceneEntity(
+        timestamp=when,
+        frame_id=WORLD_FRAME,
+        id=mark.entity_id,
+        cylinders=[_flat_disc((mark.x, mark.y), mark.radius_m, (*rgba[:3], TRACK_FILL_ALPHA))],
+        lines=[
+            fm.LinePrimitive(
+                type=fm.LinePrimitiveLineType.LineLoop,
+                pose=pose(0.0, 0.0),
+                thickness=0.03,
+                scale_invariant=False,
+                points=ring,
+                color=colour,
+            )
+        ],
+        arrows=[] if arrow is None else [arrow],
+        texts=[
+            fm.TextPrimitive(
+                pose=pose(mark.x, mark.y, OBSTACLE_HEIGHT_M + 0.1),
+                billboard=True,
+                font_size=14.0,
+                scale_invariant=True,
+                color=colour,
+                text=str(mark.track_id),
+            )
+        ],
+    )
+
+
+def _velocity_arrow(mark: TrackMark, colour: fm.Color) -> fm.ArrowPrimitive | None:
+    """The arrow from a track's centre to where its velocity takes it in TRACK_ARROW_S; None when
+    that is (nearly) nowhere or not finite."""
+    length = math.hypot(mark.vx, mark.vy) * TRACK_ARROW_S
+    if not math.isfinite(length) or length < 0.01:
+        return None
+    head = min(0.1, 0.4 * length)
+    return fm.ArrowPrimitive(
+        pose=pose(mark.x, mark.y, 0.05, math.atan2(mark.vy, mark.vx)),
+        shaft_length=length - head,
+        shaft_diameter=0.025,
+        head_length=head,
+        head_diameter=0.07,
+        color=colour,
+    )

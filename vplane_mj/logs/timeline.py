@@ -24,7 +24,8 @@ class Timeline:
     frame (m); `forces[k]` force name -> (x, y, dx, dy), the arrow as drawn in the log
     (m, 0.5 m per unit of force, at most 1.5 m); `objectives[k]` the virtual objective
     (x, y) or None; `planes[k]` the virtual planes ((x1, y1), (x2, y2)); `events` the logged
-    events in order.
+    events in order; `obstacles` (N, count, 2) where the moving obstacles stood (m), in the
+    order of the scenario's `world.moving`, None in a world without any.
     """
 
     times_s: np.ndarray
@@ -35,6 +36,7 @@ class Timeline:
     objectives: list[tuple[float, float] | None]
     planes: list[list[tuple[tuple[float, float], tuple[float, float]]]]
     events: list[LoggedEvent]
+    obstacles: np.ndarray | None = None
 
     def index_at(self, time_s: float) -> int:
         """The last tick at or before `time_s` (the first tick before the run starts)."""
@@ -58,6 +60,7 @@ def timeline_from_log(path: Path, contents: LogContents) -> Timeline:
         objectives=[objective for objective, _ in virtual],
         planes=[planes for _, planes in virtual],
         events=contents.events,
+        obstacles=contents.obstacles_at_poses(),
     )
 
 

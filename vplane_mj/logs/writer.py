@@ -12,7 +12,8 @@ messages' own `timestamp` fields, is the integer nanosecond of *simulated* time,
 | `/robot/pose` | `foxglove.PoseInFrame` | every control tick, frame `world`, z = 0 |
 | `/tf` | `foxglove.FrameTransforms` | every tick, `world` -> `base_link` and `base_link_xy` |
 | `/scan` | `foxglove.LaserScan` | every tick, frame `base_link`, NaN where no echo (see below) |
-| `/world` | `foxglove.SceneUpdate` | once at time 0: arena, obstacles, border, start, goal, robot |
+| `/world` | `foxglove.SceneUpdate` | once at time 0: arena, static obstacles, border, start, goal, robot |
+| `/world/moving` | `foxglove.SceneUpdate` | every tick, at least every 0.1 s, if any obstacle moves |
 | `/forces` | `foxglove.SceneUpdate` | every tick: force arrows at the robot |
 | `/virtual` | `foxglove.SceneUpdate` | at time 0 (empty), then when the objective or planes change |
 | `/path` | `foxglove.SceneUpdate` | the path so far: first tick, about once per simulated second, close |
@@ -20,6 +21,7 @@ messages' own `timestamp` fields, is the integer nanosecond of *simulated* time,
 | `/run/events` | JSON (`vplane_mj.Event` JSON schema) | the same events as data: kind, text, points |
 | `/metrics` | JSON (`vplane_mj.Metrics` JSON schema) | every tick (see below) |
 | `/robot/odometry` | `foxglove.PoseInFrame` | believed pose, every tick, if `sensors.pose = "odometry"` |
+| `/tracks` | `foxglove.SceneUpdate` | every tick with tracks, from the first (and when the last vanish) |
 
 An arrow whose force is (near) zero or not finite is deleted until it comes back.
 Entity ids: `/forces` `attractive`, `repulsive`, `virtual`,
@@ -28,10 +30,15 @@ planner's list); `/path` `path` (one line strip from the start to the robot, rep
 by every message, so that the latest message before any time, all a viewer keeps of a
 scene topic after a seek, shows the whole path up to then; simplified to within
 `PATH_TOLERANCE_M` of every logged pose, which keeps it a few hundred points long);
-`/world` `arena`, `border`, `obstacle_<i>`, `start`, `goal` (frame `world`) and `robot`
+`/world` `arena`, `border`, `obstacle_<i>` (i the obstacle's index in the scenario file),
+`start`, `goal` (frame `world`) and `robot`
 (a round robot as a disc of `robot_radius_m`, another as its footprint polygon, with a
-heading arrow, in frame `base_link`, frame-locked, so it moves with `/tf`). Entities that
-vanish are removed with `SceneUpdate.deletions`.
+heading arrow, in frame `base_link`, frame-locked, so it moves with `/tf`); `/world/moving`
+`obstacle_<i>` for each moving obstacle (never in `/world`), every message all of them where
+they stood at its time: the tick's `Tick.obstacles`, and where ticks are further apart than
+`MOVING_PERIOD_S`, their motions' places between them; `/tracks` `track_<id>`, the planner's
+tracked obstacles as it estimates them (in its own frame, the world's unless its pose comes
+from odometry). Entities that vanish are removed with `SceneUpdate.deletions`.
 
 `/scan` holds the sensor's ranges from the robot's centre at the sensor's height, rounded to
 RANGE_STEP_M (a step that compresses: a 720-beam laser costs about 2 MB a minute at 20 Hz,
@@ -86,6 +93,7 @@ from vplane_mj.logs.scene import (
     FORCE_STYLE,
     ROBOT_FRAME,
     WORLD_FRAME,
+    TrackMark,
 )
 from vplane_mj.planning.events import EVENT_POINTS, Event, EventKind
 from vplane_mj.planning.types import Decision
@@ -106,6 +114,10 @@ RANGE_STEP_M = 1.0 / 1024
 leaves the low bytes of each number zero, which the chunks' compression then removes."""
 PATH_TOLERANCE_M = 0.01
 """The drawn path passes within this distance of every logged pose."""
+MOVING_TOPIC = "/world/moving"
+TRACKS_TOPIC = "/tracks"
+MOVING_PERIOD_S = 0.1
+"""Longest simulated time between two `/world/moving` messages."""
 
 METRICS_JSON_SCHEMA: dict[str, Any] = {
     "title": "vplane_mj.Metrics",
@@ -164,6 +176,8 @@ _METRIC_FORCES = tuple(
 """Where /metrics' force magnitudes are among `_FORCE_ARROWS`."""
 WARNING_EVENTS = {EventKind.COLLISION, EventKind.GAVE_UP, EventKind.ERROR, EventKind.BELIEVED_ARRIVED}
 """Events logged at the Warning level."""
+_Pending = tuple[Tick, _Forces, tuple[TrackMark, ...]]
+"""A tick kept until its simulated second is written, with its forces and tracks as they came."""
 
 
 class McapLog:
@@ -212,6 +226,11 @@ class McapLog:
         self._odometry_ch = None
         if scenario.sensors.pose == "odometry":
             self._odometry_ch = fc.PoseInFrameChannel("/robot/odometry", context=ctx)
+        self._moving = scenario.world.moving
+        self._moving_ch = fc.SceneUpdateChannel(MOVING_TOPIC, context=ctx) if self._moving else None
+        self._moving_last_s: float | None = None  # the time of the last /world/moving message
+        self._tracks_ch: fc.SceneUpdateChannel | None = None  # made at the first tick with tracks
+        self._shown_tracks: list[str] = []
 
         self._writer.write_metadata(METADATA_NAME, self._run_metadata(metadata))
         self._world_ch.log(fm.SceneUpdate(entities=scene.world_entities(scenario, self.body)), log_time=0)
@@ -231,7 +250,7 @@ class McapLog:
         self._path_dirty = False
         self._modes: dict[str, str] = {}  # mode -> its JSON string
         self._next_flush_s = 0.0  # the first tick flushes, so /path starts with the run
-        self._pending: list[tuple[Tick, _Forces]] = []
+        self._pending: list[_Pending] = []
 
     # -- metadata and the static world -------------------------------------------------------
     def _run_metadata(self, extra: dict[str, str]) -> dict[str, str]:
@@ -267,7 +286,7 @@ class McapLog:
         before the flush (one tight loop runs faster than the same work between physics steps)."""
         if self._closed:
             return
-        self._pending.append((tick, _force_vectors(tick.decision)))
+        self._pending.append((tick, _force_vectors(tick.decision), scene.track_marks(tick.tracks)))
         if tick.time_s >= self._next_flush_s - 1e-9:
             self._write_pending()
             self._log_path(self._last_ns)
@@ -315,10 +334,10 @@ class McapLog:
     def _write_pending(self) -> None:
         """Write the messages of the ticks kept since the last call, in their order."""
         pending, self._pending = self._pending, []
-        for tick, forces in pending:
-            self._write_tick(tick, forces)
+        for tick, forces, tracks in pending:
+            self._write_tick(tick, forces, tracks)
 
-    def _write_tick(self, tick: Tick, forces: _Forces) -> None:
+    def _write_tick(self, tick: Tick, forces: _Forces, tracks: tuple[TrackMark, ...]) -> None:
         ns = time_ns(tick.time_s)
         self._last_ns = max(self._last_ns, ns)
         stamp = scene.stamp(ns)
@@ -333,6 +352,8 @@ class McapLog:
         self._log_forces(ns, stamp, x, y, forces)
         self._log_virtual(ns, stamp, tick)
         self._log_metrics(ns, tick, forces)
+        self._log_moving(tick.time_s, tick.obstacles)
+        self._log_tracks(ns, stamp, tracks)
         self._path.add(x, y)
         self._path_dirty = True
 
@@ -453,6 +474,39 @@ class McapLog:
             mode = self._modes[tick.decision.mode] = json.dumps(tick.decision.mode)
         fields.append(f'"mode": {mode}')
         self._metrics_ch.log(("{" + ", ".join(fields) + "}").encode(), log_time=ns)
+
+    def _log_moving(self, time_s: float, places: np.ndarray | None) -> None:
+        """The moving obstacles where the tick saw them (`places`, count x 2; m), after where their
+        motions put them between this tick and the last, evenly, when those are further apart
+        than MOVING_PERIOD_S."""
+        if self._moving_ch is None or places is None:
+            return
+        last = self._moving_last_s
+        if last is not None and time_s - last > MOVING_PERIOD_S + 1e-9:
+            parts = math.ceil((time_s - last) / MOVING_PERIOD_S - 1e-9)
+            for between in last + (time_s - last) * np.arange(1, parts) / parts:
+                self._log_places(float(between), np.array([m.motion.position(between) for m in self._moving]))
+        self._log_places(time_s, places)
+        self._moving_last_s = time_s
+
+    def _log_places(self, time_s: float, places: np.ndarray) -> None:
+        """One `/world/moving` message: every moving obstacle at `places` (count x 2; m)."""
+        assert self._moving_ch is not None
+        ns = time_ns(time_s)
+        entities = scene.moving_entities(scene.stamp(ns), self._moving, places)
+        self._moving_ch.log(fm.SceneUpdate(entities=entities), log_time=ns)
+
+    def _log_tracks(self, ns: int, stamp: fm.Timestamp, tracks: tuple[TrackMark, ...]) -> None:
+        """Every track of the tick, replacing the last tick's; those no longer tracked deleted."""
+        if not tracks and not self._shown_tracks:
+            return
+        if self._tracks_ch is None:
+            self._tracks_ch = fc.SceneUpdateChannel(TRACKS_TOPIC, context=self._context)
+        shown = [mark.entity_id for mark in tracks]
+        deletions = [scene.deletion(stamp, name) for name in self._shown_tracks if name not in shown]
+        self._shown_tracks = shown
+        entities = [scene.track_entity(stamp, mark) for mark in tracks]
+        self._tracks_ch.log(fm.SceneUpdate(deletions=deletions, entities=entities), log_time=ns)
 
     # -- the path ----------------------------------------------------------------------------
     def _log_path(self, ns: int) -> None:

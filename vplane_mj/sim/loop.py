@@ -477,6 +477,7 @@ class Run:
                 final,
                 (0.0, 0.0),
                 obstacles=self.obstacles(),
+                tracks=self.tracks,
             )
             for observer in self.observers:
                 observer.on_tick(tick)

@@ -2,7 +2,8 @@
 
 Each frame shows the arena and its obstacles around the start, the goal and the path
 (the whole arena when that is most of it), start and goal, the path so far coloured by
-planner mode (as in the render), the virtual planes and objective, the sonar echoes, the
+planner mode (as in the render), the virtual planes and objective, the moving obstacles where
+they stand with their trails of the last `TRAIL_S` (fading with age), the sonar echoes, the
 force arrows as logged (attractive green, repulsive red, virtual purple, total blue),
 the robot's disc and heading, the latest events as a caption and the simulated time.
 Frame k shows the last control tick at or before k * speed / fps simulated seconds; the
@@ -14,6 +15,7 @@ own ffmpeg encodes them, so no system package is needed.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,18 +29,19 @@ import numpy as np
 from matplotlib.artist import Artist
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
-from matplotlib.patches import Circle, Polygon
+from matplotlib.patches import Circle, Patch, Polygon
 from matplotlib.transforms import Bbox
 
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import write_atomically
 from vplane_mj.geometry import shapes
+from vplane_mj.geometry.motion import Moving
 from vplane_mj.logs.replay import load_log
 from vplane_mj.logs.timeline import FORCE_NAMES, Timeline, timeline_from_log
 from vplane_mj.logs.writer import METADATA_NAME
 from vplane_mj.scenario import Scenario
 from vplane_mj.terminal import Progress
-from vplane_mj.viz.render import MODE_RGBA, OTHER_MODE_RGBA
+from vplane_mj.viz.render import MODE_RGBA, OTHER_MODE_RGBA, TRACE_JUMP_M, TRACE_RGBA
 
 
 @dataclass(frozen=True)
@@ -84,6 +87,8 @@ VIEW_MARGIN_M = 1.2
 """Shown around the start, the goal and the path."""
 WALL_MARGIN_M = 0.3
 """Shown beyond the arena's sides (where the border walls stand)."""
+TRAIL_S = 2.0
+"""Simulated seconds of a moving obstacle's trail."""
 _FORCE_COLOURS = {
     "attractive": "#26bf40",
     "repulsive": "#e6332a",
@@ -197,6 +202,10 @@ class FrameCanvas:
         self.planes = self._add(LineCollection([], colors=_PLANE_COLOUR, linewidths=3))
         (self.objective,) = axes.plot([], [], "*", color="#1a5ae6", ms=font * 1.6, zorder=6)
         self._animated.append(self.objective)
+        self.moving = None
+        if scenario.world.moving and timeline.obstacles is not None:
+            self.moving = MovingArtists(axes, scenario.world.moving, timeline.times_s, timeline.obstacles)
+            self._animated += self.moving.artists
         self.echoes = self._add(axes.scatter([], [], s=font * 2.2, color=_ECHO_COLOUR, zorder=7))
         self.body = self._add(Circle((0, 0), robot_radius_m, fc="#333d52", ec="white", lw=1, zorder=8))
         (self.heading,) = axes.plot([], [], color="white", lw=2, zorder=9)
@@ -255,6 +264,8 @@ class FrameCanvas:
         self.planes.set_segments([np.array(plane) for plane in tl.planes[k]])
         objective = tl.objectives[k]
         self.objective.set_data([objective[0]] if objective else [], [objective[1]] if objective else [])
+        if self.moving is not None:
+            self.moving.show(k)
         self.echoes.set_offsets(tl.echoes[k] if len(tl.echoes[k]) else np.empty((0, 2)))
         self.body.center = (x, y)
         r = self.robot_radius_m
@@ -298,11 +309,55 @@ class FrameCanvas:
         return "\n".join(recent[-CAPTION_LINES:])
 
 
+class MovingArtists:
+    """The moving obstacles of a video: each where it stands at a tick (drawn as the static ones),
+    over its trail of the last TRAIL_S simulated seconds, fading out with age."""
+
+    def __init__(self, axes, moving: tuple[Moving, ...], times_s: np.ndarray, places: np.ndarray):
+        self.times_s, self.places = times_s, places
+        """The ticks' times (N,; s) and where the obstacles stood then (N, count, 2; m)."""
+        self.trail = LineCollection([], linewidths=2.0, capstyle="round", zorder=1.5)
+        axes.add_collection(self.trail)
+        pieces = [dataclasses.replace(m.shape, center=(0.0, 0.0)).footprint()[0] for m in moving]
+        self.shapes = [axes.add_patch(_patch(piece)) for piece in pieces]
+        self.corners = [None if isinstance(p, shapes.Disc) else p.corners() for p in pieces]
+        """A box's corners about its centre (4, 2; m), None for a disc."""
+        self.artists: list[Artist] = [self.trail, *self.shapes]
+
+    def show(self, k: int) -> None:
+        """Put the obstacles where they stood at tick k, after their trails up to then."""
+        for patch, corners, place in zip(self.shapes, self.corners, self.places[k], strict=True):
+            if isinstance(patch, Circle):
+                patch.center = (float(place[0]), float(place[1]))
+            elif isinstance(patch, Polygon) and corners is not None:
+                patch.set_xy(corners + place)
+        first = int(np.searchsorted(self.times_s, self.times_s[k] - TRAIL_S))
+        starts, ends = self.places[first:k], self.places[first + 1 : k + 1]  # (M, count, 2)
+        age = (self.times_s[k] - self.times_s[first:k]) / TRAIL_S
+        alpha = np.repeat(np.clip(1.0 - age, 0.0, 1.0), self.places.shape[1])
+        segments = np.stack((starts.reshape(-1, 2), ends.reshape(-1, 2)), axis=1)
+        kept = np.hypot(*(segments[:, 1] - segments[:, 0]).T) <= TRACE_JUMP_M  # not a loop's jump
+        colours = np.tile(TRACE_RGBA, (len(segments), 1))
+        colours[:, 3] = alpha
+        self.trail.set_segments(segments[kept])
+        self.trail.set_color(colours[kept])
+
+
+def _patch(piece: shapes.Piece) -> Patch:
+    """A moving obstacle's shape about the origin, drawn over the path (which it crosses)."""
+    if isinstance(piece, shapes.Disc):
+        return Circle((0.0, 0.0), piece.radius, color=_OBSTACLE_COLOUR, zorder=3)
+    return Polygon(piece.corners(), color=_OBSTACLE_COLOUR, zorder=3)
+
+
 def _view(scenario: Scenario, timeline: Timeline) -> tuple[tuple[float, float], tuple[float, float]]:
-    """The x and y ranges (m) shown: start, goal and path with VIEW_MARGIN_M around them,
-    within the arena and its walls; the whole arena when that is nearly all of it."""
+    """The x and y ranges (m) shown: start, goal, path and wherever the moving obstacles went,
+    with VIEW_MARGIN_M around them, within the arena and its walls; the whole arena when that is
+    nearly all of it."""
     w, h = scenario.world.size
     points = np.vstack([timeline.poses[:, :2], scenario.robot.start, scenario.robot.goal])
+    if timeline.obstacles is not None:
+        points = np.vstack([points, timeline.obstacles.reshape(-1, 2)])
     low = np.maximum(points.min(axis=0) - VIEW_MARGIN_M, -WALL_MARGIN_M)
     high = np.minimum(points.max(axis=0) + VIEW_MARGIN_M, (w + WALL_MARGIN_M, h + WALL_MARGIN_M))
     if np.prod(high - low) > 0.7 * (w + 2 * WALL_MARGIN_M) * (h + 2 * WALL_MARGIN_M):
