@@ -85,8 +85,9 @@ import numpy as np
 from vplane_mj.planning import gridsearch, scan
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.body import DriveLimits, HeadingGains, RobotBody
+from vplane_mj.planning.evasion import STEP_S
 from vplane_mj.planning.events import Event, EventKind
-from vplane_mj.planning.groups import LocalMapParams, MinimumParams
+from vplane_mj.planning.groups import EvasionParams, LocalMapParams, MinimumParams
 from vplane_mj.planning.minima import report_trap
 from vplane_mj.planning.params import param
 from vplane_mj.planning.types import Decision, Observation
@@ -117,8 +118,9 @@ ROBOTS = "0: the robot's, else at most this"
 
 
 @dataclass(frozen=True)
-class DwaParams(LocalMapParams, MinimumParams):
-    """The detector's and the patience's parameters, the map's and the window's.
+class DwaParams(LocalMapParams, MinimumParams, EvasionParams):
+    """The check against moving tracks, the detector's and the patience's parameters, the map's
+    and the window's.
 
     The limits default to the robot's (0); a positive value caps the robot's (a scenario may
     drive a fast robot slower, e.g. `--set planner.max_speed=0.5`).
@@ -278,6 +280,7 @@ class DwaPlanner(Planner):
         self.period = FIRST_PERIOD_S
         self.command = (0.0, 0.0)  # the last one asked for (m/s, rad/s): at rest at the start
         self.blocked = False
+        self.evasion = p.evasion(self.robot)
 
     def step(self, obs: Observation) -> Decision:
         p = self.params
@@ -319,9 +322,39 @@ class DwaPlanner(Planner):
     def free_distance(self, obs: Observation, speeds: np.ndarray, turns: np.ndarray) -> np.ndarray:
         """dist(v, omega) (speeds, turns) in m on the map as `obs` left it (step 3 of the module
         docstring)."""
-        if self.robot.disc:
-            return self._free_distance(obs, speeds, turns)
-        return self._swept_free_distance(obs, speeds, turns)
+        dist = (
+            self._free_distance(obs, speeds, turns)
+            if self.robot.disc
+            else self._swept_free_distance(obs, speeds, turns)
+        )
+        if obs.tracks:
+            dist = np.minimum(dist, self._moving_free_distance(obs, speeds, turns))
+        return dist
+
+    def _moving_free_distance(self, obs: Observation, speeds: np.ndarray, turns: np.ndarray) -> np.ndarray:
+        """dist (speeds, turns) among the moving tracks: the length (m) each arc's centre (on the
+        spot: its outermost point) travels, at its speed, before the footprint comes within the
+        evasion's margin of a track's predicted disc (`kernels.evasion.arc_hits`, over the
+        evasion's horizon), L when none does."""
+        threat = self.evasion.threat(obs.position, obs.tracks, obs.time_s)
+        dist = np.full((len(speeds), len(turns)), self.lookahead)
+        if not threat:
+            return dist
+        from vplane_mj.planning.kernels import evasion  # numba: loaded by the first call
+
+        commands = np.stack(np.broadcast_arrays(speeds[:, None], turns[None, :]), axis=-1).reshape(-1, 2)
+        hits = evasion.arc_hits(
+            np.ascontiguousarray(commands),
+            (float(obs.position[0]), float(obs.position[1]), float(obs.yaw)),
+            (self.evasion.horizon_s, STEP_S),
+            np.ascontiguousarray(self.robot.footprint, float),
+            float(self.radius),
+            threat.tracks,
+            float(self.evasion.margin_m),
+        ).reshape(dist.shape)
+        rate = np.where(speeds[:, None] > 0, speeds[:, None], self.radius * np.abs(turns)[None, :])
+        met = np.isfinite(hits)
+        return np.where(met, np.minimum(rate * np.where(met, hits, 0.0), self.lookahead), self.lookahead)
 
     def _velocity(self, obs: Observation) -> tuple[float, float]:
         """(v, omega) averaged over the last control period (m/s, rad/s); it also times the period."""

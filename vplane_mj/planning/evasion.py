@@ -14,10 +14,11 @@ Burgard and Thrun 1997, with the obstacles' motion, as Seder and Petrovic 2007).
 A candidate is a motion: a heading to turn to and a speed to drive along it (or to back off
 at), followed as the heading controller follows a force. The command asked for stays when its
 motion meets no moving track within the horizon. Otherwise the candidates (headings about the
-direction asked for, at several speeds, standing, backing) are ranked: those that stay clear
-over the whole horizon by how far they take the robot the way it was asked to go (and a little
-by the room they keep and by keeping the last evasion's heading); when none does, by how late
-they meet a track. Standing still is no refuge from an obstacle that comes on. Only a robot
+direction asked for and the robot's own, at several speeds, standing, backing) are ranked by
+how much nearer they take the robot to where its planner is going (the aim: the goal, or a
+point of its way) before they meet a track, by how soon they would meet one and how deep into
+it within the first second, and a little by the room they keep and by keeping the last
+evasion's heading. Standing still is no refuge from an obstacle that comes on. Only a robot
 that some moving track can reach within the horizon is checked: in a world that stands still
 nothing changes.
 """
@@ -114,11 +115,11 @@ class Evasion:
 
     def risks(
         self, candidates: np.ndarray, pose: tuple[float, float, float], state: tuple[float, float],
-        threat: Threat, toward: float,
+        threat: Threat, aim: np.ndarray,
     ) -> np.ndarray:  # fmt: skip
         """(C, 6) per candidate: the first time (s) a track comes within the margin (inf: none),
-        the least room (m) over the horizon, the advance (m) along `toward` (rad, world) until
-        then, the first command (m/s, rad/s), and the least room within NEAR_S
+        the least room (m) over the horizon, the progress (m) toward the point `aim` (m, world)
+        until then, the first command (m/s, rad/s), and the least room within NEAR_S
         (`kernels.evasion.candidate_risks`)."""
         from vplane_mj.planning.kernels import evasion  # numba: loaded by the first call
 
@@ -140,13 +141,13 @@ class Evasion:
             float(self.body.radius_m),
             threat.tracks,
             float(self.margin_m),
-            float(toward),
+            (float(aim[0]), float(aim[1])),
             NEAR_S,
         )
 
     def ranking(self, candidates: np.ndarray, risks: np.ndarray) -> np.ndarray:
-        """The candidates' indices, best first, by their score: the advance over the horizon as
-        a share of the top speed's, plus ROOM_WEIGHT of the room kept (up to ROOM_CAP_M), plus
+        """The candidates' indices, best first, by their score: the progress toward the aim over
+        the horizon as a share of the top speed's, plus ROOM_WEIGHT of the room kept (up to ROOM_CAP_M), plus
         KEEP_BONUS near the last evasion's heading, less HIT_WEIGHT (1 - t / horizon)^2 for
         meeting a track at t and DEPTH_WEIGHT times the overlap predicted within NEAR_S."""
         top = self.body.limits.max_speed_mps * self.horizon_s

@@ -4,8 +4,9 @@ A planner's parameters combine them by inheritance (bases listed last group firs
 `PlannerParams`): `FieldParams` (Khatib's fields, eqs. 2-6), `DetectorParams` (the
 local-minimum detector), `MinimumParams` (the detector and the patience of a planner without
 an escape), `LocalMapParams` (the sonar certainty grid), `SonarMapParams` (the grid and its
-polar histogram) and `MotionParams` (the margins of the governor that drives a force on the
-robot's body, and its check against moving obstacles).
+polar histogram), `EvasionParams` (the check of motions against moving tracks) and
+`MotionParams` (the margins of the governor that drives a force on the robot's body, and its
+evasion).
 """
 
 from __future__ import annotations
@@ -47,8 +48,28 @@ class FieldParams(PlannerParams):
 
 
 @dataclass(frozen=True)
-class MotionParams(PlannerParams):
-    """The margins of the governor that drives a force on the robot's body (motion.py)."""
+class EvasionParams(PlannerParams):
+    """How commands are checked against the moving tracks in time (evasion.py)."""
+
+    evade_horizon_s: float = param(
+        3.0, "s", "how long a command's motion is checked against the moving tracks", gt=0, le=10.0
+    )
+    evade_margin_m: float = param(
+        0.15, "m", "the footprint keeps this far from a moving track's predicted disc", ge=0, le=2.0
+    )
+    evade_growth_mps: float = param(
+        0.15, "m/s", "a moving track's predicted disc grows this much per second ahead", ge=0, le=2.0
+    )
+
+    def evasion(self, body: RobotBody) -> Evasion:
+        """The check of `body`'s motions against moving tracks with these parameters."""
+        return Evasion(body, self.evade_horizon_s, self.evade_margin_m, self.evade_growth_mps)
+
+
+@dataclass(frozen=True)
+class MotionParams(EvasionParams):
+    """The margins of the governor that drives a force on the robot's body (motion.py), and its
+    check against moving tracks."""
 
     stop_margin_m: float = param(
         0.1,
@@ -60,21 +81,11 @@ class MotionParams(PlannerParams):
     turn_margin_m: float = param(
         0.03, "m", "turns and predicted motions keep the footprint this far from obstacles", ge=0, le=1.0
     )
-    evade_horizon_s: float = param(
-        3.0, "s", "how long a command's motion is checked against the moving tracks", gt=0, le=10.0
-    )
-    evade_margin_m: float = param(
-        0.15, "m", "the footprint keeps this far from a moving track's predicted disc", ge=0, le=2.0
-    )
-    evade_growth_mps: float = param(
-        0.15, "m/s", "a moving track's predicted disc grows this much per second ahead", ge=0, le=2.0
-    )
 
     def governor(self, body: RobotBody) -> Governor:
         """A governor of forces for `body` with these margins (one per planner: it follows
         the planner's commands), that evades moving tracks (evasion.py)."""
-        evasion = Evasion(body, self.evade_horizon_s, self.evade_margin_m, self.evade_growth_mps)
-        return Governor(body, self.stop_margin_m, self.turn_margin_m, evasion)
+        return Governor(body, self.stop_margin_m, self.turn_margin_m, self.evasion(body))
 
 
 @dataclass(frozen=True)

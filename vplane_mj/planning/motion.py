@@ -392,12 +392,18 @@ class Governor:
         return self.body.disc and not self.policy.active
 
     def steer(
-        self, force: np.ndarray, obs: Observation, points: np.ndarray, speed_mps: float = math.inf
+        self,
+        force: np.ndarray,
+        obs: Observation,
+        points: np.ndarray,
+        speed_mps: float = math.inf,
+        aim: np.ndarray | None = None,
     ) -> Steering:
         """The body speed and turn rate to drive for `force` among obstacle `points` (N, 2;
         world, m), at most `speed_mps` (m/s) besides, and the force to show (its direction where
-        the robot steers): see the class docstring. The idle governor's: the force as it is, no
-        command."""
+        the robot steers): see the class docstring. Among moving tracks, the evasion makes for
+        `aim` (m, world; the goal by default), where the planner is going. The idle governor's:
+        the force as it is, no command."""
         length = float(np.hypot(force[0], force[1]))
         if self.idle:
             return Steering(force)
@@ -413,7 +419,7 @@ class Governor:
         if command is None:
             command = self._creep(local, obs.yaw, wanted) or (0.0, 0.0)
         if self.evasion is not None and obs.tracks:
-            command = self._evade(command, obs, local, wanted)
+            command = self._evade(command, obs, local, wanted, obs.goal if aim is None else aim)
         self.drive.commanded(command)
         shown = (
             np.array([math.cos(wanted), math.sin(wanted)])
@@ -468,12 +474,17 @@ class Governor:
         return direction, command
 
     def _evade(
-        self, command: tuple[float, float], obs: Observation, local: np.ndarray, wanted: float
+        self,
+        command: tuple[float, float],
+        obs: Observation,
+        local: np.ndarray,
+        wanted: float,
+        aim: np.ndarray,
     ) -> tuple[float, float]:
         """`command`, or when a moving track meets its motion within the evasion's horizon, the
         first command of the best of the evasion's candidate motions (`Evasion.ranking`, about
-        `wanted`, rad, world) that the static points of `local` allow (`_safe`); the best of
-        them all when none does."""
+        `wanted`, rad, world, making for `aim`, m, world) that the static points of `local`
+        allow (`_safe`); the best of them all when none does."""
         evasion = self.evasion
         assert evasion is not None
         threat = evasion.threat(obs.position, obs.tracks, obs.time_s)
@@ -482,7 +493,7 @@ class Governor:
             return command
         pose = (float(obs.position[0]), float(obs.position[1]), float(obs.yaw))
         candidates = evasion.candidates(wanted, command[0], float(obs.yaw))
-        risks = evasion.risks(candidates, pose, self.drive.ramp, threat, wanted)
+        risks = evasion.risks(candidates, pose, self.drive.ramp, threat, aim)
         if math.isinf(risks[0, 0]):
             evasion.kept = None
             return command

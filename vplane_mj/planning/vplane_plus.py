@@ -69,6 +69,11 @@ BEND_HORIZON_M = 3.0
 """The way this far ahead (m) bounds the speed by the turns it asks for (motion.py)."""
 TRAP_REACH_M = 2.5
 """Obstacle cells farther than this from the robot are not part of the trap it is in."""
+AIM_AHEAD_M = 3.0
+"""Among moving tracks, the governor makes for the point of the way this far (m) along it."""
+OFF_WAY_M = 0.5
+"""A robot this far (m) from the way it follows (pushed off it evading a moving track) searches
+its way again at once."""
 NO_WAY = np.empty((0, 2))
 NO_WAY.flags.writeable = False
 """An empty way (K = 0 waypoints): ways are (K, 2) arrays of waypoints (m), never written."""
@@ -317,7 +322,18 @@ class VPlanePlusPlanner(VPlanePlanner):
             else math.inf
         )
         points = np.vstack((obs.static_echo_points(), cells))
-        return self.governor.steer(force, obs, points, speed)
+        return self.governor.steer(force, obs, points, speed, self._aim(obs, way))
+
+    def _aim(self, obs: Observation, way: np.ndarray) -> np.ndarray:
+        """Where the planner is going, for the governor's evasion of moving tracks: the point of
+        the way AIM_AHEAD_M along it (its end when shorter; then the objective or the goal it
+        leads to), the objective while escaping, else the goal."""
+        end = self.temp_goal if self.temp_goal is not None else obs.goal
+        if not len(way):
+            return end
+        travelled = np.cumsum(np.hypot(*np.diff(np.vstack((obs.position, way)), axis=0).T))
+        ahead = np.flatnonzero(travelled >= AIM_AHEAD_M)
+        return way[ahead[0]] if len(ahead) else end
 
     def _mapped_cells_near(self, position: np.ndarray, reach_m: float) -> np.ndarray:
         """Centres (N, 2) of the mapped obstacle cells (not swept) within a square of half side
@@ -522,10 +538,11 @@ class VPlanePlusPlanner(VPlanePlanner):
         p = self.params
         waypoint, self.follow_way = self._next_waypoint(obs.position, self.follow_way, obs.goal)
         if obs.time_s < self.next_replan_s:
-            if not len(self.follow_way) or not self._way_is_blocked(obs.position, self.follow_way):
+            way, position = self.follow_way, obs.position
+            if not len(way) or not (self._way_is_blocked(position, way) or self._off_the_way(position)):
                 return waypoint
             decision.events.append(
-                Event(EventKind.WAY_CHANGED, "the way ahead is blocked on the map: searched again")
+                Event(EventKind.WAY_CHANGED, "the way ahead is blocked on the map, or left: searched again")
             )
         self.next_replan_s = obs.time_s + p.replan_period_s
         way = self._way_to_goal(obs, decision)
@@ -551,6 +568,11 @@ class VPlanePlusPlanner(VPlanePlanner):
             self.follow_way = way  # else the current way stays: no flip-flop between similar ways
         waypoint, self.follow_way = self._next_waypoint(obs.position, self.follow_way, obs.goal)
         return waypoint
+
+    def _off_the_way(self, position: np.ndarray) -> bool:
+        """Whether the robot stands farther than OFF_WAY_M from every point of the way it follows."""
+        way = self.follow_way
+        return bool(np.min(np.hypot(way[:, 0] - position[0], way[:, 1] - position[1])) > OFF_WAY_M)
 
     def _way_cost(self, position: np.ndarray, way: np.ndarray, goal: np.ndarray) -> float:
         """What a way to the goal costs from `position`: along it on the map, then from its end to

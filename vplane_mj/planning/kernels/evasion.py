@@ -7,8 +7,9 @@ for the horizon. At every time step its footprint is set against each tracked ob
 where its constant-velocity prediction puts it then, the disc grown with time for the
 prediction's doubt. What comes back per candidate: the first time (s) a disc comes within the
 margin of the footprint (inf: none within the horizon), the least gap (m) over the horizon
-(footprint to disc, less the growth; negative: they overlap), the advance (m) along a given
-direction, and the command (m/s, rad/s) of the motion's first step.
+(footprint to disc, less the growth; negative: they overlap), the progress (m) toward a point
+until then, the command (m/s, rad/s) of the motion's first step, and the least gap over its
+first moments.
 """
 
 from __future__ import annotations
@@ -62,7 +63,7 @@ def candidate_risks(
     reach_m: float,
     tracks: np.ndarray,
     margin_m: float,
-    toward: float,
+    aim: tuple[float, float],
     near_s: float,
 ) -> np.ndarray:
     """(C, 6) per candidate of `candidates` (C, 2: heading in rad, world; speed in m/s) followed
@@ -71,16 +72,17 @@ def candidate_risks(
     rate rad/s, acceleration m/s^2, braking m/s^2, turn acceleration rad/s^2, and the heading
     controller's turn gain k_w, 1/s): the first time (s) a track's disc comes within
     `margin_m` of the footprint `outline` (k, 2; robot frame, within `reach_m` of the origin),
-    inf for none; the least gap (m); the advance (m) along the direction `toward` (rad, world)
-    up to that time (or the horizon); the first step's speed (m/s) and turn rate (rad/s); and
-    the least gap (m) within the first `near_s` s. `tracks` (N, 6): x, y (m), vx, vy (m/s),
-    radius (m) and its growth (m/s)."""
+    inf for none; the least gap (m); the progress (m) toward the point `aim` (world) up to that
+    time (or the horizon): how much nearer it the robot gets; the first step's speed (m/s) and
+    turn rate (rad/s); and the least gap (m) within the first `near_s` s. `tracks` (N, 6): x, y
+    (m), vx, vy (m/s), radius (m) and its growth (m/s)."""
     horizon, dt = timing
     top_speed, top_turn, accel, brake, alpha, gain = limits
     steps = math.ceil(horizon / dt - 1e-9)
     result = np.empty((candidates.shape[0], 6))
     x0, y0, yaw0 = pose
-    ux, uy = math.cos(toward), math.sin(toward)
+    ax, ay = aim
+    away = math.hypot(ax - x0, ay - y0)
     for c in range(candidates.shape[0]):
         heading, speed = candidates[c, 0], candidates[c, 1]
         v, w = state
@@ -123,7 +125,54 @@ def candidate_risks(
                 if gap < margin_m and t < hit:
                     hit = t
             if hit == math.inf:
-                advance = (x - x0) * ux + (y - y0) * uy
+                advance = away - math.hypot(ax - x, ay - y)
         result[c, 0], result[c, 1], result[c, 2] = hit, least, advance
         result[c, 3], result[c, 4], result[c, 5] = first_v, first_w, near
     return result
+
+
+@njit(cache=True)
+def arc_hits(
+    commands: np.ndarray,
+    pose: tuple[float, float, float],
+    timing: tuple[float, float],
+    outline: np.ndarray,
+    reach_m: float,
+    tracks: np.ndarray,
+    margin_m: float,
+) -> np.ndarray:
+    """(C,) per command of `commands` (C, 2: m/s, rad/s) driven at once and held from `pose` (x, y
+    in m, yaw in rad; world) for `timing[0]` s, checked every `timing[1]` s: the first time (s)
+    a track's disc comes within `margin_m` of the footprint `outline` (k, 2; robot frame, within
+    `reach_m` of the origin), inf for none (the dynamic window's arcs; `tracks` as
+    `candidate_risks` takes them)."""
+    horizon, dt = timing
+    steps = math.ceil(horizon / dt - 1e-9)
+    hits = np.full(commands.shape[0], math.inf)
+    x0, y0, yaw0 = pose
+    for c in range(commands.shape[0]):
+        v, w = commands[c, 0], commands[c, 1]
+        for s in range(1, steps + 1):
+            t = s * dt
+            yaw = yaw0 + w * t
+            if abs(w) > 1e-9:
+                x = x0 + v / w * (math.sin(yaw) - math.sin(yaw0))
+                y = y0 - v / w * (math.cos(yaw) - math.cos(yaw0))
+            else:
+                x, y = x0 + v * t * math.cos(yaw0), y0 + v * t * math.sin(yaw0)
+            cos_yaw, sin_yaw = math.cos(yaw), math.sin(yaw)
+            hit = False
+            for n in range(tracks.shape[0]):
+                ox = tracks[n, 0] + tracks[n, 2] * t - x
+                oy = tracks[n, 1] + tracks[n, 3] * t - y
+                size = tracks[n, 4] + tracks[n, 5] * t
+                if math.sqrt(ox * ox + oy * oy) - reach_m - size >= margin_m:
+                    continue
+                gap = _outline_gap(outline, cos_yaw * ox + sin_yaw * oy, -sin_yaw * ox + cos_yaw * oy) - size
+                if gap < margin_m:
+                    hit = True
+                    break
+            if hit:
+                hits[c] = t
+                break
+    return hits
