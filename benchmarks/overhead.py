@@ -3,7 +3,8 @@
 For each scenario and planner: a full run (sensor, planner, controller, metrics; no log, no
 render) takes N physics steps. The floor is MuJoCo alone on the same world with the sensor
 stage disabled (no rays), replaying the run's own wheel torques (one `mj_step` of k steps per
-motor period: the same N steps, the same motion and contacts). The same replay on the world as
+motor period: the same N steps, the same motion and contacts; moving obstacles placed before
+every step, as the run places them). The same replay on the world as
 exported, whose rangefinders cast every sonar ray at every physics step, is the physics "as
 built" before the sonar cast its rays only when it pings. Reported: run over floor, run
 writing its MCAP log (into a temporary directory) over floor, as built over floor, and run
@@ -44,6 +45,7 @@ from vplane_mj.planning.registry import register_planner
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.laser import LaserScanner
 from vplane_mj.sim.loop import run_scenario
+from vplane_mj.sim.moving import MovingObstacles
 from vplane_mj.sim.sensors import scan_bearings
 from vplane_mj.sim.world import build_model
 
@@ -91,14 +93,21 @@ class LaserClock:
         LaserScanner.read = self._read
 
 
-def replay_time(model: mujoco.MjModel, torques, steps: int, clock=time.process_time) -> float:
-    """Time (s, by `clock`) of bare physics replaying recorded wheel torques over `steps` steps."""
+def replay_time(model: mujoco.MjModel, torques, steps: int, clock=time.process_time, world=None) -> float:
+    """Time (s, by `clock`) of bare physics replaying recorded wheel torques over `steps` steps;
+    a `world` with moving obstacles has them placed before every step, as the run does."""
     data = mujoco.MjData(model)
+    moving = MovingObstacles(model, data, world) if world is not None and world.moving else None
     per_update = steps // len(torques)
     start = clock()
     for left, right in torques:
         data.ctrl[0], data.ctrl[1] = left, right
-        mujoco.mj_step(model, data, per_update)
+        if moving is None:
+            mujoco.mj_step(model, data, per_update)
+            continue
+        for _ in range(per_update):
+            moving.place(data.time)
+            mujoco.mj_step(model, data)
     return clock() - start
 
 
@@ -137,9 +146,12 @@ def measure(ref: str, planner: str, repeat: int, log_dir: Path | None) -> dict:
         times["laser"].append(laser.seconds)
         summary = result.summary
         times["run wall"].append(summary.wall_time_s)
-        times["floor"].append(replay_time(floor, result.torques, summary.steps))
-        times["floor wall"].append(replay_time(floor, result.torques, summary.steps, time.perf_counter))
-        times["built"].append(replay_time(built, result.torques, summary.steps))
+        world = scenario.world
+        times["floor"].append(replay_time(floor, result.torques, summary.steps, world=world))
+        times["floor wall"].append(
+            replay_time(floor, result.torques, summary.steps, time.perf_counter, world=world)
+        )
+        times["built"].append(replay_time(built, result.torques, summary.steps, world=world))
         if log_dir is not None:
             cpu, log_bytes = logged_run(scenario, log_dir)
             times["log"].append(cpu - setup)

@@ -73,7 +73,8 @@ AIM_AHEAD_M = 3.0
 """Among moving tracks, the governor makes for the point of the way this far (m) along it."""
 OFF_WAY_M = 0.5
 """A robot this far (m) from the way it follows (pushed off it evading a moving track) searches
-its way again at once."""
+its way again, at most every OFF_WAY_PERIOD_S."""
+OFF_WAY_PERIOD_S = 0.25
 NO_WAY = np.empty((0, 2))
 NO_WAY.flags.writeable = False
 """An empty way (K = 0 waypoints): ways are (K, 2) arrays of waypoints (m), never written."""
@@ -539,7 +540,9 @@ class VPlanePlusPlanner(VPlanePlanner):
         waypoint, self.follow_way = self._next_waypoint(obs.position, self.follow_way, obs.goal)
         if obs.time_s < self.next_replan_s:
             way, position = self.follow_way, obs.position
-            if not len(way) or not (self._way_is_blocked(position, way) or self._off_the_way(position)):
+            searched = obs.time_s - (self.next_replan_s - p.replan_period_s)  # since the last search
+            left = searched >= OFF_WAY_PERIOD_S and self._off_the_way(position)
+            if not len(way) or not (left or self._way_is_blocked(position, way)):
                 return waypoint
             decision.events.append(
                 Event(EventKind.WAY_CHANGED, "the way ahead is blocked on the map, or left: searched again")

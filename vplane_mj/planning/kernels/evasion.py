@@ -72,8 +72,9 @@ def candidate_risks(
     rate rad/s, acceleration m/s^2, braking m/s^2, turn acceleration rad/s^2, and the heading
     controller's turn gain k_w, 1/s): the first time (s) a track's disc comes within
     `margin_m` of the footprint `outline` (k, 2; robot frame, within `reach_m` of the origin),
-    inf for none; the least gap (m); the progress (m) toward the point `aim` (world) up to that
-    time (or the horizon): how much nearer it the robot gets; the first step's speed (m/s) and
+    inf for none; the least gap (m) (of a motion that meets a track, up to then or to `near_s`,
+    whichever is later); the progress (m) toward the point `aim` (world) up to that time (or the
+    horizon): how much nearer it the robot gets; the first step's speed (m/s) and
     turn rate (rad/s); and the least gap (m) within the first `near_s` s. `tracks` (N, 6): x, y
     (m), vx, vy (m/s), radius (m) and its growth (m/s)."""
     horizon, dt = timing
@@ -126,6 +127,8 @@ def candidate_risks(
                     hit = t
             if hit == math.inf:
                 advance = away - math.hypot(ax - x, ay - y)
+            elif t >= near_s:
+                break  # what is left to learn of a motion that meets a track: nothing that ranks it
         result[c, 0], result[c, 1], result[c, 2] = hit, least, advance
         result[c, 3], result[c, 4], result[c, 5] = first_v, first_w, near
     return result
