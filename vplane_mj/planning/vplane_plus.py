@@ -539,10 +539,10 @@ class VPlanePlusPlanner(VPlanePlanner):
         p = self.params
         waypoint, self.follow_way = self._next_waypoint(obs.position, self.follow_way, obs.goal)
         if obs.time_s < self.next_replan_s:
-            way, position = self.follow_way, obs.position
+            followed, position = self.follow_way, obs.position
             searched = obs.time_s - (self.next_replan_s - p.replan_period_s)  # since the last search
             left = searched >= OFF_WAY_PERIOD_S and self._off_the_way(position)
-            if not len(way) or not (left or self._way_is_blocked(position, way)):
+            if not len(followed) or not (left or self._way_is_blocked(position, followed)):
                 return waypoint
             decision.events.append(
                 Event(EventKind.WAY_CHANGED, "the way ahead is blocked on the map, or left: searched again")
