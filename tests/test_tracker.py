@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from scipy.optimize import linear_sum_assignment
+from scipy.optimize import least_squares, linear_sum_assignment
 
 from vplane_mj.geometry.shapes import Disc, Rect
 from vplane_mj.planning.kernels import tracking
@@ -114,6 +114,93 @@ def test_two_discs_crossing_paths_keep_their_identities():
     assert owners[0] != owners[1]
 
 
+def test_two_discs_side_by_side_give_two_tracks():
+    # Centres 0.85 m apart: their outlines overlap, one cluster of 1.8 m, too large for one object,
+    # until it is cut where the two arcs meet.
+    movers = [lambda t, side=side: (2.5 + 0.8 * t, -1.5 + 0.425 * side + 0.5 * t) for side in (-1, 1)]
+    for seed in range(2):
+        _, ticks = simulate(movers, at_origin, 2.0, seed=seed)
+        for t, _, centres, tracks, _, _ in ticks:
+            if t >= 0.3:
+                matched = [nearest(tracks, centre) for centre in centres]
+                assert None not in matched
+                assert all(
+                    np.linalg.norm(track.position - c) < 0.1
+                    for track, c in zip(matched, centres, strict=True)
+                )
+                assert matched[0].track_id != matched[1].track_id
+                assert all(track.moving for track in matched)
+
+
+def scan_clusters(pieces, pose=(0.0, 0.0, 0.0)):
+    """`tracking.scan_clusters` of a noiseless scan of `pieces` from `pose`: bounds, ends, usable,
+    fitted, centres."""
+    tracker = Tracker()
+    bearings, cos_b, sin_b, _, cyclic = tracker._fan_of(BEARINGS).packed
+    _, segmentation, features, *_ = tracker._settings
+    ranges = cast(pieces, pose)
+    out = tracking.scan_clusters(
+        bearings, cos_b, sin_b, ranges, cyclic, np.array(pose), segmentation, features
+    )
+    bounds, _, ends, _, usable, fitted, centres, _, _ = out
+    return bounds, ends, usable, fitted, centres
+
+
+@pytest.mark.parametrize(
+    "discs",
+    [
+        [(2.5, -0.45), (2.5, 0.45)],  # side by side, overlapping
+        [(3.0, -0.9), (3.0, 0.0), (3.0, 0.9)],  # three in a row
+        [(2.3, -0.4), (2.6, 0.45)],  # one a little behind the other
+    ],
+)
+def test_round_objects_in_one_cluster_are_cut_apart(discs):
+    pieces = [Disc(centre, RADIUS_M) for centre in discs]
+    segmented = tracking.segment(
+        BEARINGS, cast(pieces, (0.0, 0.0, 0.0)), False, math.radians(10.0), 0.01, 0.1, 1, 0.2
+    )
+    assert len(segmented[1]) - 1 == 1  # one cluster as Borges and Aldon cut the scan
+    bounds, ends, usable, fitted, centres = scan_clusters(pieces)
+    assert len(bounds) - 1 == len(discs)
+    assert usable.all() and fitted.all()
+    for centre in discs:
+        assert np.min(np.linalg.norm(centres - centre, axis=1)) < 0.01
+    assert (ends[1:, 0] == tracking.END_BLOCKED).all() and (ends[:-1, 1] == tracking.END_BLOCKED).all()
+
+
+def test_a_disc_against_a_wall_is_cut_from_it_and_bent_walls_stay_whole():
+    wall = Rect((3.0, 0.0), (0.05, 3.0))  # x = 3 from y = -3 to 3
+    bounds, _, usable, fitted, centres = scan_clusters([wall, Disc((2.45, 0.5), RADIUS_M)])
+    assert np.sum(usable & fitted) == 1
+    assert np.linalg.norm(centres[usable & fitted][0] - (2.45, 0.5)) < 0.01
+    assert np.sum(~usable) >= 1  # the wall is still fixed structure
+    corner = [wall, Rect((1.5, 3.0), (1.5, 0.05))]  # an L, its inner corner toward the sensor
+    bounds, _, usable, _, _ = scan_clusters(corner)
+    assert len(bounds) - 1 == 1 and not usable.any()
+
+
+@pytest.mark.parametrize(
+    ("mover", "static", "scans"),
+    [
+        (lambda t: (3.0, -2.0 + 1.5 * t), (), 2),  # in view from the first scan
+        (lambda t: (2.5, -1.6 + 1.5 * t), (Rect((1.5, -1.5), (0.05, 1.0)),), 8),  # past a wall's end
+    ],
+)
+def test_a_disc_at_1_5_m_per_s_is_moving_soon_after_its_first_sight(mover, static, scans):
+    # From a scan 0.1 s old, it has moved 0.15 m; its third measurement (second, its motion plain)
+    # tells it moves. Coming out past a wall, it first shows a few echoes: its circle fit waits for
+    # an arc of 45 degrees that places its centre within 5 cm.
+    for seed in range(3):
+        _, ticks = simulate([mover], at_origin, 3.0, static, seed)
+        seen = next(i for i, tick in enumerate(ticks) if tick[5][0].sum() >= 3)
+        moving = next(
+            i
+            for i, (_, _, centres, tracks, _, _) in enumerate(ticks)
+            if any(track.moving and np.linalg.norm(track.position - centres[0]) < 0.2 for track in tracks)
+        )
+        assert moving - seen <= scans
+
+
 def test_nothing_moves_in_a_static_world_the_robot_drives_past():
     static = [
         Rect((5.0, 4.0), (6.0, 0.05)),  # a wall along y = 4
@@ -141,7 +228,7 @@ def test_a_static_disc_is_left_to_the_map_once_judged_fixed():
     tracker, ticks = simulate([], lambda t: (0.5 * t, 0.0, 0.0), 4.0, static=[Disc((4.0, 1.5), 0.3)])
     seen = [t for t, _, _, tracks, _, _ in ticks if tracks]
     assert seen and seen[0] < 0.5  # confirmed, not moving
-    assert max(seen) < tracker.params.reference_age_s + tracker.params.static_drop_s + 0.2
+    assert max(seen) < tracker.params.slow_reference_age_s + tracker.params.static_drop_s + 0.2
     assert not any(track.moving for _, _, _, tracks, _, _ in ticks for track in tracks)
 
 
@@ -323,6 +410,38 @@ def test_the_circle_fit_finds_an_arc_exactly():
     cx, cy, radius, rms = tracking.kasa_fit(points, 0, 15)
     assert (cx, cy, radius) == pytest.approx((2.0, 1.0, 0.5))
     assert rms < 1e-9
+
+
+def test_the_geometric_fit_refines_kasas_on_a_short_noisy_arc():
+    rng = np.random.default_rng(4)
+    kasa, refined = [], []
+    for _ in range(200):
+        angles = np.linspace(-0.5, 0.5, 30)  # 57 degrees
+        points = np.c_[0.5 * np.cos(angles), 0.5 * np.sin(angles)] + rng.normal(0.0, 0.01, (30, 2))
+        optimum = least_squares(lambda q, p=points: np.hypot(*(p - q[:2]).T) - q[2], (0.0, 0.0, 0.5)).x
+        kasa.append(np.linalg.norm(tracking.kasa_fit(points, 0, 30)[:2] - optimum[:2]))
+        refined.append(np.linalg.norm(tracking.circle_fit(points, 0, 30, 2)[:2] - optimum[:2]))
+    assert np.median(refined) < 0.01 * np.median(kasa)
+
+
+@pytest.mark.parametrize("fov_deg", [270.0, 360.0])
+def test_the_window_of_beams_agrees_with_a_plain_search(fov_deg):
+    rng = np.random.default_rng(9)
+    fans = [laser_bearings(fov_deg, 720)[0], np.sort(rng.uniform(-np.pi, np.pi, 40))]
+    cyclic = fov_deg == 360.0
+    for bearings in fans:
+        for _ in range(3000):
+            lo = rng.uniform(-8.0, 8.0)
+            hi = lo + rng.choice([0.0, rng.uniform(0.0, 0.2), rng.uniform(0.0, 7.0)])
+            shift = 2 * np.pi * np.floor((lo - bearings[0]) / (2 * np.pi))
+            start = int(np.searchsorted(bearings, lo - shift))
+            if not cyclic and hi - shift > bearings[-1]:
+                expected = (start, 0)
+            else:
+                unrolled = np.r_[bearings, bearings + 2 * np.pi]
+                count = int(np.sum(unrolled[start : start + bearings.size] <= hi - shift))
+                expected = (start, count)
+            assert tracking._window(bearings, cyclic, lo, hi) == expected
 
 
 def test_the_assignment_is_scipys_optimum():

@@ -4,13 +4,15 @@
 scan's beams by bearing once per fan of bearings, as every kernel here takes them. A scan is cut
 into clusters of neighbouring echoes by Borges and Aldon's adaptive breakpoint (G. A. Borges and
 M.-J. Aldon, "Line extraction in 2D range images for mobile robotics", J. Intelligent and
-Robotic Systems 40, 2004); each small cluster's centre comes from Kasa's algebraic circle fit
-(I. Kasa, "A circle fitting procedure and its error analysis", IEEE Trans. Instrum. Meas. 25,
-1976) or, failing that, from its chord; tracks take clusters by the Hungarian method (H. W.
+Robotic Systems 40, 2004), and a cluster of round objects side by side is cut where their
+outlines meet (`split`); each small cluster's centre comes from Kasa's algebraic circle fit (I.
+Kasa, "A circle fitting procedure and its error analysis", IEEE Trans. Instrum. Meas. 25, 1976),
+refined toward the geometric fit (N. Chernov, "Circular and Linear Regression", CRC Press 2010),
+or, failing that, from its chord; tracks take clusters by the Hungarian method (H. W.
 Kuhn, Naval Research Logistics Quarterly 2, 1955) within a Mahalanobis gate; each track is a
 constant-velocity Kalman filter with white-noise acceleration (Y. Bar-Shalom, X. R. Li and
 T. Kirubarajan, "Estimation with Applications to Tracking and Navigation", Wiley 2001,
-section 6.2.2); a track moves when its echoes stand where an earlier scan saw free space, or
+section 6.2.2); a track moves when its echoes stand where earlier scans saw free space, or
 leave free where it stood (C.-C. Wang, C. Thorpe and S. Thrun, "Online simultaneous
 localization and mapping with detection and tracking of moving objects", ICRA 2003).
 """
@@ -41,13 +43,14 @@ LOOK_THROUGH = 1
 LOOK_SOMETHING = 2
 """Something echoes where a track is predicted, though no cluster was given to it."""
 TWO_PI = 2.0 * math.pi
-ID, RADIUS, FIRST_SEEN, LAST_SEEN, HITS, MISSES, CONFIRMED, MOVING, MOTION, STATIC_SINCE = range(10)
+ID, RADIUS, FIRST_SEEN, LAST_SEEN, HITS, MISSES, CONFIRMED, MOVING, MOTION, STATIC_SINCE, ECHOES = range(11)
 """The columns of a track table's `info` (rows: tracks): its id; the radius (m) of the disc that
 holds what was seen; the times (s) of its first and last measurement; its measurements; the
 scans in a row whose beams passed through its predicted disc; whether it is confirmed, and
 moving (0 or 1); the last verdict of the free-space test (`MOTION_*`), and since when (s) its
-verdicts have been `MOTION_STATIC` (-1: the last was not)."""
-INFO_COLUMNS = 10
+verdicts have been `MOTION_STATIC` (-1: the last was not); the echoes of the last cluster it
+took."""
+INFO_COLUMNS = 11
 
 
 @njit(cache=True)
@@ -256,24 +259,78 @@ def kasa_fit(points: np.ndarray, lo: int, hi: int) -> tuple[float, float, float,
 
 
 @njit(cache=True)
+def refine(
+    points: np.ndarray, lo: int, hi: int, fit: tuple[float, float, float, float], iterations: int
+) -> tuple[float, float, float, float]:
+    """A circle fit (centre x, y, radius, RMS; m) to points[lo:hi] (m) refined by `iterations`
+    Gauss-Newton steps on the points' distances from it, toward the geometric fit: centre x, y,
+    radius and the RMS distance of the points from the circle (m)."""
+    cx, cy, radius, _ = fit
+    for _ in range(iterations):
+        if not math.isfinite(radius):
+            return fit
+        # J^T J (symmetric, a b c / b d e / c e f) and J^T r for the unknowns (cx, cy, radius)
+        a = b = c = d = e = f = ga = gb = gc = 0.0
+        for k in range(lo, hi):
+            dx, dy = points[k, 0] - cx, points[k, 1] - cy
+            dist = math.sqrt(dx * dx + dy * dy)
+            if dist == 0.0:
+                continue
+            ux, uy, residual = -dx / dist, -dy / dist, dist - radius
+            a, b, c = a + ux * ux, b + ux * uy, c - ux
+            d, e, f = d + uy * uy, e - uy, f + 1.0
+            ga, gb, gc = ga + ux * residual, gb + uy * residual, gc - residual
+        det = a * (d * f - e * e) - b * (b * f - c * e) + c * (b * e - c * d)
+        if not abs(det) > 1e-12:
+            break
+        # the step solves (J^T J) step = -J^T r, by Cramer's rule
+        sa = -(ga * (d * f - e * e) - b * (gb * f - e * gc) + c * (gb * e - d * gc)) / det
+        sb = -(a * (gb * f - e * gc) - ga * (b * f - c * e) + c * (b * gc - gb * c)) / det
+        sc = -(a * (d * gc - gb * e) - b * (b * gc - gb * c) + ga * (b * e - c * d)) / det
+        cx, cy, radius = cx + sa, cy + sb, radius + sc
+    square = 0.0
+    for k in range(lo, hi):
+        dx, dy = points[k, 0] - cx, points[k, 1] - cy
+        residual = math.sqrt(dx * dx + dy * dy) - radius
+        square += residual * residual
+    return cx, cy, radius, math.sqrt(square / (hi - lo))
+
+
+@njit(cache=True)
+def circle_fit(points: np.ndarray, lo: int, hi: int, iterations: int) -> tuple[float, float, float, float]:
+    """The geometric circle fit to points[lo:hi] (m): `kasa_fit`'s circle refined by `iterations`
+    Gauss-Newton steps (`refine`; Kasa's algebraic fit draws the circle of a short noisy arc too
+    small, its centre toward the points: N. Chernov, "Circular and Linear Regression", CRC Press
+    2010, ch. 5); centre x, y, radius and the RMS distance of the points from the circle (m);
+    NaN when the points are collinear."""
+    return refine(points, lo, hi, kasa_fit(points, lo, hi), iterations)
+
+
+@njit(cache=True)
+def fit_sigma(rms: float, n: int, arc: float) -> float:
+    """The 1-sigma (m) of the centre of a circle fitted to `n` echoes over an `arc` (rad) with
+    `rms` (m) about it: sqrt(45 / n) sigma / (arc / 2)^2, sigma the echoes' noise (their RMS
+    over sqrt((n - 3) / n), for the 3 fitted values), the 1-sigma of the radius of a parabola
+    fitted to n echoes evenly spread over a short arc (more than the centre's over a long one)."""
+    noise = rms * math.sqrt(n / max(n - 3, 1))
+    return math.sqrt(45.0 / n) * noise / max(0.5 * arc, 1e-9) ** 2
+
+
+@njit(cache=True)
 def _fit_sane(
-    points: np.ndarray,
-    lo: int,
-    hi: int,
-    fit: tuple,
-    x: float,
-    y: float,
-    min_r: float,
-    max_r: float,
-    max_rms: float,
-    min_arc: float,
+    points: np.ndarray, lo: int, hi: int, fit: tuple, x: float, y: float, settings: np.ndarray
 ) -> bool:
-    """Whether a circle fit (centre, radius, RMS; m) to points[lo:hi] is believable: a radius in
-    [min_r, max_r], an RMS at most `max_rms`, an arc of at least `min_arc` (rad) from the first
-    point to the last about its centre, and its centre farther from the sensor at (x, y) than
-    the points' mean (the points are the near side of a convex outline)."""
+    """Whether a circle fit (centre, radius, RMS; m) to points[lo:hi] is believable (`settings`:
+    `cluster_features`'): a radius in [min radius, half the max object size], an RMS at most the
+    max RMS, an arc of at least the min arc (rad) from the first point to the last about its
+    centre, a centre known to the max 1-sigma (`fit_sigma`: a short arc of noisy echoes places
+    it poorly), and its centre farther from the sensor at (x, y) than the points' mean (the
+    points are the near side of a convex outline)."""
     cx, cy, radius, rms = fit
-    if not (min_r <= radius <= max_r and rms <= max_rms and _arc(points, lo, hi, cx, cy) >= min_arc):
+    if not (settings[4] <= radius <= 0.5 * settings[1] and rms <= settings[3]):
+        return False
+    arc = _arc(points, lo, hi, cx, cy)
+    if not (arc >= settings[5] and fit_sigma(rms, hi - lo, arc) <= settings[11]):
         return False
     mx = my = 0.0
     for k in range(lo, hi):
@@ -302,41 +359,222 @@ def _chord_centre(points: np.ndarray, lo: int, hi: int, x: float, y: float) -> t
 
 
 @njit(cache=True)
-def cluster_features(
+def world_points(
     order: np.ndarray,
-    bounds: np.ndarray,
-    ends: np.ndarray,
     cos_b: np.ndarray,
     sin_b: np.ndarray,
     ranges: np.ndarray,
     x: float,
     y: float,
     yaw: float,
-    settings: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Each cluster of `segment` measured from the sensor at (x, y) (m) heading `yaw` (rad), its
-    beams' bearings given by their cosines `cos_b` and sines `sin_b`.
-
-    `settings`: min points, max object size (m), min points for a circle fit, the fit's max RMS
-    (m), its min radius (m) and arc (rad), and the floor of a centre's 1-sigma (m). Returns the
-    echoes as world points (M, 2; `order`'s order); per cluster whether it is at most the max
-    object size (its largest distance of a point from either end) and has points enough to
-    track (C,), whether its centre came from a sane circle fit (C,), and, for those to track,
-    the centre (C, 2; m, world), the radius of the disc about it that holds the points (C,; m),
-    and the centre's 1-sigma along and across the line of sight (C, 2; m), each at least the
-    floor: of a fit, its RMS over sqrt(n), twice, times (pi over its arc) squared, both ways; of
-    a chord, a quarter of it along the line of sight (the depth rests on the guess of the
-    radius) and an eighth across, and when an end is not a silhouette, a quarter of what a
-    hidden part may add to the chord, both ways.
-    """
-    min_points, max_size, fit_points, max_rms, min_radius, min_arc, floor = settings
-    count = bounds.shape[0] - 1
+) -> np.ndarray:
+    """The echoes of the beams `order` (M,) as world points (M, 2; m) from the sensor at (x, y)
+    (m) heading `yaw` (rad), the beams' bearings given by their cosines `cos_b` and sines `sin_b`."""
     points = np.empty((order.shape[0], 2))
     cos_yaw, sin_yaw = math.cos(yaw), math.sin(yaw)
     for i in range(order.shape[0]):
         k = order[i]
         points[i, 0] = x + ranges[k] * (cos_yaw * cos_b[k] - sin_yaw * sin_b[k])
         points[i, 1] = y + ranges[k] * (sin_yaw * cos_b[k] + cos_yaw * sin_b[k])
+    return points
+
+
+FIT_NONE = -1
+"""No circle fit was tried on a cluster (too few echoes, or too large)."""
+FIT_FAILED = 0
+"""A cluster's circle fit is not sane (`_fit_sane`)."""
+FIT_SANE = 1
+"""A cluster's circle fit is sane."""
+
+
+@njit(cache=True)
+def _sane_fit(
+    points: np.ndarray, lo: int, hi: int, x: float, y: float, settings: np.ndarray
+) -> tuple[int, tuple[float, float, float, float]]:
+    """Kasa's circle fit to points[lo:hi] (m, `kasa_fit`) seen from the sensor at (x, y) (m), and
+    whether it is sane (`FIT_*`, `_fit_sane`; `settings` as `cluster_features`', the radius at
+    most half the max object size): `FIT_NONE` with fewer than `fit_points` echoes. The
+    geometric fit (`refine`) has at most Kasa's RMS: the cheaper fit judges."""
+    if hi - lo < settings[2]:
+        return FIT_NONE, (math.nan, math.nan, math.nan, math.nan)
+    fit = kasa_fit(points, lo, hi)
+    sane = _fit_sane(points, lo, hi, fit, x, y, settings)
+    return FIT_SANE if sane else FIT_FAILED, fit
+
+
+@njit(cache=True, inline="always")
+def concavity(points: np.ndarray, lo: int, hi: int, j: int, w: int, x: float, y: float) -> float:
+    """How far (m) the echo points[j] lies behind its neighbours in points[lo:hi] as seen from
+    the sensor at (x, y) (m): its distance beyond the line through the echoes `w` before and
+    after it (fewer at the ends), negative in front of it. A round object's echoes are convex
+    toward the sensor, a straight wall's flat; where the outlines of two round objects meet,
+    the outline turns away from the sensor."""
+    a, b = max(lo, j - w), min(hi - 1, j + w)
+    ex, ey = points[b, 0] - points[a, 0], points[b, 1] - points[a, 1]
+    side = ex * (points[j, 1] - points[a, 1]) - ey * (points[j, 0] - points[a, 0])
+    sensor = ex * (y - points[a, 1]) - ey * (x - points[a, 0])
+    behind = -side if sensor > 0.0 else side
+    return behind / math.sqrt(ex * ex + ey * ey) if behind > 0.0 else behind
+
+
+@njit(cache=True)
+def _cuts(
+    points: np.ndarray,
+    lo: int,
+    hi: int,
+    distances: np.ndarray,
+    x: float,
+    y: float,
+    beams_per_m: float,
+    settings: np.ndarray,
+    cuts: np.ndarray,
+    spans: np.ndarray,
+) -> int:
+    """The echoes after which to cut points[lo:hi] (`split`; `distances`, m, theirs from the
+    sensor at (x, y)), into `cuts`; how many. Each run of echoes more than `depth_m` deep
+    (`concavity`, over the echoes that span `reach_m` at their range, `beams_per_m` / range, at
+    least 2, each way) gives its deepest, while `min_points` remain on either side of every cut.
+    A bend spans its reach each way, so the echoes are looked at half a reach apart first, and
+    one by one only about those more than half as deep (`spans`: scratch, (M, 2))."""
+    least, depth_m = int(settings[0]), settings[8]
+    first, last = lo + least - 1, hi - least  # the echoes a cut may follow
+    hot = 0  # spans[:hot]: the stretches to look at one by one, in order, apart
+    j = first
+    while j < last:
+        w = max(2, int(beams_per_m / distances[j]))
+        step = w // 2
+        if concavity(points, lo, hi, j, w, x, y) > 0.5 * depth_m:
+            a, b = max(first, j - step), min(last, j + step + 1)
+            if hot > 0 and a <= spans[hot - 1, 1]:
+                spans[hot - 1, 1] = b
+            else:
+                spans[hot, 0], spans[hot, 1] = a, b
+                hot += 1
+        j += step
+    count = 0
+    for k in range(hot):
+        best, deepest = -1, -math.inf
+        for j in range(spans[k, 0], spans[k, 1] + 1):
+            deep = -math.inf
+            if j < spans[k, 1]:
+                w = max(2, int(beams_per_m / distances[j]))
+                deep = concavity(points, lo, hi, j, w, x, y)
+            if deep > depth_m:
+                if deep > deepest:
+                    best, deepest = j, deep
+                continue
+            previous = cuts[count - 1] if count > 0 else lo - 1
+            if best >= 0 and best - previous >= least:
+                cuts[count] = best
+                count += 1
+            best, deepest = -1, -math.inf
+    return count
+
+
+@njit(cache=True)
+def split(
+    points: np.ndarray,
+    distances: np.ndarray,
+    bounds: np.ndarray,
+    ends: np.ndarray,
+    x: float,
+    y: float,
+    step_rad: float,
+    settings: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Cut the clusters of points (m, world; `distances` m from the sensor at (x, y)) that cannot
+    be one round object (too large, or a circle fit that fails: `_sane_fit`) where their outline
+    turns away from the sensor by more than `depth_m` (`concavity` over `reach_m` each way,
+    beams `step_rad` apart; `_cuts`), so that round objects side by side, or a round object
+    against a wall, give a cluster each. A cut is kept only when a part beside it is a round
+    object (a sane circle fit of a radius at least `min_round_m`, at most the max object size):
+    the other parts stay together, and a wall with bends stays whole. A cut end meets the other
+    part: `END_BLOCKED`. `settings`: `cluster_features`'.
+
+    Returns the new bounds (C' + 1,) and ends (C', 2), and each new cluster's circle fit
+    (C', 4) and its `FIT_*` (C',) when one was made (`FIT_NONE` when not yet)."""
+    least, max_size, fit_points, min_round = int(settings[0]), settings[1], settings[2], settings[10]
+    beams_per_m = settings[7] / step_rad
+    count = bounds.shape[0] - 1
+    room = count + points.shape[0] // max(least, 1) + 1  # each cut leaves `least` echoes before it
+    new_bounds = np.empty(room, dtype=np.int64)
+    new_ends = np.empty((room, 2), dtype=np.int64)
+    fits = np.full((room, 4), np.nan)
+    states = np.full(room, FIT_NONE, dtype=np.int64)
+    cuts = np.empty(room, dtype=np.int64)
+    spans = np.empty((points.shape[0] + 1, 2), dtype=np.int64)
+    part_fits = np.empty((room, 4))
+    part_states = np.empty(room, dtype=np.int64)
+    total = 0
+    for c in range(count):
+        lo, hi = bounds[c], bounds[c + 1]
+        state, fit = FIT_NONE, (math.nan, math.nan, math.nan, math.nan)
+        large = _larger_than(points, lo, hi, max_size)
+        if hi - lo >= least and not large:
+            state, fit = _sane_fit(points, lo, hi, x, y, settings)
+        made = 0
+        if hi - lo >= 2 * least and (large or state == FIT_FAILED):
+            made = _cuts(points, lo, hi, distances, x, y, beams_per_m, settings, cuts, spans)
+        for i in range(made + 1 if made > 0 else 0):  # the parts between the cuts
+            a = lo if i == 0 else cuts[i - 1] + 1
+            b = hi if i == made else cuts[i] + 1
+            part_states[i] = FIT_NONE
+            if b - a >= fit_points and not _larger_than(points, a, b, max_size):
+                part_states[i], part_fit = _sane_fit(points, a, b, x, y, settings)
+                part_fits[i, 0], part_fits[i, 1], part_fits[i, 2], part_fits[i, 3] = part_fit
+                if part_fit[2] < min_round:
+                    part_states[i] = FIT_FAILED
+        start, first = lo, 0  # the new cluster that starts at echo `start`, part `first`
+        new_ends[total, 0] = ends[c, 0]
+        for i in range(made + 1):
+            last = i == made
+            if not last and part_states[i] != FIT_SANE and part_states[i + 1] != FIT_SANE:
+                continue  # no cut between parts i and i + 1
+            new_bounds[total] = start
+            new_ends[total, 1] = ends[c, 1] if last else END_BLOCKED
+            if first == 0 and last:  # the cluster as it came
+                states[total] = state
+                fits[total, 0], fits[total, 1], fits[total, 2], fits[total, 3] = fit
+            elif first == i:  # one part
+                states[total] = part_states[i]
+                fits[total] = part_fits[i]
+            total += 1
+            if not last:
+                start, first = cuts[i] + 1, i + 1
+                new_ends[total, 0] = END_BLOCKED
+    new_bounds[total] = bounds[count]
+    return new_bounds[: total + 1], new_ends[:total], fits[:total], states[:total]
+
+
+@njit(cache=True)
+def cluster_features(
+    points: np.ndarray,
+    bounds: np.ndarray,
+    ends: np.ndarray,
+    fits: np.ndarray,
+    states: np.ndarray,
+    x: float,
+    y: float,
+    settings: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Each cluster points[bounds[c]:bounds[c + 1]] (m, world; `split`'s, with its circle fits
+    and their `FIT_*` where made) measured from the sensor at (x, y) (m).
+
+    `settings`: min points, max object size (m), min points for a circle fit, the fit's max RMS
+    (m), its min radius (m) and arc (rad), the floor of a centre's 1-sigma (m), `split`'s
+    reach_m, depth_m, the fit's iterations (`refine`), `split`'s min_round_m, and the fit's
+    max 1-sigma (m, `_fit_sane`). Returns per cluster whether it is at most the max
+    object size (its largest distance of a point from either end) and has points enough to
+    track (C,), whether its centre came from a sane circle fit (C,; `_sane_fit`), and, for
+    those to track, the centre (C, 2; m, world), the radius of the disc about it that holds the
+    points (C,; m), and the centre's 1-sigma along and across the line of sight (C, 2; m), each
+    at least the floor: of a fit (refined by `refine` when its RMS is over a tenth of the floor),
+    `fit_sigma` both ways; of a chord, a quarter of it along the line of sight (the depth rests
+    on the guess of the radius) and an eighth across, and when an end is not a silhouette, a
+    quarter of what a hidden part may add to the chord, both ways.
+    """
+    min_points, max_size, floor, iterations = settings[0], settings[1], settings[6], int(settings[9])
+    count = bounds.shape[0] - 1
     usable = np.zeros(count, dtype=np.bool_)
     fitted = np.zeros(count, dtype=np.bool_)
     centres = np.full((count, 2), np.nan)
@@ -347,13 +585,19 @@ def cluster_features(
         if hi - lo < min_points or _larger_than(points, lo, hi, max_size):
             continue
         usable[c] = True
-        fit = kasa_fit(points, lo, hi) if hi - lo >= fit_points else (math.nan, math.nan, math.nan, math.nan)
+        state, fit = states[c], (fits[c, 0], fits[c, 1], fits[c, 2], fits[c, 3])
+        if state == FIT_NONE:
+            state, fit = _sane_fit(points, lo, hi, x, y, settings)
         cx, cy, chord = _chord_centre(points, lo, hi, x, y)
-        if _fit_sane(points, lo, hi, fit, x, y, min_radius, 0.5 * max_size, max_rms, min_arc):
+        if state == FIT_SANE:
             fitted[c] = True
+            if fit[3] > 0.1 * floor:  # Kasa's bias grows with the noise squared: nil below that
+                refined = refine(points, lo, hi, fit, iterations)
+                if _fit_sane(points, lo, hi, refined, x, y, settings):
+                    fit = refined
             cx, cy = fit[0], fit[1]
             arc = _arc(points, lo, hi, cx, cy)
-            sigmas[c, :] = max(floor, 2.0 * fit[3] / math.sqrt(hi - lo) * (math.pi / arc) ** 2)
+            sigmas[c, :] = max(floor, fit_sigma(fit[3], hi - lo, arc))
         else:
             hidden = 0.25 * (max_size - chord) if ends[c, 0] != END_CLEAR or ends[c, 1] != END_CLEAR else 0.0
             sigmas[c, 0] = max(floor, 0.25 * chord, hidden)
@@ -363,7 +607,7 @@ def cluster_features(
         for k in range(lo, hi):
             hold2 = max(hold2, (points[k, 0] - cx) ** 2 + (points[k, 1] - cy) ** 2)
         radii[c] = math.sqrt(hold2)
-    return points, usable, fitted, centres, radii, sigmas
+    return usable, fitted, centres, radii, sigmas
 
 
 @njit(cache=True)
@@ -592,6 +836,29 @@ def associate(
     return rows, clusters
 
 
+@njit(cache=True, inline="always")
+def _search(bearings: np.ndarray, angle: float, right: bool) -> int:
+    """The first index of `bearings` (N,; rad, increasing) at least `angle` (rad), or, `right`,
+    beyond it (N: none), as `np.searchsorted` finds it (side "left" or "right"), from a guess as
+    though they were evenly spread (exact for a laser's fan, a few steps off for others)."""
+    n = bearings.shape[0]
+    span = bearings[n - 1] - bearings[0]
+    k = n if angle > bearings[n - 1] else 0
+    if span > 0.0 and bearings[0] < angle <= bearings[n - 1]:
+        k = min(n - 1, max(0, int((angle - bearings[0]) / span * (n - 1))))
+    if right:
+        while k > 0 and bearings[k - 1] > angle:
+            k -= 1
+        while k < n and bearings[k] <= angle:
+            k += 1
+    else:
+        while k > 0 and bearings[k - 1] >= angle:
+            k -= 1
+        while k < n and bearings[k] < angle:
+            k += 1
+    return k
+
+
 @njit(cache=True)
 def _window(bearings: np.ndarray, cyclic: bool, lo: float, hi: float) -> tuple[int, int]:
     """The beams whose bearings (rad, increasing) lie in [lo, hi] (rad, robot frame, taken a
@@ -603,16 +870,12 @@ def _window(bearings: np.ndarray, cyclic: bool, lo: float, hi: float) -> tuple[i
         lo, hi = lo + TWO_PI, hi + TWO_PI
     while lo >= bearings[0] + TWO_PI:
         lo, hi = lo - TWO_PI, hi - TWO_PI
-    start = int(np.searchsorted(bearings, lo))
-    if not cyclic and hi > bearings[n - 1]:
+    start = _search(bearings, lo, False)
+    if hi <= bearings[n - 1]:
+        return start, max(0, _search(bearings, hi, True) - start)
+    if not cyclic:
         return start, 0
-    count = 0
-    while count < n:
-        k = start + count
-        if bearings[k % n] + (TWO_PI if k >= n else 0.0) > hi:
-            break
-        count += 1
-    return start, count
+    return start, min(n, n - start + _search(bearings, hi - TWO_PI, True))  # on past the last
 
 
 @njit(cache=True)
@@ -782,26 +1045,38 @@ def scan_clusters(
 ) -> tuple:
     """A scan (by bearing: `bearings`, rad, their cosines and sines; `ranges`, m) taken at `pose`
     (x, y in m, yaw in rad): `segment`'s bounds, labels and ends (`segmentation`: lambda
-    (rad), sigma_m, min_gap_m, max_missing, clear_depth_m), and `cluster_features`' points,
-    usable, fitted, centres, radii and sigmas (`features`); the points are the echoes cluster by
-    cluster, as `segment` orders them."""
+    (rad), sigma_m, min_gap_m, max_missing, clear_depth_m), cut apart where round objects meet
+    (`split`: its bounds, ends and labels then), the points (`world_points`), and
+    `cluster_features`' usable, fitted, centres, radii and sigmas (`features`); the points are
+    the echoes cluster by cluster, as `segment` orders them."""
     lambda_rad, sigma_m, min_gap_m, max_missing, clear_depth_m = segmentation
     order, bounds, labels, ends = segment(
         bearings, ranges, cyclic, lambda_rad, sigma_m, min_gap_m, int(max_missing), clear_depth_m
     )
-    points, usable, fitted, centres, radii, sigmas = cluster_features(
-        order, bounds, ends, cos_b, sin_b, ranges, pose[0], pose[1], pose[2], features
+    x, y = pose[0], pose[1]
+    points = world_points(order, cos_b, sin_b, ranges, x, y, pose[2])
+    distances = np.empty(order.shape[0])
+    for i in range(order.shape[0]):
+        distances[i] = ranges[order[i]]
+    n = bearings.shape[0]
+    step = (bearings[n - 1] - bearings[0]) / (n - 1) if n > 1 else TWO_PI
+    cut, ends, fits, states = split(points, distances, bounds, ends, x, y, step, features)
+    if cut.shape[0] != bounds.shape[0]:
+        bounds = cut
+        for c in range(bounds.shape[0] - 1):
+            for i in range(bounds[c], bounds[c + 1]):
+                labels[order[i]] = c
+    usable, fitted, centres, radii, sigmas = cluster_features(
+        points, bounds, ends, fits, states, x, y, features
     )
     return bounds, labels, ends, points, usable, fitted, centres, radii, sigmas
 
 
 @njit(cache=True, inline="always")
 def _whole(ends: np.ndarray, fitted: np.ndarray, c: int) -> bool:
-    """Whether cluster c shows a whole object: not cut by the edge of the view, and silhouettes
-    at both ends unless its circle fit is sane (a part that meets a nearer echo places its
-    centre only when the arc that shows fits a circle)."""
-    if ends[c, 0] == END_EDGE or ends[c, 1] == END_EDGE:
-        return False
+    """Whether cluster c shows enough of its object to place it: silhouettes at both ends, or an
+    arc whose circle fit is sane (a part that meets a nearer echo, another object's outline or
+    the edge of the view places its centre only when the arc that shows fits a circle)."""
     return fitted[c] or (ends[c, 0] == END_CLEAR and ends[c, 1] == END_CLEAR)
 
 
@@ -839,24 +1114,28 @@ def _largest_sd(cov: np.ndarray, first: int) -> float:
 
 @njit(cache=True)
 def _classify(state: np.ndarray, cov: np.ndarray, info: np.ndarray, count: int, settings: np.ndarray) -> None:
-    """Set MOVING for the first `count` tracks. A track starts moving when confirmed, seen for
-    `min_age_s`, its motion `MOTION_MOVED`, and its speed above `floor_mps` and `sigmas` times
-    its velocity's 1-sigma; it stops when its motion turns `MOTION_STATIC` or its speed falls to
-    `hold_mps`. `settings`: floor_mps, sigmas, min_age_s, hold_mps."""
-    floor_mps, sigmas, min_age_s, hold_mps = settings
+    """Set MOVING for the first `count` tracks. A track starts moving when measured `min_hits`
+    times, seen for `min_age_s`, its motion `MOTION_MOVED`, and its speed above `floor_mps` and
+    `sigmas` times its velocity's 1-sigma, `young_sigmas` times while it is not confirmed (a
+    young track whose motion is plain and fast need not wait for `confirm_hits`: it is confirmed
+    then); it stops when its motion turns `MOTION_STATIC` or its speed falls to `hold_mps`.
+    `settings`: floor_mps, sigmas, min_age_s, hold_mps, min_hits, young_sigmas."""
+    floor_mps, sigmas, min_age_s, hold_mps, min_hits, young_sigmas = settings
     for t in range(count):
         speed = math.hypot(state[t, 2], state[t, 3])
         if info[t, MOVING]:
             moving = info[t, MOTION] != MOTION_STATIC and speed > hold_mps
         else:
+            young = info[t, CONFIRMED] == 0.0
             moving = (
-                info[t, CONFIRMED] > 0.0
+                info[t, HITS] >= min_hits
                 and info[t, MOTION] == MOTION_MOVED
-                and info[t, LAST_SEEN] - info[t, FIRST_SEEN] >= min_age_s
+                and info[t, LAST_SEEN] - info[t, FIRST_SEEN] >= min_age_s - 1e-9
                 and speed > floor_mps
-                and speed > sigmas * _largest_sd(cov[t], 2)
+                and speed > (young_sigmas if young else sigmas) * _largest_sd(cov[t], 2)
             )
         info[t, MOVING] = 1.0 if moving else 0.0
+        info[t, CONFIRMED] = 1.0 if moving else info[t, CONFIRMED]
 
 
 @njit(cache=True)
@@ -913,8 +1192,8 @@ def _fold_one(
 ) -> None:
     """Fold cluster c (`scan`: `fold`'s) into track t: its Kalman filter with the centre
     (`_kalman_update`), its radius (taken when larger, else smoothed by `smoothing`), its last
-    sight (`time_s`), hits and misses, and its confirmation (`confirm_hits`)."""
-    pose, _, _, _, centres, sigmas, radii, _, _, _ = scan
+    sight (`time_s`), hits and misses, its confirmation (`confirm_hits`) and its echoes."""
+    pose, _, _, _, centres, sigmas, radii, _, bounds, _ = scan
     ux, uy = _unit_from(pose[0], pose[1], centres[c, 0], centres[c, 1])
     _kalman_update(state[t], cov[t], centres[c, 0], centres[c, 1], sigmas[c, 0], sigmas[c, 1], ux, uy)
     radius = info[t, RADIUS]
@@ -923,6 +1202,53 @@ def _fold_one(
     info[t, HITS] += 1.0
     info[t, MISSES] = 0.0
     info[t, CONFIRMED] = 1.0 if info[t, HITS] >= confirm_hits else info[t, CONFIRMED]
+    info[t, ECHOES] = bounds[c + 1] - bounds[c]
+
+
+@njit(cache=True)
+def _verdicts(
+    references: tuple[tuple[np.ndarray, np.ndarray, float, np.ndarray], ...],
+    scan: tuple,
+    wanted: np.ndarray,
+    young: np.ndarray,
+    ranges: np.ndarray,
+    fan: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool],
+    evidence: np.ndarray,
+) -> tuple[bool, np.ndarray]:
+    """Whether the pose can be trusted, and the `wanted` clusters' verdicts (C,; `judge`) against
+    earlier scans (`references`, oldest first, each its pose, ranges, time and structure's
+    sample; no ranges: none yet). The oldest there judges first: a slow object has moved
+    enough in its time, and a fixed one stays where it stood (`MOTION_STATIC` comes from the
+    first, `slow_reference_age_s` old, alone); each younger one then judges what the older
+    ones could not tell of the `young` clusters (those of no track, or of a track first seen
+    after the oldest: hidden or out of view then, or no such old scan yet), and only whether it
+    moved, so that a new object is told as soon as it has moved far enough. The pose is trusted
+    when the fixed structure stands where it stood in the oldest (`structure_stays`); nothing
+    is judged when it does not, or there is no earlier scan."""
+    pose, _, _, _, _, _, _, points, bounds, now = scan
+    bearings, _, _, _, cyclic = fan
+    verdicts = np.full(wanted.shape[0], MOTION_UNKNOWN, dtype=np.int64)
+    oldest = 0
+    while oldest < len(references) and references[oldest][1].shape[0] == 0:
+        oldest += 1
+    if oldest == len(references):
+        return False, verdicts
+    ref_pose, ref_ranges, _, then = references[oldest]
+    if not structure_stays(now, then, pose, ranges, (ref_pose, ref_ranges), bearings, cyclic, evidence):
+        return False, verdicts
+    verdicts = judge(points, bounds, wanted, ref_pose, bearings, ref_ranges, cyclic, evidence)
+    if oldest > 0:
+        for c in range(verdicts.shape[0]):  # only the first, slow reference tells one is fixed
+            verdicts[c] = MOTION_MOVED if verdicts[c] == MOTION_MOVED else MOTION_UNKNOWN
+    for which in range(oldest + 1, len(references)):
+        untold = wanted & young & (verdicts == MOTION_UNKNOWN)
+        if not untold.any():
+            break
+        ref_pose, ref_ranges, _, _ = references[which]
+        again = judge(points, bounds, untold, ref_pose, bearings, ref_ranges, cyclic, evidence)
+        for c in range(verdicts.shape[0]):
+            verdicts[c] = MOTION_MOVED if again[c] == MOTION_MOVED else verdicts[c]
+    return True, verdicts
 
 
 @njit(cache=True)
@@ -936,7 +1262,7 @@ def fold(
     scan: tuple,
     ranges: np.ndarray,
     fan: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool],
-    reference: tuple[np.ndarray, np.ndarray, float, np.ndarray],
+    references: tuple[tuple[np.ndarray, np.ndarray, float, np.ndarray], ...],
     time_s: float,
     settings: np.ndarray,
     evidence: np.ndarray,
@@ -946,40 +1272,50 @@ def fold(
 
     `scan` holds the scan's pose, ends, usable, fitted, centres, sigmas, radii, points, bounds and
     its fixed structure's sample (`scan_clusters`, `structure`), `ranges` its ranges (m) along
-    the `fan`. Only a whole cluster (`_whole`) updates its track or is judged (`judge`,
-    `evidence`, against `reference`: the earlier scan's pose, ranges, time and structure's
-    sample): a track that takes a part of its object coasts. A track faster than `floor_mps`
-    whose cluster does not tell it moved is asked whether it left the place it stood at the
-    earlier scan free (`left_free`). Nothing is judged, and every verdict is forgotten (so no
-    track moves), when there is no earlier scan or the fixed structure seems to have moved
+    the `fan`. Only a whole cluster (`_whole`) updates its track or is judged (`_verdicts`,
+    `evidence`, against `references`: earlier scans, oldest first, each its pose, ranges, time
+    and structure's sample); a confirmed track leaving the view (its part cut by the edge of the
+    view shows fewer echoes than the last cluster it took) coasts on the velocity of its whole
+    views, as does a track that takes a part that does not place its object. A track faster
+    than `floor_mps` whose cluster does not tell it moved is asked whether it left the place it
+    stood at an earlier scan free (`left_free`): the oldest, and the oldest taken since the
+    track's first sight. Nothing is judged, and every verdict is forgotten (so no track moves),
+    when there is no earlier scan or the fixed structure seems to have moved
     (`structure_stays`). `settings`: confirm_hits, radius_smoothing, and `_classify`'s
     (floor_mps, ...).
     """
-    pose, ends, usable, fitted, _, _, _, points, bounds, now = scan
-    bearings, _, _, _, cyclic = fan
-    ref_pose, ref_ranges, ref_time, then = reference
+    pose, ends, usable, fitted, _, _, _, _, bounds, _ = scan
     fraction, min_free = evidence[2], evidence[3]
     wanted = np.zeros(usable.shape[0], dtype=np.bool_)
     for c in range(usable.shape[0]):
         wanted[c] = usable[c] and _whole(ends, fitted, c)
-    trusted = ref_ranges.shape[0] > 0 and structure_stays(
-        now, then, pose, ranges, (ref_pose, ref_ranges), bearings, cyclic, evidence
-    )
-    judged = wanted if trusted else np.zeros_like(wanted)
-    verdicts = judge(points, bounds, judged, ref_pose, bearings, ref_ranges, cyclic, evidence)
+    young = np.ones(usable.shape[0], dtype=np.bool_)
+    for i in range(rows.shape[0]):
+        young[clusters[i]] = info[rows[i], FIRST_SEEN] > references[0][2] or references[0][1].shape[0] == 0
+    trusted, verdicts = _verdicts(references, scan, wanted, young, ranges, fan, evidence)
     for i in range(rows.shape[0]):
         t, c = rows[i], clusters[i]
-        if not wanted[c]:
-            continue
+        leaving = ends[c, 0] == END_EDGE or ends[c, 1] == END_EDGE
+        leaving = leaving and info[t, CONFIRMED] > 0.0 and bounds[c + 1] - bounds[c] < info[t, ECHOES]
+        if not wanted[c] or leaving:
+            continue  # a track leaving the view coasts on the velocity of its whole views
         verdict = verdicts[c]
         _fold_one(state, cov, info, t, c, scan, time_s, settings[0], settings[1])
         if trusted and verdict != MOTION_MOVED and math.hypot(state[t, 2], state[t, 3]) > settings[2]:
-            age = time_s - ref_time
-            x, y = state[t, 0] - state[t, 2] * age, state[t, 1] - state[t, 3] * age
-            free, looked = left_free(
-                x, y, info[t, RADIUS], fan, (ref_pose, ref_ranges), pose, ranges, evidence
-            )
-            verdict = MOTION_MOVED if free >= max(min_free, fraction * looked) else verdict
+            tries = 0  # the oldest earlier scan, and the oldest since the track's first sight
+            for which in range(len(references)):
+                ref_pose, ref_ranges, ref_time, _ = references[which]
+                if ref_ranges.shape[0] == 0 or verdict == MOTION_MOVED or tries == 2:
+                    continue
+                if tries == 1 and ref_time < info[t, FIRST_SEEN]:
+                    continue
+                tries += 1
+                age = time_s - ref_time
+                x, y = state[t, 0] - state[t, 2] * age, state[t, 1] - state[t, 3] * age
+                free, looked = left_free(
+                    x, y, info[t, RADIUS], fan, (ref_pose, ref_ranges), pose, ranges, evidence
+                )
+                verdict = MOTION_MOVED if free >= max(min_free, fraction * looked) else verdict
         _judged(info, t, verdict, time_s)
     for t in range(0 if trusted else count):  # what was judged before may rest on a wrong pose
         info[t, MOTION], info[t, STATIC_SINCE] = MOTION_UNKNOWN, -1.0
@@ -1167,6 +1503,7 @@ def start_tracks(
     centres: np.ndarray,
     sigmas: np.ndarray,
     radii: np.ndarray,
+    bounds: np.ndarray,
     pose: np.ndarray,
     time_s: float,
     first_id: int,
@@ -1174,7 +1511,8 @@ def start_tracks(
 ) -> None:
     """Start a tentative track in rows first, first + 1, ... at each cluster of `fresh`, ids from
     `first_id`: at its centre, at rest, the position's covariance its measurement noise (seen
-    from `pose`), the velocity's 1-sigma `speed_std_mps`. `settings`: speed_std_mps, confirm_hits."""
+    from `pose`), the velocity's 1-sigma `speed_std_mps`, its cluster's echoes (`bounds`).
+    `settings`: speed_std_mps, confirm_hits."""
     speed_std_mps, confirm_hits = settings
     for i in range(fresh.shape[0]):
         t, c = first + i, fresh[i]
@@ -1192,6 +1530,7 @@ def start_tracks(
         info[t, CONFIRMED] = 1.0 if confirm_hits <= 1 else 0.0
         info[t, MOTION] = MOTION_UNKNOWN
         info[t, STATIC_SINCE] = -1.0
+        info[t, ECHOES] = bounds[c + 1] - bounds[c]
 
 
 @njit(cache=True)
@@ -1220,7 +1559,7 @@ def track_scan(
     pose: np.ndarray,
     time_s: float,
     dt: float,
-    reference: tuple[np.ndarray, np.ndarray, float, np.ndarray],
+    references: tuple[tuple[np.ndarray, np.ndarray, float, np.ndarray], ...],
     settings: tuple[np.ndarray, ...],
 ) -> tuple[int, int, np.ndarray, np.ndarray, np.ndarray]:
     """Fold one scan into the track table and return its new count and next id, per beam the id
@@ -1230,12 +1569,13 @@ def track_scan(
     `table`: the tracks' states, covariances and info (rows; room for a track per cluster more
     than `count`); `fan`: the bearings (rad, increasing), their cosines and sines, the beams by
     bearing (none: given so) and whether they go all round; `ranges` (m, by bearing) taken at
-    `pose` (x, y in m, yaw in rad) at `time_s`, `dt` s after the last scan; `reference`: the
-    earlier scan's pose, ranges, time and structure's sample (`fold`). The steps: `predict`
-    (settings[0]: accel_psd, gate_chi2, max_gate_m), `scan_clusters` (settings[1], settings[2]),
-    `associate`, `structure`, `fold` (settings[3], and settings[4] for `judge`, `left_free` and
-    `structure_stays`, whose 7th is structure_points), `_beam_labels`, `_fresh`, `_gone`
-    (settings[5]), `_compact` and `start_tracks` (settings[6]).
+    `pose` (x, y in m, yaw in rad) at `time_s`, `dt` s after the last scan; `references`:
+    earlier scans, oldest first, each its pose, ranges, time and structure's sample (`fold`).
+    The steps: `predict` (settings[0]: accel_psd, gate_chi2, max_gate_m), `scan_clusters`
+    (settings[1], settings[2]), `associate`, `structure`, `fold` (settings[3], and settings[4]
+    for `judge`, `left_free` and `structure_stays`, whose 7th is structure_points),
+    `_beam_labels`, `_fresh`, `_gone` (settings[5]), `_compact` and `start_tracks`
+    (settings[6]).
     """
     state, cov, info = table
     bearings, cos_b, sin_b, by_bearing, cyclic = fan
@@ -1248,13 +1588,15 @@ def track_scan(
     fixed = structure(points, bounds, usable, int(features[0]), int(evidence[7]))
     measured = (pose, ends, usable, fitted, centres, sigmas, radii, points, bounds, fixed)
     verdicts = fold(
-        state, cov, info, count, rows, clusters, measured, ranges, fan, reference, time_s, folding, evidence
+        state, cov, info, count, rows, clusters, measured, ranges, fan, references, time_s, folding, evidence
     )
     ids, moving = _beam_labels(labels, by_bearing, usable.shape[0], rows, clusters, info)
     fresh = _fresh(usable, fitted, ends, centres, verdicts, clusters, state, info, rows)
     drop = _gone(state, info, count, rows, pose, bearings, ranges, cyclic, time_s, settling)
     count = _compact(state, cov, info, count, drop)
-    start_tracks(state, cov, info, count, fresh, centres, sigmas, radii, pose, time_s, next_id, starting)
+    start_tracks(
+        state, cov, info, count, fresh, centres, sigmas, radii, bounds, pose, time_s, next_id, starting
+    )
     return count + fresh.shape[0], next_id + fresh.shape[0], ids, moving, fixed
 
 

@@ -6,17 +6,28 @@ Each scan is handled in five steps (the loops are numba kernels, `kernels.tracki
    neighbours exceeds Borges and Aldon's adaptive breakpoint, max(min_gap, r sin(dphi) /
    sin(lambda - dphi) + 3 sigma_r) (G. A. Borges and M.-J. Aldon, "Line extraction in 2D range
    images for mobile robotics", J. Intelligent and Robotic Systems 40, 2004), or where more
-   than `max_missing_beams` beams between them have no echo. Clusters larger than
-   `max_object_size_m` (walls, blobs of clutter) are fixed structure and never tracked; so are
-   those of fewer than `min_points` echoes. Each end of a cluster is a silhouette (clear), meets
-   a nearer or about as near echo (blocked: the object may go on unseen) or is the edge of the
-   field of view.
-2. **Measurement.** A small cluster's centre is Kasa's algebraic circle fit (I. Kasa, IEEE
-   Trans. Instrum. Meas. 25, 1976) when it has `fit_min_points` echoes and the fit is sane (a
-   plausible radius, a small RMS, an arc of `fit_min_arc_deg`, the centre behind the echoes),
-   else the chord's midpoint pushed away from the sensor by half the chord (the centre of a
-   disc whose near side the chord spans); its noise is anisotropic about the line of sight,
-   from the fit's RMS or the chord, larger when an end is not a silhouette.
+   than `max_missing_beams` beams between them have no echo. Round objects that touch or
+   overlap in the scan (two or three cylinders side by side, one against a wall) come as one
+   cluster, too large for one object or whose circle fit fails: such a cluster is cut where
+   its outline turns away from the sensor, an echo more than `split_depth_m` behind the line
+   through its neighbours `split_reach_m` either way (a round object's echoes are convex
+   toward the sensor, a wall's flat), where a part beside the cut is a round object of its
+   own (a sane circle fit of at least `split_min_radius_m`): the other parts stay together,
+   and a wall, bent or not, stays whole. Clusters larger than `max_object_size_m` (walls,
+   blobs of clutter) are fixed structure and never tracked; so are those of fewer than
+   `min_points` echoes. Each end of a cluster is a silhouette (clear), meets a nearer or about
+   as near echo or the part it was cut from (blocked: the object may go on unseen) or is the
+   edge of the field of view.
+2. **Measurement.** A small cluster's centre is a circle fit when it has `fit_min_points`
+   echoes and the fit is sane (a plausible radius, a small RMS, an arc of `fit_min_arc_deg`,
+   a centre within `fit_max_std_m`, the centre behind the echoes): Kasa's algebraic fit (I.
+   Kasa, IEEE Trans. Instrum. Meas. 25, 1976), refined by `fit_iterations` Gauss-Newton steps
+   toward the geometric fit when its echoes are noisy (Kasa's circle of a short noisy arc is
+   too small: N. Chernov, "Circular and Linear Regression", CRC Press 2010), its 1-sigma that
+   of a parabola's radius over the arc, sqrt(45 / n) sigma / (arc / 2)^2; else the chord's
+   midpoint pushed away from the sensor by half the chord (the centre of a disc whose near
+   side the chord spans), its noise anisotropic about the line of sight, from the chord,
+   larger when an end is not a silhouette.
 3. **Association.** Predicted tracks and measured centres are paired within a gate on the
    squared Mahalanobis distance of the innovation (`gate_chi2`, and at most `max_gate_m`) by
    an optimal assignment, a global nearest neighbour (S. S. Blackman and R. Popoli, "Design
@@ -27,34 +38,42 @@ Each scan is handled in five steps (the loops are numba kernels, `kernels.tracki
    white-noise acceleration (Y. Bar-Shalom, X. R. Li and T. Kirubarajan, "Estimation with
    Applications to Tracking and Navigation", Wiley 2001, section 6.2.2). A new track starts
    at its first centre at rest with a velocity 1-sigma of `initial_speed_std_mps`, so its
-   second measurement sets its velocity; it is confirmed after `confirm_hits` measurements.
-   Only a whole cluster updates or starts a track: not cut by the edge of the view, and
-   silhouettes at both ends unless its arc fits a circle. A track that takes a part of its
-   object (cut by the edge of the view, or hidden in part behind another) labels its beams but
-   coasts, as does one that takes nothing. It is dropped when unseen for `coast_s`, when the
-   beams toward its predicted centre pass through it `max_misses_in_view` scans in a row, or
-   when it lies on a track that was seen and goes its way (a duplicate).
+   second measurement sets its velocity; it is confirmed after `confirm_hits` measurements,
+   or when it is found moving. Only a cluster that places its object updates or starts a
+   track: silhouettes at both ends, or an arc that fits a circle (cut by the edge of the view,
+   by another object or by a cut). A track leaving the view (its part at the edge of the view
+   shows fewer echoes than the last it took) coasts on the velocity of its whole views, as
+   does one that takes a part that does not place its object (it labels its beams) or nothing.
+   It is dropped when unseen for `coast_s`, when the beams toward its predicted centre pass
+   through it `max_misses_in_view` scans in a row, or when it lies on a track that was seen
+   and goes its way (a duplicate).
 5. **Moving or not.** A fixed blob whose visible part changes as the robot drives past, or
-   whose track hops between its fragments, seems to move. So a track is moving only when the
-   scan of `reference_age_s` earlier says so (C.-C. Wang, C. Thorpe and S. Thrun, "Online
-   simultaneous localization and mapping with detection and tracking of moving objects",
-   ICRA 2003: moving objects violate the free space of earlier scans): its echoes of now
-   stand where that scan saw free space (at least `min_free_points` and `free_fraction` of
-   them, every beam of that scan within `held_tolerance_m` sideways having passed more than
-   `free_margin_m` beyond), or, for an object that recedes along the beams and so stands
-   where it hid before, the echoes that scan had where the track stood then (its position
-   less its velocity times the age) stand in the free space of now. A fixed surface does
-   neither: a part newly seen was hidden before, which is no evidence. Its speed must also
-   exceed `moving_floor_mps` and `moving_sigmas` times its 1-sigma, seen for
-   `moving_min_age_s`; it stays moving while faster than `moving_hold_mps` and not judged
-   fixed. A track whose echoes stand where the earlier scan's did (half of them, and fewer
-   than `min_free_points` free) is judged fixed; one not moving and judged fixed for
-   `static_drop_s` is dropped, and a cluster judged fixed starts no track: fixed structure is
-   the planner's map's. When the fixed structure itself (the clusters too large to track)
-   seems to move, more than `pose_check_share` of a sample of its echoes standing in the
-   other scan's free space either way, the pose is off (odometry that drifts, wheels that
-   slip): nothing is judged and no track is moving until it holds again. Without fixed
-   structure in view a wrong pose cannot be told from motion.
+   whose track hops between its fragments, seems to move. So a track is moving only when an
+   earlier scan says so (C.-C. Wang, C. Thorpe and S. Thrun, "Online simultaneous localization
+   and mapping with detection and tracking of moving objects", ICRA 2003: moving objects
+   violate the free space of earlier scans): its echoes of now stand where that scan saw free
+   space (at least `min_free_points` and `free_fraction` of them, every beam of that scan
+   within `held_tolerance_m` sideways having passed more than `free_margin_m` beyond), or, for
+   an object that recedes along the beams and so stands where it hid before, the echoes that
+   scan had where the track stood then (its position less its velocity times the age) stand in
+   the free space of now. A fixed surface does neither: a part newly seen was hidden before,
+   which is no evidence. The earlier scans are the newest `slow_reference_age_s` old, in whose
+   time a slow object has moved enough, and the newest `reference_age_s` old, twice that, ...
+   below it: an object the old one cannot tell about (new in view, hidden then, or no scan that
+   old yet) is told moving as soon as it has moved `free_margin_m` since one of them. Its speed
+   must also exceed `moving_floor_mps` and `moving_sigmas` times its 1-sigma, measured
+   `moving_min_hits` times and seen for `moving_min_age_s`; before it is confirmed, its
+   velocity from fewer measurements, `young_moving_sigmas` times (a fast track is then
+   confirmed at once); it stays moving while faster than `moving_hold_mps` and not judged
+   fixed. A track whose echoes stand where the `slow_reference_age_s` old scan's
+   did (half of them, and fewer than `min_free_points` free) is judged fixed; one not moving
+   and judged fixed for `static_drop_s` is dropped, and a cluster judged fixed starts no track:
+   fixed structure is the planner's map's. When the fixed structure itself (the clusters too
+   large to track) seems to move against the oldest of those scans, more than
+   `pose_check_share` of a sample of its echoes standing in the other scan's free space either
+   way, the pose is off (odometry that drifts, wheels that slip): nothing is judged and no
+   track is moving until it holds again. Without fixed structure in view a wrong pose cannot be
+   told from motion.
 
 Deterministic: no randomness, tracks in the order of their ids, which count up from 1.
 """
@@ -143,11 +162,36 @@ class TrackerParams(PlannerParams):
     )
     max_object_size_m: float = param(1.6, "m", "clusters larger than this are fixed structure", gt=0)
     min_points: int = param(3, "", "clusters of fewer echoes are not tracked", ge=1, integer=True)
+    split_reach_m: float = param(
+        0.15, "m", "how far along a cluster, each way, its outline's bend at an echo is measured", gt=0
+    )
+    split_depth_m: float = param(
+        0.05,
+        "m",
+        "a cluster that is not one round object is cut where an echo lies this far behind its neighbours",
+        gt=0,
+    )
+    split_min_radius_m: float = param(
+        0.15,
+        "m",
+        "a cut is kept only beside a part that fits a circle at least this large (thin posts in a clump "
+        "stay fixed structure)",
+        ge=0,
+    )
     fit_min_points: int = param(6, "", "echoes a cluster needs for a circle fit", ge=3, integer=True)
     fit_max_rms_m: float = param(0.03, "m", "largest RMS distance of the echoes from a sane fit", gt=0)
     fit_min_radius_m: float = param(0.05, "m", "smallest radius of a sane fit", ge=0)
     fit_min_arc_deg: float = param(
-        90.0, "deg", "smallest arc of a sane fit, from the first echo to the last about its centre", ge=0
+        45.0, "deg", "smallest arc of a sane fit, from the first echo to the last about its centre", ge=0
+    )
+    fit_max_std_m: float = param(
+        0.05,
+        "m",
+        "largest 1-sigma of a sane fit's centre (a short arc of noisy echoes places it poorly)",
+        gt=0,
+    )
+    fit_iterations: int = param(
+        2, "", "Gauss-Newton steps that refine Kasa's circle into the geometric fit", ge=0, integer=True
     )
     measurement_floor_m: float = param(0.02, "m", "least 1-sigma of a measured centre", gt=0)
     accel_psd: float = param(
@@ -174,7 +218,18 @@ class TrackerParams(PlannerParams):
         0.2, "", "weight of a new measurement in a track's radius (a larger one is taken at once)", gt=0, le=1
     )
     reference_age_s: float = param(
-        0.5, "s", "age of the earlier scan whose free space a moving track's echoes must stand in", gt=0
+        0.1,
+        "s",
+        "age of the youngest earlier scan whose free space a moving track's echoes may stand in "
+        "(then twice that, ... below slow_reference_age_s)",
+        gt=0,
+    )
+    slow_reference_age_s: float = param(
+        0.5,
+        "s",
+        "age of the oldest earlier scan: slow objects show they moved against it, and it alone "
+        "judges a track fixed",
+        gt=0,
     )
     free_margin_m: float = param(
         0.1, "m", "an echo stands in free space when the earlier beams passed this much beyond it", ge=0
@@ -207,8 +262,25 @@ class TrackerParams(PlannerParams):
     )
     moving_floor_mps: float = param(0.3, "m/s", "a track slower than this is not moving", ge=0)
     moving_sigmas: float = param(2.0, "", "a moving track's speed exceeds its 1-sigma this many times", ge=0)
-    moving_min_age_s: float = param(0.3, "s", "a track is moving only once seen this long", ge=0)
+    moving_min_hits: int = param(
+        2,
+        "",
+        "measurements a track needs to be moving (it is confirmed then, before confirm_hits)",
+        ge=1,
+        integer=True,
+    )
+    young_moving_sigmas: float = param(
+        3.0, "", "moving_sigmas of a track not yet confirmed (its velocity from fewer measurements)", ge=0
+    )
+    moving_min_age_s: float = param(0.05, "s", "a track is moving only once seen this long", ge=0)
     moving_hold_mps: float = param(0.15, "m/s", "a moving track stays moving while faster than this", ge=0)
+
+
+_Scan = tuple[np.ndarray, np.ndarray, float, np.ndarray]
+"""An earlier scan as the free-space test takes it: its pose (x, y in m, yaw in rad), ranges (m)
+by bearing, time (s) and its fixed structure's sample (K, 2; m)."""
+_NO_SCAN: _Scan = (np.zeros(3), np.zeros(0), 0.0, np.zeros((0, 2)))
+"""No earlier scan (no ranges)."""
 
 
 class _Fan(NamedTuple):
@@ -302,6 +374,11 @@ class Tracker:
                     p.fit_min_radius_m,
                     math.radians(p.fit_min_arc_deg),
                     p.measurement_floor_m,
+                    p.split_reach_m,
+                    p.split_depth_m,
+                    p.fit_iterations,
+                    p.split_min_radius_m,
+                    p.fit_max_std_m,
                 ),
                 (
                     p.confirm_hits,
@@ -310,6 +387,8 @@ class Tracker:
                     p.moving_sigmas,
                     p.moving_min_age_s,
                     p.moving_hold_mps,
+                    p.moving_min_hits,
+                    p.young_moving_sigmas,
                 ),
                 (
                     p.free_margin_m,
@@ -332,13 +411,19 @@ class Tracker:
                 (p.initial_speed_std_mps, p.confirm_hits),
             )
         )
+        ages = [p.reference_age_s]
+        while 2.0 * ages[-1] < p.slow_reference_age_s:
+            ages.append(2.0 * ages[-1])
+        self._ages = (max(p.slow_reference_age_s, p.reference_age_s), *reversed(ages))
+        """The ages (s) of the earlier scans the free-space test looks at, oldest first: the slow
+        reference's, then `reference_age_s` doubled while below it, ..., `reference_age_s`."""
         self._table = _Table(tracking.INFO_COLUMNS)
         self._time: float | None = None
         self._next_id = 1
         self._fan: _Fan | None = None
-        self._history: deque[tuple[np.ndarray, np.ndarray, float, np.ndarray]] = deque()
-        """Earlier scans (pose, ranges by bearing, time s, structure's sample), the oldest the
-        reference."""
+        self._history: deque[_Scan] = deque()
+        """Earlier scans (pose, ranges by bearing, time s, structure's sample), by time, the oldest
+        the slow reference."""
         self._tracks: tuple[Track, ...] = ()
         self._moving_beams = np.zeros(0, dtype=bool)
         self._beam_ids = np.zeros(0, dtype=np.int64)
@@ -388,7 +473,7 @@ class Tracker:
             pose,
             time_s,
             0.0 if self._time is None else time_s - self._time,
-            self._reference(time_s),
+            self._references(time_s),
             self._settings,
         )
         self._time = time_s
@@ -407,20 +492,24 @@ class Tracker:
             self._history.clear()
         return fan
 
-    def _reference(self, time_s: float) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
-        """The earlier scan for the free-space test, the newest at least `reference_age_s` old:
-        its pose, ranges by bearing, time and fixed structure's sample; no ranges when there is
-        none."""
-        if self._history and time_s - self._history[0][2] >= self.params.reference_age_s:
-            return self._history[0]
-        return np.zeros(3), np.zeros(0), time_s, np.zeros((0, 2))
+    def _references(self, time_s: float) -> tuple[_Scan, ...]:
+        """The earlier scans for the free-space test, oldest first: for each of `_ages`, the
+        newest scan at least that old (each: its pose, ranges by bearing, time and fixed
+        structure's sample; no ranges when there is none)."""
+        history, found = self._history, []
+        k = len(history) - 1
+        for age in reversed(self._ages):  # youngest first, walking back through the history
+            while k >= 0 and time_s - history[k][2] < age - 1e-9:
+                k -= 1
+            found.append(history[k] if k >= 0 else _NO_SCAN)
+        return tuple(reversed(found))
 
-    def _remember(self, time_s: float, scan: tuple[np.ndarray, np.ndarray, float, np.ndarray]) -> None:
+    def _remember(self, time_s: float, scan: _Scan) -> None:
         """Keep this scan (pose, ranges by bearing, time, structure's sample) for the free-space
-        test; forget those older than the newest that is `reference_age_s` old."""
+        test; forget those older than the newest that is as old as the slow reference's age."""
         history = self._history
         history.append(scan)
-        while len(history) > 1 and time_s - history[1][2] >= self.params.reference_age_s:
+        while len(history) > 1 and time_s - history[1][2] >= self._ages[0] - 1e-9:
             history.popleft()
 
     def _publish(self, time_s: float) -> tuple[Track, ...]:
