@@ -51,12 +51,20 @@ robot at 1.5 m/s straight ahead will be when it gets there."""
 
 def test_a_straight_motion_meets_the_crossing_cylinder_and_a_slower_one_does_not():
     threat = EVASION.threat(np.zeros(2), (CROSSING,), 0.0)
-    candidates = np.array([[0.0, 1.5], [0.0, 0.3]])
+    candidates = np.array([[1.5, 0.0, 3.0], [0.3, 0.0, 3.0]])  # held all the horizon
     risks = EVASION.risks(candidates, (0.0, 0.0, 0.0), (1.5, 0.0), threat, np.array([10.0, 0.0]))
     assert 1.0 < risks[0, 0] < 2.5  # meets it about when both reach the crossing
     assert math.isinf(risks[1, 0])  # lets it pass first
-    assert risks[0, 3] == pytest.approx(1.5) and risks[0, 4] == pytest.approx(0.0)
+    assert tuple(risks[0, 3:5]) == (1.5, 0.0)  # the command
 
+
+def test_a_dodge_resumes_toward_the_aim():
+    # Held for half a second, then the heading controller makes for the aim: a turn away first
+    # still ends up nearer the aim than where it started, unlike the same turn held throughout.
+    candidates = np.array([[1.5, 1.5, 0.5], [1.5, 1.5, 3.0]])
+    no_threat = EVASION.threat(np.zeros(2), (), 0.0)
+    risks = EVASION.risks(candidates, (0.0, 0.0, 0.0), (1.5, 0.0), no_threat, np.array([10.0, 0.0]))
+    assert risks[0, 2] > 2.5 > risks[1, 2]
 
 def test_tracks_that_stand_still_or_cannot_reach_the_robot_are_no_threat():
     far = track(40.0, 0.0, -1.0, 0.0)
@@ -66,8 +74,9 @@ def test_tracks_that_stand_still_or_cannot_reach_the_robot_are_no_threat():
 
 def test_the_ranking_picks_a_clear_motion_that_still_makes_progress():
     threat = EVASION.threat(np.zeros(2), (CROSSING,), 0.0)
-    candidates = EVASION.candidates(0.0, 1.5, 0.0)
+    candidates = EVASION.candidates((1.5, 0.0))
     risks = EVASION.risks(candidates, (0.0, 0.0, 0.0), (1.5, 0.0), threat, np.array([10.0, 0.0]))
+    assert not math.isinf(risks[0, 0])  # the command asked for meets it
     best = EVASION.ranking(candidates, risks)[0]
     assert math.isinf(risks[best, 0])
     assert risks[best, 2] > 1.0  # gets on toward the goal, not away from it
@@ -78,7 +87,7 @@ def test_a_robot_already_in_the_way_gets_out_rather_than_on():
     # chosen one must take the robot away from it (left or back), not on across its path.
     beside = track(0.2, -1.05, 0.0, 1.0)
     threat = EVASION.threat(np.zeros(2), (beside,), 0.0)
-    candidates = EVASION.candidates(0.0, 1.5, 0.0)
+    candidates = EVASION.candidates((1.5, 0.0))
     risks = EVASION.risks(candidates, (0.0, 0.0, 0.0), (0.5, 0.0), threat, np.array([10.0, 0.0]))
     best = EVASION.ranking(candidates, risks)[0]
     assert risks[best, 5] > np.median(risks[:, 5])  # more room in the first second than most

@@ -11,10 +11,11 @@ check of the velocity-obstacle family (Fiorini and Shiller 1998, "Motion Plannin
 Environments Using Velocity Obstacles"; sampled as the dynamic window samples commands, Fox,
 Burgard and Thrun 1997, with the obstacles' motion, as Seder and Petrovic 2007).
 
-A candidate is a motion: a heading to turn to and a speed to drive along it (or to back off
-at), followed as the heading controller follows a force. The command asked for stays when its
-motion meets no moving track within the horizon. Otherwise the candidates (headings about the
-direction asked for and the robot's own, at several speeds, standing, backing) are ranked by
+A candidate is a motion: a command (speed and turn rate) held for a while, a dodge, after which
+the robot makes for where its planner is going (the aim: the goal, or a point of its way) as
+the heading controller drives it. The command asked for stays when its motion meets no moving
+track within the horizon. Otherwise the candidates (speeds forward, standing and backing, turn
+rates either way, held half a second or longer) are ranked by
 how much nearer they take the robot to where its planner is going (the aim: the goal, or a
 point of its way) before they meet a track, by how soon they would meet one and how deep into
 it within the first second, and a little by the room they keep and by keeping the last
@@ -35,16 +36,21 @@ from vplane_mj.planning.perception.tracker import Track
 
 STEP_S = 0.1
 """Time step (s) of the check along a candidate's motion."""
-HEADING_OFFSETS_DEG = (0, -10, 10, -20, 20, -35, 35, -50, 50, -70, 70, -90, 90)
-"""The candidates' headings, about the direction asked for and about the robot's heading (deg)."""
-SPEED_SHARES = (1.0, 0.7, 0.45, 0.2)
-"""The candidates' speeds along their headings, as shares of the top speed."""
-BACK_SHARES = (0.3,)
-"""The candidates that back off without turning, their speeds as shares of the top speed."""
+SPEED_SHARES = (-0.3, 0.0, 0.35, 0.7, 1.0)
+"""The candidates' speeds, as shares of the top speed (negative: backing)."""
+TURN_SHARES = (-1.0, -0.6, -0.3, -0.1, 0.0, 0.1, 0.3, 0.6, 1.0)
+"""The candidates' turn rates, as shares of the top turn rate."""
+HOLDS_S = (0.5, 1.5)
+"""How long (s) a candidate holds its command before it makes for the aim."""
 HIT_WEIGHT = 3.0
 """What meeting a track at once costs, against a whole horizon's progress at the top speed (1):
 HIT_WEIGHT (1 - t / horizon)^2 for a meeting at t, so a meeting far ahead, which later ticks can
 still avoid, costs little."""
+DOUBT_CAP_M, DOUBT_CAP_MPS = 0.1, 0.2
+"""A track's doubt grows its disc by at most this (m), and its growth by at most this (m/s): a
+track that coasts unseen behind the robot grows doubtful, and a disc grown by all of its doubt
+would cover the robot and leave no motion clear of anything."""
+HIT_EXPONENT = 2.0
 ROOM_WEIGHT = 0.2
 """What room up to ROOM_CAP_M over the horizon earns, against a whole horizon's progress."""
 NEAR_S = 1.0
@@ -54,8 +60,7 @@ DEPTH_WEIGHT = 4.0
 ROOM_CAP_M = 1.0
 """Room beyond this (m) earns nothing more."""
 KEEP_BONUS = 0.1
-"""What keeping the last evasion's heading (within KEEP_RAD) earns: no dithering between equals."""
-KEEP_RAD = math.radians(12.0)
+"""What keeping the last evasion's command earns: no dithering between equals."""
 
 
 @dataclass(frozen=True)
@@ -77,13 +82,14 @@ class Evasion:
     horizon_s: float
     margin_m: float
     growth_mps: float
-    kept: float | None = None
-    """The heading (rad, world) of the last evasion, None when the last tick needed none."""
+    kept: tuple[float, float] | None = None
+    """The command (m/s, rad/s) of the last evasion, None when the last tick needed none."""
 
     def threat(self, position: np.ndarray, tracks: tuple[Track, ...], time_s: float) -> Threat:
         """The moving tracks that could come within the margin of the robot at `position` (m)
         within the horizon from `time_s` (s), whatever it does (each closing at its speed plus
-        the robot's top); each where it is predicted at `time_s`."""
+        the robot's top); each where it is predicted at `time_s`, its disc and its growth wider
+        by its doubt (up to DOUBT_CAP_M and DOUBT_CAP_MPS)."""
         top = self.body.limits.max_speed_mps
         rows = []
         for track in tracks:
@@ -91,26 +97,21 @@ class Evasion:
                 continue
             x, y = track.predicted(time_s)
             speed = math.hypot(track.velocity[0], track.velocity[1])
-            growth = self.growth_mps + track.velocity_std_mps
-            size = track.radius_m + track.position_std_m
+            growth = self.growth_mps + min(track.velocity_std_mps, DOUBT_CAP_MPS)
+            size = track.radius_m + min(track.position_std_m, DOUBT_CAP_M)
             reach = (top + speed + growth) * self.horizon_s + self.body.radius_m + self.margin_m + size
             if math.hypot(x - position[0], y - position[1]) < reach:
                 rows.append((x, y, track.velocity[0], track.velocity[1], size, growth))
         return Threat(np.array(rows, dtype=float).reshape(-1, 6))
 
-    def candidates(self, wanted: float, speed: float, yaw: float) -> np.ndarray:
-        """The motions to rank (C, 2: heading in rad, world; speed in m/s): the one asked for
-        (`wanted`, rad; `speed`, m/s) first, then HEADING_OFFSETS_DEG about it and about the
-        robot's heading `yaw` (rad) at SPEED_SHARES of the top speed, the last evasion's heading
-        likewise, standing, and backing off (BACK_SHARES)."""
-        top = self.body.limits.max_speed_mps
-        headings = [base + math.radians(offset) for base in (wanted, yaw) for offset in HEADING_OFFSETS_DEG]
-        if self.kept is not None:
-            headings.append(self.kept)
-        rows = [(wanted, speed)]
-        rows += [(heading, share * top) for heading in headings for share in SPEED_SHARES]
-        rows += [(yaw, 0.0)]
-        rows += [(yaw, -share * top) for share in BACK_SHARES]
+    def candidates(self, wanted: tuple[float, float]) -> np.ndarray:
+        """The motions to rank (C, 3: speed m/s, turn rate rad/s, held s; then on for the aim):
+        the command asked for (`wanted`, held HOLDS_S[0]) first, then SPEED_SHARES x TURN_SHARES
+        of the robot's limits, each held HOLDS_S."""
+        limits = self.body.limits
+        top, turn = limits.max_speed_mps, limits.max_turn_rate_radps
+        rows = [(wanted[0], wanted[1], HOLDS_S[0])]
+        rows += [(v * top, w * turn, hold) for v in SPEED_SHARES for w in TURN_SHARES for hold in HOLDS_S]
         return np.array(rows, dtype=float)
 
     def risks(
@@ -147,18 +148,18 @@ class Evasion:
 
     def ranking(self, candidates: np.ndarray, risks: np.ndarray) -> np.ndarray:
         """The candidates' indices, best first, by their score: the progress toward the aim over
-        the horizon as a share of the top speed's, plus ROOM_WEIGHT of the room kept (up to ROOM_CAP_M), plus
-        KEEP_BONUS near the last evasion's heading, less HIT_WEIGHT (1 - t / horizon)^2 for
-        meeting a track at t and DEPTH_WEIGHT times the overlap predicted within NEAR_S."""
+        the horizon as a share of the top speed's, plus ROOM_WEIGHT of the room kept (up to
+        ROOM_CAP_M), plus KEEP_BONUS for the last evasion's command, less HIT_WEIGHT
+        (1 - t / horizon)^HIT_EXPONENT for meeting a track at t and DEPTH_WEIGHT times the
+        overlap predicted within NEAR_S."""
         top = self.body.limits.max_speed_mps * self.horizon_s
         soon = 1.0 - np.minimum(risks[:, 0], self.horizon_s) / self.horizon_s
         score = (
             risks[:, 2] / top
             + ROOM_WEIGHT * np.clip(risks[:, 1], 0.0, ROOM_CAP_M) / ROOM_CAP_M
-            - HIT_WEIGHT * soon * soon
+            - HIT_WEIGHT * soon**HIT_EXPONENT
             - DEPTH_WEIGHT * np.maximum(0.0, -risks[:, 5])
         )
         if self.kept is not None:
-            near = np.abs((candidates[:, 0] - self.kept + math.pi) % (2 * math.pi) - math.pi) < KEEP_RAD
-            score += KEEP_BONUS * (near & (candidates[:, 1] > 0))
+            score += KEEP_BONUS * np.all(candidates[:, :2] == self.kept, axis=1)
         return np.argsort(-score, kind="stable")

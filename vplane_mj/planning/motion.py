@@ -419,7 +419,7 @@ class Governor:
         if command is None:
             command = self._creep(local, obs.yaw, wanted) or (0.0, 0.0)
         if self.evasion is not None and obs.tracks:
-            command = self._evade(command, obs, local, wanted, obs.goal if aim is None else aim)
+            command = self._evade(command, obs, local, obs.goal if aim is None else aim)
         self.drive.commanded(command)
         shown = (
             np.array([math.cos(wanted), math.sin(wanted)])
@@ -474,17 +474,12 @@ class Governor:
         return direction, command
 
     def _evade(
-        self,
-        command: tuple[float, float],
-        obs: Observation,
-        local: np.ndarray,
-        wanted: float,
-        aim: np.ndarray,
+        self, command: tuple[float, float], obs: Observation, local: np.ndarray, aim: np.ndarray
     ) -> tuple[float, float]:
         """`command`, or when a moving track meets its motion within the evasion's horizon, the
-        first command of the best of the evasion's candidate motions (`Evasion.ranking`, about
-        `wanted`, rad, world, making for `aim`, m, world) that the static points of `local`
-        allow (`_safe`); the best of them all when none does."""
+        command of the best of the evasion's candidate motions (`Evasion.ranking`, making for
+        `aim`, m, world) that the static points of `local` allow (`_safe`); the best of them
+        all when none does."""
         evasion = self.evasion
         assert evasion is not None
         threat = evasion.threat(obs.position, obs.tracks, obs.time_s)
@@ -492,20 +487,20 @@ class Governor:
             evasion.kept = None
             return command
         pose = (float(obs.position[0]), float(obs.position[1]), float(obs.yaw))
-        candidates = evasion.candidates(wanted, command[0], float(obs.yaw))
-        risks = evasion.risks(candidates, pose, self.drive.ramp, threat, aim)
-        if math.isinf(risks[0, 0]):
+        candidates = evasion.candidates(command)
+        if math.isinf(evasion.risks(candidates[:1], pose, self.drive.ramp, threat, aim)[0, 0]):
             evasion.kept = None
-            return command
+            return command  # the command asked for meets no track: the others need no check
+        risks = evasion.risks(candidates, pose, self.drive.ramp, threat, aim)
         ranking = evasion.ranking(candidates, risks)
         chosen = ranking[0]
         for index in ranking:
-            candidate = (float(risks[index, 3]), float(risks[index, 4]))
+            candidate = (float(candidates[index, 0]), float(candidates[index, 1]))
             if not self._moves(candidate) or self._safe(candidate, local, self.turn_margin_m):
                 chosen = index
                 break
-        evasion.kept = float(candidates[chosen, 0]) if candidates[chosen, 1] > 0 else None
-        return float(risks[chosen, 3]), float(risks[chosen, 4])
+        evasion.kept = (float(candidates[chosen, 0]), float(candidates[chosen, 1]))
+        return evasion.kept
 
     def _creep(self, local: np.ndarray, yaw: float, wanted: float) -> tuple[float, float] | None:
         """For a robot that no motion keeps the turn margin: straight on at the back-off speed or

@@ -1,15 +1,15 @@
 """Motions checked against moving obstacles in time, compiled (`planning.evasion`).
 
-A candidate is a heading (rad, world) and a speed (m/s, negative: backing without turning):
-the robot turns toward the heading as the heading controller turns it (turn rate k_w e, limited,
-ramped) while its speed ramps toward the candidate's times max(0, cos e), e the heading error,
-for the horizon. At every time step its footprint is set against each tracked obstacle's disc
-where its constant-velocity prediction puts it then, the disc grown with time for the
-prediction's doubt. What comes back per candidate: the first time (s) a disc comes within the
-margin of the footprint (inf: none within the horizon), the least gap (m) over the horizon
-(footprint to disc, less the growth; negative: they overlap), the progress (m) toward a point
-until then, the command (m/s, rad/s) of the motion's first step, and the least gap over its
-first moments.
+A candidate is a command (speed m/s, turn rate rad/s) held for a while, after which the robot
+makes for the point it is going to as the heading controller drives it (turn rate k_w e,
+limited; speed the top one times max(0, cos e), e the heading error): a dodge, then on. Speeds
+and turn rates ramp at the drive's accelerations throughout. At every time step the robot's
+footprint is set against each tracked obstacle's disc where its constant-velocity prediction
+puts it then, the disc grown with time for the prediction's doubt. What comes back per
+candidate: the first time (s) a disc comes within the margin of the footprint (inf: none within
+the horizon), the least gap (m) (footprint to disc, less the growth; negative: they overlap),
+the progress (m) toward the point until then, the command, and the least gap over its first
+moments. `arc_hits` does the same for constant commands alone (the dynamic window's arcs).
 """
 
 from __future__ import annotations
@@ -66,16 +66,17 @@ def candidate_risks(
     aim: tuple[float, float],
     near_s: float,
 ) -> np.ndarray:
-    """(C, 6) per candidate of `candidates` (C, 2: heading in rad, world; speed in m/s) followed
-    for `timing[0]` s from the robot's `pose` (x, y in m, yaw in rad; world) and its speed and
-    turn rate `state`, checked every `timing[1]` s, within `limits` (top speed m/s, top turn
-    rate rad/s, acceleration m/s^2, braking m/s^2, turn acceleration rad/s^2, and the heading
-    controller's turn gain k_w, 1/s): the first time (s) a track's disc comes within
-    `margin_m` of the footprint `outline` (k, 2; robot frame, within `reach_m` of the origin),
-    inf for none; the least gap (m) (of a motion that meets a track, up to then or to `near_s`,
-    whichever is later); the progress (m) toward the point `aim` (world) up to that time (or the
-    horizon): how much nearer it the robot gets; the first step's speed (m/s) and
-    turn rate (rad/s); and the least gap (m) within the first `near_s` s. `tracks` (N, 6): x, y
+    """(C, 6) per candidate of `candidates` (C, 3: a command's speed in m/s and turn rate in
+    rad/s, held for its third column's seconds; then the heading controller makes for `aim`
+    at the top speed) followed for `timing[0]` s from the robot's `pose` (x, y in m, yaw in rad;
+    world) and its speed and turn rate `state`, ramped within `limits` (top speed m/s, top
+    turn rate rad/s, acceleration m/s^2, braking m/s^2, turn acceleration rad/s^2, and the
+    heading controller's turn gain k_w, 1/s), checked every `timing[1]` s: the first time (s) a
+    track's disc comes within `margin_m` of the footprint `outline` (k, 2; robot frame, within
+    `reach_m` of the origin), inf for none; the least gap (m) (of a motion that meets a track,
+    up to then or to `near_s`, whichever is later); the progress (m) toward the point `aim`
+    (world) up to that time (or the horizon): how much nearer it the robot gets; the command
+    (m/s, rad/s); and the least gap (m) within the first `near_s` s. `tracks` (N, 6): x, y
     (m), vx, vy (m/s), radius (m) and its growth (m/s)."""
     horizon, dt = timing
     top_speed, top_turn, accel, brake, alpha, gain = limits
@@ -85,24 +86,20 @@ def candidate_risks(
     ax, ay = aim
     away = math.hypot(ax - x0, ay - y0)
     for c in range(candidates.shape[0]):
-        heading, speed = candidates[c, 0], candidates[c, 1]
+        v_hold, w_hold, hold_s = candidates[c, 0], candidates[c, 1], candidates[c, 2]
         v, w = state
         x, y, yaw = x0, y0, yaw0
         hit, least, near, advance = math.inf, math.inf, math.inf, 0.0
-        first_v, first_w = 0.0, 0.0
         for s in range(1, steps + 1):
             t = s * dt
-            if speed < 0.0:
-                v_cmd, w_cmd = speed, 0.0
-            else:
-                error = _wrap(heading - yaw)
-                v_cmd = speed * max(0.0, math.cos(error))
+            if t <= hold_s + 1e-9:
+                v_cmd, w_cmd = v_hold, w_hold
+            else:  # resume: the heading controller toward the aim, at the top speed
+                error = _wrap(math.atan2(ay - y, ax - x) - yaw)
+                v_cmd = top_speed * max(0.0, math.cos(error))
                 w_cmd = min(max(gain * error, -top_turn), top_turn)
-                # No faster a turn than one that stops when the heading is reached.
-                stop = math.sqrt(2.0 * alpha * abs(error))
+                stop = math.sqrt(2.0 * alpha * abs(error))  # no turn faster than one that stops there
                 w_cmd = min(max(w_cmd, -stop), stop)
-            if s == 1:
-                first_v, first_w = v_cmd, w_cmd
             rate = accel if abs(v_cmd) > abs(v) and v_cmd * v >= 0.0 else brake
             v_next = _toward(v, min(max(v_cmd, -top_speed), top_speed), rate * dt)
             w_next = _toward(w, w_cmd, alpha * dt)
@@ -130,7 +127,7 @@ def candidate_risks(
             elif t >= near_s:
                 break  # what is left to learn of a motion that meets a track: nothing that ranks it
         result[c, 0], result[c, 1], result[c, 2] = hit, least, advance
-        result[c, 3], result[c, 4], result[c, 5] = first_v, first_w, near
+        result[c, 3], result[c, 4], result[c, 5] = v_hold, w_hold, near
     return result
 
 
