@@ -705,3 +705,33 @@ def test_the_nearest_cell_is_the_first_nearest_of_the_cells_near_a_point():
             assert nearest is None
         else:
             np.testing.assert_array_equal(nearest, cells[np.argmin(np.hypot(*(cells - point).T))])
+
+
+def test_the_map_forgets_the_cells_under_a_moving_track_and_keeps_the_rest():
+    from vplane_mj.planning.perception.tracker import Track
+
+    grid = mapped(WALL, (0.0, 0.0))
+    before = {tuple(c) for c in grid.cells(min_certainty=1)[0].round(3)}
+    assert before
+
+    def track(moving: bool) -> Track:
+        return Track(
+            track_id=1,
+            position=np.array([2.0, 0.5]),
+            velocity=np.array([0.0, 1.0]),
+            radius_m=0.2,
+            position_std_m=0.01,
+            velocity_std_mps=0.01,
+            first_seen_s=0.0,
+            last_seen_s=0.0,
+            moving=moving,
+            stamp_s=0.0,
+        )
+
+    grid.forget((track(False),), 0.0)
+    assert {tuple(c) for c in grid.cells(min_certainty=1)[0].round(3)} == before  # a fixed track stays
+    grid.forget((track(True),), 0.5, margin_m=0.1)  # predicted at (2.0, 1.0), cleared 0.3 m round it
+    after = grid.cells(min_certainty=1)[0]
+    assert np.all(np.hypot(after[:, 0] - 2.0, after[:, 1] - 1.0) > 0.3)
+    kept = [c for c in before if math.hypot(c[0] - 2.0, c[1] - 1.0) > 0.3 + 1e-9]
+    assert {tuple(c) for c in after.round(3)} == set(kept) and len(kept) < len(before)

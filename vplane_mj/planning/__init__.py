@@ -7,6 +7,7 @@ The names for writing a planner of one's own (docs/own-planner.md):
 - `RobotBody`, `DriveLimits`, `HeadingGains`: the robot a planner is built for (footprint,
   limits, the heading controller's gains, sensor kind);
 - `Observation`, `Decision`, `Event`, `EventKind`, `point`: what it receives and returns;
+  `Track`, an obstacle the run's tracker follows (`Observation.tracks`);
 - `PlannerParams`, `param`, `with_default`: its parameters as a frozen dataclass;
 - `FieldParams`, `DetectorParams`, `MinimumParams`, `LocalMapParams`, `SonarMapParams`: the
   parameter groups of the built-in planners with their set-ups (fields, local-minimum
@@ -28,6 +29,7 @@ from vplane_mj.planning.groups import (
 from vplane_mj.planning.localmap import LocalMap
 from vplane_mj.planning.minima import LocalMinimumDetector, report_trap
 from vplane_mj.planning.params import Param, ParamError, PlannerParams, param, with_default
+from vplane_mj.planning.perception.tracker import Track
 from vplane_mj.planning.plugins import PlannerError
 from vplane_mj.planning.registry import load_planner, register_planner
 from vplane_mj.planning.types import Decision, Observation
@@ -53,6 +55,7 @@ __all__ = [
     "PlannerParams",
     "RobotBody",
     "SonarMapParams",
+    "Track",
     "load_planner",
     "param",
     "point",

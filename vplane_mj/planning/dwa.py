@@ -285,6 +285,7 @@ class DwaPlanner(Planner):
     def step(self, obs: Observation) -> Decision:
         p = self.params
         self.map.update(obs.position, obs.yaw, obs.bearings, obs.static_ranges(), obs.beam_width)
+        self.map.forget(obs.tracks, obs.time_s)
         speeds, turns = self.window(obs)
         dist = self.free_distance(obs, speeds, turns)
         admissible = self.stopping_length(speeds, turns) <= dist

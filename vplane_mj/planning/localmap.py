@@ -48,7 +48,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from vplane_mj.planning.beams import BeamFan
+from vplane_mj.planning.perception.tracker import Track
 
+FORGET_MARGIN_M = 0.2
+"""`forget` clears this far (m) beyond a moving track's disc: the trail its echoes left in the
+scans before it was known to move (a scan or two, at up to 2 m/s)."""
 _NONE = np.zeros((0, 0), dtype=bool)
 """An empty mask: no cell skipped."""
 
@@ -71,7 +75,7 @@ class LocalMap:
 
         self._fold_scan = map_update.fold_scan
         self._cells_near, self._nearest_cell = grid.cells_near, grid.nearest_cell
-        self._mark_disc = grid.mark_disc
+        self._mark_disc, self._clear_disc = grid.mark_disc, grid.clear_disc
         self._dilate, self._label_regions = grid.dilate, grid.label_regions
         self.cell_m = cell_m
         self.n = max(8, math.ceil(size_m / cell_m))
@@ -156,6 +160,19 @@ class LocalMap:
         self._mark_disc(
             self._swept, self._seen, origin, self.cell_m, float(position[0]), float(position[1]), radius_m
         )
+
+    def forget(self, tracks: tuple[Track, ...], time_s: float, margin_m: float = FORGET_MARGIN_M) -> None:
+        """Clear the cells under each moving track's disc, its radius plus `margin_m` (m), where
+        it is predicted at `time_s` (s): what echoed there is the track itself, or the trail of
+        echoes it left before it was known to move."""
+        if self.origin is None:
+            return
+        for track in tracks:
+            if track.moving:
+                x, y = track.predicted(time_s)
+                self._clear_disc(
+                    self._grid, self.origin, self.cell_m, float(x), float(y), track.radius_m + margin_m
+                )
 
     def cells(
         self,

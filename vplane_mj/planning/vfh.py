@@ -70,6 +70,7 @@ class VfhPlanner(Planner):
     def step(self, obs: Observation) -> Decision:
         p = self.params
         self.map.update(obs.position, obs.yaw, obs.bearings, obs.static_ranges(), obs.beam_width)
+        self.map.forget(obs.tracks, obs.time_s)
         enlarge = self.robot.half_width_m + p.clearance_m
         window = min(p.window_m, obs.distance_to_goal() + enlarge)  # nothing beyond the goal blocks it
         h, _ = histogram.map_histogram(

@@ -131,6 +131,7 @@ class VPlanePlanner(Planner):
     def step(self, obs: Observation) -> Decision:
         p = self.params
         self.map.update(obs.position, obs.yaw, obs.bearings, obs.static_ranges(), obs.beam_width)
+        self.map.forget(obs.tracks, obs.time_s)
         self.echoes.append(obs.static_echo_points())
         decision = Decision(force=np.zeros(2), mode="normal")
         if self.planes:

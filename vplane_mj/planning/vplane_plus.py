@@ -69,8 +69,9 @@ BEND_HORIZON_M = 3.0
 """The way this far ahead (m) bounds the speed by the turns it asks for (motion.py)."""
 TRAP_REACH_M = 2.5
 """Obstacle cells farther than this from the robot are not part of the trap it is in."""
-AIM_AHEAD_M = 3.0
-"""Among moving tracks, the governor makes for the point of the way this far (m) along it."""
+AIM_AHEAD_M = 8.0
+"""Among moving tracks, the governor makes for the point of the way this far (m) along it:
+farther than the robot gets within the evasion's horizon, so that no motion overshoots it."""
 OFF_WAY_M = 0.5
 """A robot this far (m) from the way it follows (pushed off it evading a moving track) searches
 its way again, at most every OFF_WAY_PERIOD_S."""
@@ -176,6 +177,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         if self._moved_since_last_scan(obs):
             self.map.update(obs.position, obs.yaw, obs.bearings, obs.static_ranges(), obs.beam_width)
             self.map.sweep(obs.position, self.robot.inner_radius_m)  # under the robot at any heading
+        self.map.forget(obs.tracks, obs.time_s)
         decision = Decision(force=np.zeros(2), mode="normal")
         if not self.following and self.last_scan_pose is not None and scan.is_dense(obs):
             self._start_following(obs, decision, "a dense scan maps the way from the start")
@@ -542,10 +544,15 @@ class VPlanePlusPlanner(VPlanePlanner):
             followed, position = self.follow_way, obs.position
             searched = obs.time_s - (self.next_replan_s - p.replan_period_s)  # since the last search
             left = searched >= OFF_WAY_PERIOD_S and self._off_the_way(position)
-            if not len(followed) or not (left or self._way_is_blocked(position, followed)):
+            if not len(followed) or not (
+                left or self._way_is_blocked(position, followed) or self._way_ends_here(obs)
+            ):
                 return waypoint
             decision.events.append(
-                Event(EventKind.WAY_CHANGED, "the way ahead is blocked on the map, or left: searched again")
+                Event(
+                    EventKind.WAY_CHANGED,
+                    "the way ahead is blocked on the map, left, or ends short of the goal: searched again",
+                )
             )
         self.next_replan_s = obs.time_s + p.replan_period_s
         way = self._way_to_goal(obs, decision)
@@ -567,10 +574,18 @@ class VPlanePlusPlanner(VPlanePlanner):
             decision.events.append(Event(EventKind.WAY_CHANGED, "the map shows a way to the goal again"))
         self.no_way_since = None
         kept = self._way_cost(obs.position, self.follow_way, obs.goal) if len(self.follow_way) else np.inf
-        if kept > KEEP_WAY_RATIO * self._way_cost(obs.position, way, obs.goal):
+        if kept > KEEP_WAY_RATIO * self._way_cost(obs.position, way, obs.goal) or self._way_ends_here(obs):
             self.follow_way = way  # else the current way stays: no flip-flop between similar ways
         waypoint, self.follow_way = self._next_waypoint(obs.position, self.follow_way, obs.goal)
         return waypoint
+
+    def _way_ends_here(self, obs: Observation) -> bool:
+        """Whether the way followed ends within `waypoint_m` of the robot short of the goal: it
+        ran to the edge of the map, which has moved with the robot since (a goal farther than
+        half the map away)."""
+        end = self.follow_way[-1]
+        near = math.hypot(end[0] - obs.position[0], end[1] - obs.position[1]) <= self.params.waypoint_m
+        return near and math.hypot(end[0] - obs.goal[0], end[1] - obs.goal[1]) > obs.goal_tolerance
 
     def _off_the_way(self, position: np.ndarray) -> bool:
         """Whether the robot stands farther than OFF_WAY_M from every point of the way it follows."""

@@ -109,6 +109,21 @@ def mark_disc(
 
 
 @njit(cache=True)
+def clear_disc(
+    grid: np.ndarray, first_cell: np.ndarray, cell_m: float, x: float, y: float, radius_m: float
+) -> None:
+    """Set to 0 the certainty of the cells of `grid` whose centres lie within `radius_m` of (x, y)
+    (m); cell (i, j) as in `cells_near`."""
+    lo_i, lo_j, hi_i, hi_j = square(first_cell, grid.shape[0], cell_m, x, y, radius_m)
+    for i in range(lo_i, hi_i):
+        rel_x = ((first_cell[0] + i) + 0.5) * cell_m - x
+        for j in range(lo_j, hi_j):
+            rel_y = ((first_cell[1] + j) + 0.5) * cell_m - y
+            if math.hypot(rel_x, rel_y) <= radius_m:
+                grid[i, j] = 0
+
+
+@njit(cache=True)
 def dilate(mask: np.ndarray, disk: np.ndarray) -> np.ndarray:
     """Binary dilation of `mask` by the centred structuring element `disk` (cells beyond the edge
     are off)."""

@@ -260,8 +260,8 @@ class TrackerParams(PlannerParams):
     static_drop_s: float = param(
         1.0, "s", "a track that is not moving, judged fixed this long, is dropped (left to the map)", ge=0
     )
-    moving_floor_mps: float = param(0.3, "m/s", "a track slower than this is not moving", ge=0)
-    moving_sigmas: float = param(2.0, "", "a moving track's speed exceeds its 1-sigma this many times", ge=0)
+    moving_floor_mps: float = param(0.15, "m/s", "a track slower than this is not moving", ge=0)
+    moving_sigmas: float = param(1.0, "", "a moving track's speed exceeds its 1-sigma this many times", ge=0)
     moving_min_hits: int = param(
         2,
         "",
