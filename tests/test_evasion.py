@@ -66,6 +66,7 @@ def test_a_dodge_resumes_toward_the_aim():
     risks = EVASION.risks(candidates, (0.0, 0.0, 0.0), (1.5, 0.0), no_threat, np.array([10.0, 0.0]))
     assert risks[0, 2] > 2.5 > risks[1, 2]
 
+
 def test_tracks_that_stand_still_or_cannot_reach_the_robot_are_no_threat():
     far = track(40.0, 0.0, -1.0, 0.0)
     assert not EVASION.threat(np.zeros(2), (track(2.0, 0.0, 0.0, 0.0, moving=False), far), 0.0)

@@ -542,11 +542,11 @@ class VPlanePlusPlanner(VPlanePlanner):
         waypoint, self.follow_way = self._next_waypoint(obs.position, self.follow_way, obs.goal)
         if obs.time_s < self.next_replan_s:
             followed, position = self.follow_way, obs.position
+            if not len(followed):
+                return waypoint
             searched = obs.time_s - (self.next_replan_s - p.replan_period_s)  # since the last search
             left = searched >= OFF_WAY_PERIOD_S and self._off_the_way(position)
-            if not len(followed) or not (
-                left or self._way_is_blocked(position, followed) or self._way_ends_here(obs)
-            ):
+            if not (left or self._way_is_blocked(position, followed) or self._way_ends_here(obs)):
                 return waypoint
             decision.events.append(
                 Event(
