@@ -26,13 +26,12 @@ nothing changes.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from vplane_mj.planning.body import RobotBody
-from vplane_mj.planning.perception.tracker import Track
+from vplane_mj.planning.perception.tracker import Track, moving_tracks
 
 STEP_S = 0.1
 """Time step (s) of the check along a candidate's motion."""
@@ -90,19 +89,17 @@ class Evasion:
         within the horizon from `time_s` (s), whatever it does (each closing at its speed plus
         the robot's top); each where it is predicted at `time_s`, its disc and its growth wider
         by its doubt (up to DOUBT_CAP_M and DOUBT_CAP_MPS)."""
+        moving = moving_tracks(tracks, time_s)
+        if not len(moving):
+            return Threat(np.empty((0, 6)))
+        speed = np.hypot(moving[:, 2], moving[:, 3])
+        growth = self.growth_mps + np.minimum(moving[:, 6], DOUBT_CAP_MPS)
+        size = moving[:, 4] + np.minimum(moving[:, 5], DOUBT_CAP_M)
         top = self.body.limits.max_speed_mps
-        rows = []
-        for track in tracks:
-            if not track.moving:
-                continue
-            x, y = track.predicted(time_s)
-            speed = math.hypot(track.velocity[0], track.velocity[1])
-            growth = self.growth_mps + min(track.velocity_std_mps, DOUBT_CAP_MPS)
-            size = track.radius_m + min(track.position_std_m, DOUBT_CAP_M)
-            reach = (top + speed + growth) * self.horizon_s + self.body.radius_m + self.margin_m + size
-            if math.hypot(x - position[0], y - position[1]) < reach:
-                rows.append((x, y, track.velocity[0], track.velocity[1], size, growth))
-        return Threat(np.array(rows, dtype=float).reshape(-1, 6))
+        reach = (top + speed + growth) * self.horizon_s + self.body.radius_m + self.margin_m + size
+        near = np.hypot(moving[:, 0] - position[0], moving[:, 1] - position[1]) < reach
+        rows = np.column_stack((moving[:, :4], size, growth))[near]
+        return Threat(np.ascontiguousarray(rows, dtype=float))
 
     def candidates(self, wanted: tuple[float, float]) -> np.ndarray:
         """The motions to rank (C, 3: speed m/s, turn rate rad/s, held s; then on for the aim):

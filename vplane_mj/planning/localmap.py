@@ -48,7 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vplane_mj.planning.beams import BeamFan
-from vplane_mj.planning.perception.tracker import Track
+from vplane_mj.planning.perception.tracker import Track, moving_tracks
 
 FORGET_MARGIN_M = 0.2
 """`forget` clears this far (m) beyond a moving track's disc: the trail its echoes left in the
@@ -75,7 +75,7 @@ class LocalMap:
 
         self._fold_scan = map_update.fold_scan
         self._cells_near, self._nearest_cell = grid.cells_near, grid.nearest_cell
-        self._mark_disc, self._clear_disc = grid.mark_disc, grid.clear_disc
+        self._mark_disc, self._clear_discs = grid.mark_disc, grid.clear_discs
         self._dilate, self._label_regions = grid.dilate, grid.label_regions
         self.cell_m = cell_m
         self.n = max(8, math.ceil(size_m / cell_m))
@@ -167,12 +167,10 @@ class LocalMap:
         echoes it left before it was known to move."""
         if self.origin is None:
             return
-        for track in tracks:
-            if track.moving:
-                x, y = track.predicted(time_s)
-                self._clear_disc(
-                    self._grid, self.origin, self.cell_m, float(x), float(y), track.radius_m + margin_m
-                )
+        moving = moving_tracks(tracks, time_s)
+        if len(moving):
+            discs = np.column_stack((moving[:, :2], moving[:, 4] + margin_m))
+            self._clear_discs(self._grid, self.origin, self.cell_m, discs)
 
     def cells(
         self,

@@ -109,18 +109,19 @@ def mark_disc(
 
 
 @njit(cache=True)
-def clear_disc(
-    grid: np.ndarray, first_cell: np.ndarray, cell_m: float, x: float, y: float, radius_m: float
-) -> None:
-    """Set to 0 the certainty of the cells of `grid` whose centres lie within `radius_m` of (x, y)
-    (m); cell (i, j) as in `cells_near`."""
-    lo_i, lo_j, hi_i, hi_j = square(first_cell, grid.shape[0], cell_m, x, y, radius_m)
-    for i in range(lo_i, hi_i):
-        rel_x = ((first_cell[0] + i) + 0.5) * cell_m - x
-        for j in range(lo_j, hi_j):
-            rel_y = ((first_cell[1] + j) + 0.5) * cell_m - y
-            if math.hypot(rel_x, rel_y) <= radius_m:
-                grid[i, j] = 0
+def clear_discs(grid: np.ndarray, first_cell: np.ndarray, cell_m: float, discs: np.ndarray) -> None:
+    """Set to 0 the certainty of the cells of `grid` whose centres lie within a disc of `discs`
+    (N, 3: x, y, radius; m); cell (i, j) as in `cells_near`."""
+    for k in range(discs.shape[0]):
+        x, y, radius_m = discs[k, 0], discs[k, 1], discs[k, 2]
+        lo_i, lo_j, hi_i, hi_j = square(first_cell, grid.shape[0], cell_m, x, y, radius_m)
+        for i in range(lo_i, hi_i):
+            rel_x = ((first_cell[0] + i) + 0.5) * cell_m - x
+            for j in range(lo_j, hi_j):
+                if grid[i, j] != 0:  # most are: no distance to measure
+                    rel_y = ((first_cell[1] + j) + 0.5) * cell_m - y
+                    if math.hypot(rel_x, rel_y) <= radius_m:
+                        grid[i, j] = 0
 
 
 @njit(cache=True)

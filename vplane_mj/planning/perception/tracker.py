@@ -142,6 +142,21 @@ def tracks_of(states: np.ndarray, values: np.ndarray, stamp_s: float) -> tuple[T
     return tuple(tracks)
 
 
+def moving_tracks(tracks: tuple[Track, ...], time_s: float) -> np.ndarray:
+    """The moving ones of `tracks`, packed (M, 7): x, y (m) predicted at `time_s` (s), vx, vy
+    (m/s), radius (m), position 1-sigma (m), velocity 1-sigma (m/s)."""
+    rows = [
+        (*t.position, *t.velocity, t.radius_m, t.position_std_m, t.velocity_std_mps, t.stamp_s)
+        for t in tracks
+        if t.moving
+    ]
+    if not rows:
+        return np.empty((0, 7))
+    packed = np.array(rows, dtype=float)
+    packed[:, :2] += packed[:, 2:4] * (time_s - packed[:, 7:8])
+    return packed[:, :7]
+
+
 @dataclass(frozen=True)
 class TrackerParams(PlannerParams):
     """The tracker's thresholds (defaults for a laser of about 0.4 degrees a beam and 0.01 m of
