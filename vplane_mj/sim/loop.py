@@ -190,7 +190,7 @@ class Run:
         self.tolerance = scenario.robot.goal_tolerance
         self.ranges = np.full(len(self.sensor.bearings), np.nan)
         self.next_scan_s = 0.0
-        self.tracker = Tracker()
+        self.tracker = Tracker() if scenario.sensors.kind == "laser" else None
         self.tracks: tuple[TrackedObstacle, ...] = ()
         self.moving_echoes: np.ndarray | None = None
         self.position = self.drive.xpos[:2].copy()
@@ -354,8 +354,9 @@ class Run:
     # -- the stages of a tick ---------------------------------------------------------------
     def _sense(self) -> tuple[np.ndarray, float]:
         """Read the range sensor (when a reading is due at its rate), the pose the planner uses,
-        and fold a new reading into the tracker at that pose: the pose (position in m, yaw in
-        rad), also kept for the rest of the tick."""
+        and fold a new reading into the tracker at that pose (a laser's: a sonar ring's cones put
+        too few echoes on an obstacle to cut a scan into clusters): the pose (position in m, yaw
+        in rad), also kept for the rest of the tick."""
         time_s = self.data.time
         self.yaw = self.drive.yaw()
         scanned = time_s >= self.next_scan_s - 1e-9
@@ -365,7 +366,7 @@ class Run:
                 self.next_scan_s += 1.0 / self.sensor.rate_hz
         self.yaws.append(self.yaw)
         self._belief = self.localiser.pose(self.position, self.yaw)
-        if scanned:
+        if scanned and self.tracker is not None:
             xy, yaw = self._belief
             self.tracks = self.tracker.update(time_s, xy, yaw, self.sensor.bearings, self.ranges)
             moving = self.tracker.moving_beams
