@@ -168,15 +168,16 @@ def test_tracks_are_drawn_and_vanish(tmp_path):
     updates = list(iter_messages(path, (TRACKS_TOPIC,)))
     assert [u.log_time_ns for u in updates] == [time_ns(0.05), time_ns(0.1), time_ns(0.15)]
     first, second, last = (u.message for u in updates)
-    shown = {entity.id: entity for entity in first.entities}
-    assert set(shown) == {"track_7", "track_2"} and not first.deletions
-    moving, still = shown["track_7"], shown["track_2"]
-    (arrow,) = moving.arrows
+    assert [e.id for e in first.entities] == ["track_7"] and not first.deletions  # the post stands
+    (arrow,) = first.entities[0].arrows
     assert arrow.shaft_length + arrow.head_length == pytest.approx(1.2 * TRACK_ARROW_S)
     assert (arrow.pose.position.x, arrow.pose.position.y) == (3.0, 2.0)
-    assert not still.arrows and moving.lines[0].color != still.lines[0].color
-    assert still.cylinders[0].size.x == pytest.approx(0.4) and still.texts[0].text == "2"
-    assert [d.id for d in second.deletions] == ["track_2"] and [e.id for e in second.entities] == ["track_7"]
+    assert (
+        first.entities[0].cylinders[0].size.x == pytest.approx(0.6)
+        and not first.entities[0].lines
+        and first.entities[0].texts[0].text == "7"
+    )
+    assert [e.id for e in second.entities] == ["track_7"] and not second.deletions
     assert [d.id for d in last.deletions] == ["track_7"] and not last.entities
 
 

@@ -5,8 +5,8 @@ with `/tf`). Force arrows start at the robot's centre and point along the force;
 length is `ARROW_M_PER_UNIT` per unit of force, clipped to `ARROW_MAX_M`. Virtual planes are
 thin translucent walls with their centre line; the virtual objective a sphere on a post;
 the path one line strip. Moving obstacles look like the static ones, wherever they stand; the
-planner's tracks are discs of their radius, coloured by whether they move, with their velocity
-as an arrow and their id as a label.
+planner's moving tracks are discs of their radius with their velocity as an arrow and their id
+as a label.
 """
 
 from __future__ import annotations
@@ -63,15 +63,12 @@ _COLOURS = {
     "robot": (0.20, 0.24, 0.32, 0.9),
     "heading": (1.00, 1.00, 1.00, 1.0),
     "outline": (1.00, 0.55, 0.10, 1.0),
-    "track_moving": (0.90, 0.15, 0.55, 1.0),
-    "track_static": (0.20, 0.60, 0.85, 1.0),
+    "track": (0.90, 0.15, 0.55, 1.0),
 }
-TRACK_FILL_ALPHA = 0.3
-"""Opacity of a track's disc (its outline and label are opaque)."""
+TRACK_FILL_ALPHA = 0.35
+"""Opacity of a track's cylinder (its arrow and label are opaque)."""
 TRACK_ARROW_S = 1.0
 """A moving track's velocity arrow reaches where it would be after this long (s)."""
-TRACK_OUTLINE_POINTS = 32
-"""Points of a track's outline."""
 
 
 IDENTITY = fm.Quaternion(x=0.0, y=0.0, z=0.0, w=1.0)
@@ -378,8 +375,7 @@ class TrackedObstacle(Protocol):
 
 
 class TrackMark(NamedTuple):
-    """A tracked obstacle as drawn: its id, centre (m), velocity (m/s), radius (m), and whether
-    it moves."""
+    """A moving track as drawn: its id, centre (m), velocity (m/s) and radius (m)."""
 
     track_id: int
     x: float
@@ -387,7 +383,6 @@ class TrackMark(NamedTuple):
     vx: float
     vy: float
     radius_m: float
-    moving: bool
 
     @property
     def entity_id(self) -> str:
@@ -395,46 +390,43 @@ class TrackMark(NamedTuple):
 
 
 def track_marks(tracks: Iterable[TrackedObstacle]) -> tuple[TrackMark, ...]:
-    """The tracks as numbers, taken when the tick comes (a tracker may reuse its objects); a track
-    without a finite centre and radius is left out."""
+    """The moving tracks, those the planners act on, as numbers taken when the tick comes (a
+    tracker may reuse its objects); one without a finite centre and radius is left out. Tracks
+    that stand (a BARN world's dozens of posts) are not drawn: they would double its log."""
     marks = []
     for track in tracks:
+        if not track.moving:
+            continue
         x, y = (float(v) for v in track.position[:2])
         vx, vy = (float(v) for v in track.velocity[:2])
         radius = float(track.radius_m)
         if math.isfinite(x) and math.isfinite(y) and math.isfinite(radius):
-            marks.append(TrackMark(int(track.track_id), x, y, vx, vy, max(radius, 0.0), bool(track.moving)))
+            marks.append(TrackMark(int(track.track_id), x, y, vx, vy, max(radius, 0.0)))
     return tuple(marks)
 
 
 def track_entity(when: fm.Timestamp, mark: TrackMark) -> fm.SceneEntity:
-    """A track: a translucent disc of its radius with its outline, its id as a label above it and,
-    when it moves, an arrow from its centre to where it will be in TRACK_ARROW_S."""
-    rgba = _COLOURS["track_moving" if mark.moving else "track_static"]
+    """A track: a translucent cylinder of its radius, a little taller than the obstacles (seen from
+    above, a tinted disc around the obstacle it follows), its id as a label above it and an arrow
+    from its centre to where it will be in TRACK_ARROW_S. No outline: a polygon per track at
+    every tick would be most of a log."""
+    rgba = _COLOURS["track"]
     colour = _colour(rgba)
-    z = 0.03
-    angles = np.linspace(0.0, 2 * math.pi, TRACK_OUTLINE_POINTS, endpoint=False)
-    ring = [
-        fm.Point3(x=mark.x + mark.radius_m * math.cos(a), y=mark.y + mark.radius_m * math.sin(a), z=z)
-        for a in angles
-    ]
-    arrow = _velocity_arrow(mark, colour) if mark.moving else None
+    height = OBSTACLE_HEIGHT_M + 0.05
     return fm.SceneEntity(
         timestamp=when,
         frame_id=WORLD_FRAME,
         id=mark.entity_id,
-        cylinders=[_flat_disc((mark.x, mark.y), mark.radius_m, (*rgba[:3], TRACK_FILL_ALPHA))],
-        lines=[
-            fm.LinePrimitive(
-                type=fm.LinePrimitiveLineType.LineLoop,
-                pose=pose(0.0, 0.0),
-                thickness=0.03,
-                scale_invariant=False,
-                points=ring,
-                color=colour,
+        cylinders=[
+            fm.CylinderPrimitive(
+                pose=pose(mark.x, mark.y, height / 2),
+                size=fm.Vector3(x=2 * mark.radius_m, y=2 * mark.radius_m, z=height),
+                bottom_scale=1.0,
+                top_scale=1.0,
+                color=_colour((*rgba[:3], TRACK_FILL_ALPHA)),
             )
         ],
-        arrows=[] if arrow is None else [arrow],
+        arrows=[arrow] if (arrow := _velocity_arrow(mark, colour)) is not None else [],
         texts=[
             fm.TextPrimitive(
                 pose=pose(mark.x, mark.y, OBSTACLE_HEIGHT_M + 0.1),

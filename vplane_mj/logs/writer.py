@@ -21,7 +21,7 @@ messages' own `timestamp` fields, is the integer nanosecond of *simulated* time,
 | `/run/events` | JSON (`vplane_mj.Event` JSON schema) | the same events as data: kind, text, points |
 | `/metrics` | JSON (`vplane_mj.Metrics` JSON schema) | every tick (see below) |
 | `/robot/odometry` | `foxglove.PoseInFrame` | believed pose, every tick, if `sensors.pose = "odometry"` |
-| `/tracks` | `foxglove.SceneUpdate` | every tick with tracks, from the first (and when the last vanish) |
+| `/tracks` | `foxglove.SceneUpdate` | ticks with moving tracks, from the first (and when the last vanish) |
 
 An arrow whose force is (near) zero or not finite is deleted until it comes back.
 Entity ids: `/forces` `attractive`, `repulsive`, `virtual`,
@@ -37,7 +37,7 @@ heading arrow, in frame `base_link`, frame-locked, so it moves with `/tf`); `/wo
 `obstacle_<i>` for each moving obstacle (never in `/world`), every message all of them where
 they stood at its time: the tick's `Tick.obstacles`, and where ticks are further apart than
 `MOVING_PERIOD_S`, their motions' places between them; `/tracks` `track_<id>`, the planner's
-tracked obstacles as it estimates them (in its own frame, the world's unless its pose comes
+moving tracks as it estimates them (in its own frame, the world's unless its pose comes
 from odometry). Entities that vanish are removed with `SceneUpdate.deletions`.
 
 `/scan` holds the sensor's ranges from the robot's centre at the sensor's height, rounded to
