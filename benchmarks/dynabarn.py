@@ -137,7 +137,7 @@ def plot(table: list[dict], path: Path) -> None:
     planners = list(dict.fromkeys(row["planner"] for row in table))
     x = np.arange(len(THIRDS))
     width = 0.8 / max(1, len(planners))
-    figure, ax = plt.subplots(figsize=(7, 4))
+    figure, ax = plt.subplots(figsize=(7, 4.8))
     for k, planner in enumerate(planners):
         rates = {row["third"]: row["success_rate"] for row in table if row["planner"] == planner}
         ax.bar(
@@ -146,13 +146,13 @@ def plot(table: list[dict], path: Path) -> None:
             width,
             label=planner,
         )
-    for (name, rates), marker in zip(PUBLISHED[:2], ("v", "^"), strict=True):
+    for (name, rates), marker in zip(PUBLISHED, ("v", "^", "s", "D"), strict=True):
         shown = [(i, 100 * r) for i, r in enumerate(rates) if r is not None]
         ax.scatter(*zip(*shown, strict=True), marker=marker, color="black", zorder=3, label=name)
     ax.set_xticks(x, THIRDS)
     ax.set_ylabel("success, % of runs")
     ax.set_ylim(0, 100)
-    ax.legend(fontsize=7, loc="upper right", ncols=2)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.08), ncols=4)
     runs = next(row["runs"] for row in table if row["third"] == "all")
     ax.set_title(f"Generated DynaBARN worlds, Jackal with laser ({runs} runs per planner)")
     figure.tight_layout()

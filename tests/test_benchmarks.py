@@ -161,6 +161,33 @@ def test_barn_protocol_sweeps_the_planners_beside_barns_published_figures(tmp_pa
     assert (tmp_path / "barn" / "barn_protocol.png").stat().st_size > 1000
 
 
+def test_dynabarn_sweeps_each_third_beside_the_published_rates(tmp_path):
+    out = run_benchmark(
+        "dynabarn.py",
+        *("--count", "3", "--seeds", "0", "--planners", "apf", "--out", "dyn"),
+        cwd=tmp_path,
+    )
+    rows = list(csv.DictReader((tmp_path / "dyn" / "dynabarn.csv").open()))
+    assert [(row["third"], row["runs"]) for row in rows] == [
+        ("easy", "1"),
+        ("medium", "1"),
+        ("hard", "1"),
+        ("all", "3"),
+    ]
+    assert table_rows(out, "DynaBARN: DWA") and (tmp_path / "dyn" / "dynabarn.md").is_file()
+    assert (tmp_path / "dyn" / "dynabarn.png").stat().st_size > 1000
+
+
+def test_tracker_accuracy_scores_the_tracks_against_the_simulator(tmp_path):
+    out = run_benchmark(
+        "tracker_accuracy.py", "--count", "3", "--planner", "apf", "--out", "acc", cwd=tmp_path
+    )
+    (row,) = table_rows(out, "all")
+    assert int(row[1]) > 0  # obstacle-ticks scored
+    assert 0.5 < number(row[2].rstrip("%")) / 100 <= 1.0  # found
+    assert 0.0 <= number(row[4]) < 0.1  # median position error (m)
+
+
 def test_sweep_rate_counts_runs_per_core_minute_of_each_planners_sweep(tmp_path):
     out = run_benchmark(
         "sweep_rate.py", *("--worlds", "2", "--planners", "apf,vplane", "--out", "rate"), cwd=tmp_path
