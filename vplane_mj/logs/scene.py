@@ -5,8 +5,8 @@ with `/tf`). Force arrows start at the robot's centre and point along the force;
 length is `ARROW_M_PER_UNIT` per unit of force, clipped to `ARROW_MAX_M`. Virtual planes are
 thin translucent walls with their centre line; the virtual objective a sphere on a post;
 the path one line strip. Moving obstacles look like the static ones, wherever they stand; the
-planner's moving tracks are discs of their radius with their velocity as an arrow and their id
-as a label.
+planner's moving tracks are translucent cylinders of their radius with their velocity as an
+arrow and their id as a label.
 """
 
 from __future__ import annotations
