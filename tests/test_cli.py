@@ -322,4 +322,4 @@ def test_version_names_the_package_and_the_contract(capsys):
     assert main(["--version"]) == 0
     out = capsys.readouterr().out
     assert out.strip() == f"vplane-mj {vplane_mj.__version__} (contract v{vplane_mj.CONTRACT_VERSION})"
-    assert vplane_mj.CONTRACT_VERSION == "1.2"
+    assert vplane_mj.CONTRACT_VERSION == "1.3"

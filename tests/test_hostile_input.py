@@ -990,7 +990,7 @@ MISTAKES = [
     ),
     (
         ["run", "paper_c_escape", "--set", "sensors.pose=odometri"],
-        "error: --set sensors.pose: must be one of 'truth', 'odometry', got 'odometri'",
+        "error: --set sensors.pose: must be one of 'truth', 'odometry', 'ekf', got 'odometri'",
         "; did you mean 'odometry'? (applied to SCENARIO)",
     ),
     (

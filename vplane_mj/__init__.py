@@ -19,7 +19,7 @@ import warnings
 from typing import TYPE_CHECKING, Any
 
 __version__ = "0.2.0"
-CONTRACT_VERSION = "1.2"
+CONTRACT_VERSION = "1.3"
 """The version of the public contract (docs/interface.md: scenario format, command line,
 outputs, log topics) this package follows."""
 

@@ -248,7 +248,7 @@ class NavigationTask:
     def _agent_observation(self) -> dict[str, np.ndarray]:
         """Sonar ranges and echoes, the goal in the robot frame and the body velocity.
 
-        Within an episode the pose is the planner's (truth or odometry, as `sensors.pose`
+        Within an episode the pose is the planner's (truth, odometry or an EKF's, as `sensors.pose`
         says); once the run is over, the simulator's.
         """
         run = self._episode_run

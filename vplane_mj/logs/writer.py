@@ -20,7 +20,7 @@ messages' own `timestamp` fields, is the integer nanosecond of *simulated* time,
 | `/events` | `foxglove.Log` | one per event (`run started: ...` at time 0), name = its kind |
 | `/run/events` | JSON (`vplane_mj.Event` JSON schema) | the same events as data: kind, text, points |
 | `/metrics` | JSON (`vplane_mj.Metrics` JSON schema) | every tick (see below) |
-| `/robot/odometry` | `foxglove.PoseInFrame` | believed pose, every tick, if `sensors.pose = "odometry"` |
+| `/robot/odometry` | `foxglove.PoseInFrame` | believed pose, every tick, unless `sensors.pose = "truth"` |
 | `/tracks` | `foxglove.SceneUpdate` | ticks with moving tracks, from the first (and when the last vanish) |
 
 An arrow whose force is (near) zero or not finite is deleted until it comes back.
@@ -133,7 +133,7 @@ METRICS_JSON_SCHEMA: dict[str, Any] = {
         "mode": {"type": "string", "description": "planner mode"},
         "command_v_mps": {"type": "number", "description": "forward speed command (m/s)"},
         "command_omega_radps": {"type": "number", "description": "turn rate command (rad/s)"},
-        "odometry_error_m": {"type": "number", "description": "believed to true position, odometry only"},
+        "odometry_error_m": {"type": "number", "description": "believed to true position, not with truth"},
     },
     "required": ["time_s", "mode"],
 }
@@ -224,7 +224,7 @@ class McapLog:
         self._event_data_ch = foxglove.Channel(EVENTS_DATA_TOPIC, schema=EVENTS_JSON_SCHEMA, context=ctx)
         self._metrics_ch = foxglove.Channel("/metrics", schema=METRICS_JSON_SCHEMA, context=ctx)
         self._odometry_ch = None
-        if scenario.sensors.pose == "odometry":
+        if scenario.sensors.pose in ("odometry", "ekf"):
             self._odometry_ch = fc.PoseInFrameChannel("/robot/odometry", context=ctx)
         self._moving = scenario.world.moving
         self._moving_ch = fc.SceneUpdateChannel(MOVING_TOPIC, context=ctx) if self._moving else None

@@ -54,6 +54,10 @@ class RobotProfile:
     the limits' accelerations, which the model's motors deliver with margin, without wheel
     spin-out; without (the default robot, whose runs stay exactly as they were), the commands
     step and the limits are what the motors deliver from standing.
+    `odometry_track_scale` multiplies the wheel separation in the robot's own wheel odometry (a
+    skid-steer controller's `wheel_separation_multiplier`); `gyro_noise_radps` (rad/s, white)
+    and `gyro_drift_radps` (rad/s per root second, the bias's random walk) are its IMU's gyro
+    at the model's `imu` site (`sensors.pose = "ekf"`).
     """
 
     name: str
@@ -73,6 +77,9 @@ class RobotProfile:
     sonar_mounts: tuple[tuple[float, float, float], ...] | None
     sensor_height_m: float
     sources: Mapping[str, str]
+    odometry_track_scale: float = 1.0
+    gyro_noise_radps: float = 0.005
+    gyro_drift_radps: float = 0.005
 
     def footprint_radius_m(self) -> float | None:
         """Radius (m) of the smallest disc about base_link's origin holding the outline."""
@@ -128,6 +135,7 @@ DEFAULT = RobotProfile(
             "37 at the start, of which the dynamic window has always assumed 30",
             "gains": "vplane_mj/control.py ControllerGains",
             "sensors": "vplane_mj/scenario/spec.py SensorSpec",
+            "imu": "chosen: at the chassis' centre, the Jackal's gyro noise and drift",
         }
     ),
 )
@@ -174,6 +182,7 @@ JACKAL = RobotProfile(
     ),
     sonar_mounts=None,
     sensor_height_m=0.199,
+    odometry_track_scale=1.5,
     sources=_frozen(
         {
             "outline, mass, top speed": "Clearpath Robotics, Jackal UGV datasheet: 508 x 430 x 250 mm, "
@@ -191,6 +200,10 @@ JACKAL = RobotProfile(
             "base_link (0.0655 m above the floor), focal point 0.0474 m above the mount: 0.297 m above "
             "the floor, 0.199 m above the axle; the real laser sits 0.12 m ahead of the centre",
             "wheel friction": "jackal_description/urdf/jackal.urdf.xacro: Gazebo tyre mu1 = mu2 = 0.5",
+            "odometry": "jackal_control/config/control.yaml: the controller's odometry multiplies the "
+            "wheel separation by wheel_separation_multiplier 1.5",
+            "imu": "jackal_description/urdf/jackal.urdf.xacro and jackal.gazebo: imu_link at base_link's "
+            "origin; Gazebo's IMU plugin with 0.005 rad/s of rate noise and 0.005 of bias drift",
             "track scale": "measured (tests/test_profiles.py): turning in place at 4 rad/s on tyres of "
             "friction 0.5 the model yaws at the geometric rate of a 1.9 times wider track "
             "(Clearpath's controller multiplies the separation by 1.5, "
@@ -301,6 +314,7 @@ PIONEER_3DX = RobotProfile(
             "0-15, front array +-90, +-50, +-30, +-10 deg, rear array mirrored",
             "sonar beam and range": "Stage worlds/pioneer.inc p3dx sonar: view 0.1-5.0 m, 30 deg",
             "sonar rate": "chosen: 10 Hz for the whole ring (the firing cycle is not in the sources checked)",
+            "imu": "chosen: the optional gyro at the body's centre, the Jackal's noise and drift",
             "caster": "p2os_urdf/defs/pioneer3dx_body.xacro (https://github.com/allenh1/p2os): swivel "
             "wheel r = 0.0375 m at x = -0.211 m; wheel mass 0.5 kg",
             "inertia": "chosen: 8 kg body as a uniform 0.44 x 0.38 x 0.18 m box centred 0.045 m behind "
@@ -365,6 +379,8 @@ TURTLEBOT3_BURGER = RobotProfile(
             "over 360 deg, 0.12-3.5 m, 5 Hz",
             "sensor height": "turtlebot3_burger.urdf: scan 0.172 m above base_link, 0.182 m above the "
             "floor, 0.149 m above the axle; the real scanner sits 0.032 m behind it",
+            "imu": "turtlebot3_burger.urdf: imu_link 0.032 m behind and 0.068 m above base_link "
+            "(0.045 m above the axle); noise and drift chosen as the Jackal's",
             "navigation footprint": "turtlebot3_navigation/param/costmap_common_params_burger.yaml: "
             "[[-0.105, -0.105], [-0.105, 0.105], [0.041, 0.105], [0.041, -0.105]]",
             "turn acceleration": "turtlebot3_navigation/param/dwa_local_planner_params_burger.yaml: "

@@ -68,7 +68,7 @@ SENSOR_FIELDS = {
     "dropout": Field("number", ge=0, lt=1),
     "crosstalk": Field("number", ge=0, lt=1),
     "dead": Field("ints", ge=0),
-    "pose": Field("str", choices=("truth", "odometry")),
+    "pose": Field("str", choices=("truth", "odometry", "ekf")),
     "odometry_noise": Field("number", ge=0, le=1),
     "count": Field("int", ge=4, le=128),
     "rays_per_sonar": Field("int", ge=1, le=15),

@@ -66,8 +66,9 @@ class SensorSpec:
 
     Sensor faults: `crosstalk` is the probability that a reading is a spurious short
     echo, `dead` the indices of sonars that never echo. `pose` is where the planner's
-    pose comes from: "truth" (the simulator, an ideal localiser) or "odometry" (dead
-    reckoning from the wheel encoders, whose travel has relative noise `odometry_noise`).
+    pose comes from: "truth" (the simulator, an ideal localiser), "odometry" (dead
+    reckoning from the wheel encoders, whose travel has relative noise `odometry_noise`) or
+    "ekf" (that odometry fused with the IMU's gyro, `sim.odometry.FusedOdometry`).
     """
 
     noise_std: float = 0.0

@@ -12,8 +12,9 @@ from vplane_mj.robots.facts import BASE_BODY, WHEEL_JOINTS, WHEEL_MOTORS, robot_
 from vplane_mj.robots.profiles import PROFILES
 from vplane_mj.scenario import Scenario
 from vplane_mj.sim.control import CommandRamp, WheelPI, wheel_targets
+from vplane_mj.sim.imu import Gyro
 from vplane_mj.sim.moving import MovingObstacles
-from vplane_mj.sim.odometry import WheelOdometry
+from vplane_mj.sim.odometry import FusedOdometry, WheelOdometry
 from vplane_mj.sim.world import BUMP_SENSOR, OBSTACLES_BODY, ROBOT_PREFIX
 
 ODOMETRY_STREAM = 1
@@ -164,28 +165,46 @@ class Drive:
 
 
 class Localiser:
-    """The pose the planner sees: the simulator's (`sensors.pose = "truth"`), or the belief of
-    wheel odometry (`"odometry"`), updated at each control tick from the wheel encoders."""
+    """The pose the planner sees: the simulator's (`sensors.pose = "truth"`), the belief of
+    wheel odometry (`"odometry"`), or an EKF's over the wheel odometry and the IMU's gyro
+    (`"ekf"`), updated at each control tick; both odometries with the wheel separation the
+    robot's own odometry uses (its profile's `odometry_track_scale`)."""
 
     def __init__(self, drive: Drive, scenario: Scenario):
         self._drive = drive
         self._arrived_at: float | None = None
-        self.odometry = None
+        self._time = drive.data.time
+        self.odometry: WheelOdometry | FusedOdometry | None = None
+        self.largest_error = 0.0
+        pose = (*scenario.robot.start, scenario.robot.start_yaw)
+        profile = PROFILES[scenario.robot.profile]
+        radius, track = (
+            drive.geometry["wheel_radius_m"],
+            drive.geometry["track_m"] * profile.odometry_track_scale,
+        )
+        rng = np.random.default_rng((scenario.run.seed, ODOMETRY_STREAM))
+        noise = scenario.sensors.odometry_noise
         if scenario.sensors.pose == "odometry":
-            self.odometry = WheelOdometry(
-                (*scenario.robot.start, scenario.robot.start_yaw),
-                drive.wheel_angles(),
-                drive.geometry["wheel_radius_m"],
-                drive.geometry["track_m"],
-                scenario.sensors.odometry_noise,
-                np.random.default_rng((scenario.run.seed, ODOMETRY_STREAM)),
+            self.odometry = WheelOdometry(pose, drive.wheel_angles(), radius, track, noise, rng)
+        elif scenario.sensors.pose == "ekf":
+            gyro = Gyro(drive.model, drive.data, profile.gyro_noise_radps, profile.gyro_drift_radps, rng)
+            limits = profile.limits
+            accelerations = (limits.max_accel_mps2, limits.max_turn_accel_radps2)
+            self.odometry = FusedOdometry(
+                pose, drive.wheel_angles(), (radius, track), noise, rng, gyro, accelerations
             )
 
     def pose(self, position: np.ndarray, yaw: float) -> tuple[np.ndarray, float]:
         """The planner's position (m) and yaw (rad), given the true ones."""
         if self.odometry is None:
             return position, yaw
-        x, y, believed_yaw = self.odometry.update(self._drive.wheel_angles())
+        time_s = self._drive.data.time
+        if isinstance(self.odometry, FusedOdometry):
+            x, y, believed_yaw = self.odometry.update(self._drive.wheel_angles(), time_s - self._time)
+        else:
+            x, y, believed_yaw = self.odometry.update(self._drive.wheel_angles())
+        self._time = time_s
+        self.largest_error = max(self.largest_error, math.hypot(x - position[0], y - position[1]))
         return np.array([x, y]), believed_yaw
 
     def believes_arrived(self, time_s: float, xy: np.ndarray, goal: np.ndarray, tolerance: float) -> bool:
@@ -201,6 +220,12 @@ class Localiser:
     def belief(self, xy: np.ndarray, yaw: float) -> tuple[float, float, float] | None:
         """The believed pose for observers, None when the planner uses the true pose."""
         return None if self.odometry is None else (float(xy[0]), float(xy[1]), yaw)
+
+    def largest(self, position: np.ndarray) -> float | None:
+        """The largest distance (m) between the believed and the true position over the run, now
+        included; None when the planner uses the true pose."""
+        error = self.error(position)
+        return None if error is None else max(self.largest_error, error)
 
     def error(self, position: np.ndarray) -> float | None:
         """Distance (m) between the believed and the true position, None without odometry."""

@@ -551,6 +551,7 @@ class Run:
                 self.goal[0] - self.position[0], self.goal[1] - self.position[1]
             ),
             odometry_error_m=self.localiser.error(self.position),
+            odometry_error_max_m=self.localiser.largest(self.position),
             trajectory_sha256=trajectory_digest(self.positions, self.position, self.drive.yaw()),
             message="" if reached or ending.outcome is Outcome.TIMEOUT else ending.event.text,
             traceback=self.planner_failure.traceback if self.planner_failure else "",

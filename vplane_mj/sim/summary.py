@@ -68,6 +68,7 @@ class RunSummary:
     score: float | None = None
     final_distance_to_goal_m: float | None = None
     odometry_error_m: float | None = None
+    odometry_error_max_m: float | None = None
     trajectory_sha256: str = ""
     message: str = ""
     traceback: str = ""

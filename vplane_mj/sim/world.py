@@ -29,6 +29,7 @@ from vplane_mj.scenario import RobotSpec, Scenario, SensorSpec
 
 OBSTACLE_HEIGHT_M = 0.5
 ROBOT_PREFIX = "robot/"
+IMU_SITE, IMU_GYRO, IMU_ACCELEROMETER = "imu", "imu_gyro", "imu_accelerometer"
 OBSTACLES_BODY = "obstacles"
 """The static body that holds every obstacle and border geom."""
 BUMP_SENSOR = "bump"
@@ -145,6 +146,8 @@ def build_spec(scenario: Scenario, rangefinders: bool = True) -> mujoco.MjSpec:
         layout = SonarLayout.from_spec(scenario.sensors, scenario.robot.profile)
         _add_sonar_ring(robot, layout, scenario.sensors, rangefinders)
     _apply_actuation_faults(robot, scenario.robot)
+    if scenario.sensors.pose == "ekf":
+        _add_imu(robot)
     x, y = scenario.robot.start
     yaw = scenario.robot.start_yaw
     mount = arena.worldbody.add_body(
@@ -231,6 +234,17 @@ def _add_piece(body: mujoco.MjsBody, name: str, piece: shapes.Piece, material: s
     )
     geom.alt.type = mujoco.mjtOrientation.mjORIENTATION_EULER
     geom.alt.euler = [0.0, 0.0, piece.yaw]
+
+
+def _add_imu(robot: mujoco.MjSpec) -> None:
+    """A gyro and an accelerometer at the robot model's `imu` site (the maker's mounting),
+    `IMU_GYRO` and `IMU_ACCELEROMETER` after the robot's prefix: what `sensors.pose = "ekf"`
+    fuses (only then: an accelerometer makes MuJoCo compute accelerations at every step)."""
+    for name, kind in (
+        (IMU_GYRO, mujoco.mjtSensor.mjSENS_GYRO),
+        (IMU_ACCELEROMETER, mujoco.mjtSensor.mjSENS_ACCELEROMETER),
+    ):
+        robot.add_sensor(name=name, type=kind, objtype=mujoco.mjtObj.mjOBJ_SITE, objname=IMU_SITE)
 
 
 def _add_sonar_ring(robot: mujoco.MjSpec, layout: SonarLayout, spec: SensorSpec, rangefinders: bool) -> None:
