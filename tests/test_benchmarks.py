@@ -188,6 +188,17 @@ def test_tracker_accuracy_scores_the_tracks_against_the_simulator(tmp_path):
     assert 0.0 <= number(row[4]) < 0.1  # median position error (m)
 
 
+def test_localisation_sets_the_ekf_beside_wheel_odometry(tmp_path):
+    out = run_benchmark(
+        "localisation.py", *("--count", "2", "--poses", "odometry,ekf", "--out", "loc"), cwd=tmp_path
+    )
+    (odometry,) = table_rows(out, "odometry")
+    (ekf,) = table_rows(out, "ekf")
+    assert odometry[1] == ekf[1] == "2"  # runs
+    assert 0.0 < number(ekf[4]) < number(odometry[4])  # median final position error (m)
+    assert (tmp_path / "loc" / "localisation.csv").is_file()
+
+
 def test_sweep_rate_counts_runs_per_core_minute_of_each_planners_sweep(tmp_path):
     out = run_benchmark(
         "sweep_rate.py", *("--worlds", "2", "--planners", "apf,vplane", "--out", "rate"), cwd=tmp_path

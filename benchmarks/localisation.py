@@ -1,0 +1,156 @@
+"""The pose a planner is handed against the true pose: wheel odometry and the EKF on BARN worlds.
+
+Runs `--planner` (default vplane_plus) with the Jackal on each scenario (files given, else
+`--count` worlds generated as `vplane-mj generate barn --protocol` does, seed `--world-seed`,
+written to `OUT/cases/`) for each seed of `--seeds` and each pose source of `--poses`
+(`sensors.pose`: `truth`, `odometry`, `ekf`), with laser noise `--noise` (m). At every control
+tick it compares the pose the planner used with the simulator's.
+
+Prints per pose source: the runs, the success rate (reached without a collision), the share
+with a collision, and, over the runs, the median and 95th percentile of the final position
+error (m) and heading error (degrees) and the median of each run's largest position error;
+writes `OUT/localisation.csv` and `.md`.
+
+    python benchmarks/localisation.py [--count 20] [--seeds 0] [--poses odometry,ekf] [--out DIR]
+    python benchmarks/localisation.py barn-train/*.toml --poses truth,odometry,ekf
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from vplane_mj.bench.report import markdown_table
+from vplane_mj.bench.sweep import parse_seeds
+from vplane_mj.errors import VPlaneError
+from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
+from vplane_mj.scenario import load_scenario
+from vplane_mj.sim.loop import Run
+from vplane_mj.worlds.barn_protocol import generate_protocol
+
+POSES = ("truth", "odometry", "ekf")
+COLUMNS = (
+    "pose",
+    "runs",
+    "success_rate",
+    "collision_rate",
+    "final_error_median_m",
+    "final_error_p95_m",
+    "largest_error_median_m",
+    "heading_error_median_deg",
+    "heading_error_p95_deg",
+)
+
+
+def run_one(job: tuple[str, str, str, int, float]) -> dict:
+    """One run: its success, collision and the errors of the pose its planner used."""
+    path, planner, pose, seed, noise = job
+    overrides = [f"planner.name={planner}", f"sensors.pose={pose}", f"run.seed={seed}"]
+    scenario = load_scenario(path, [*overrides, *([f"sensors.noise_std={noise}"] if noise > 0 else [])])
+    run = Run(scenario)
+    while run.step() is None:
+        pass
+    summary = run.summary()
+    belief = run.localiser.odometry
+    heading = 0.0 if belief is None else math.degrees(abs(math.remainder(belief.yaw - run.yaw, math.tau)))
+    return {
+        "pose": pose,
+        "success": bool(summary.success),
+        "collided": summary.collisions > 0,
+        "final_error_m": summary.odometry_error_m or 0.0,
+        "largest_error_m": summary.odometry_error_max_m or 0.0,
+        "heading_error_deg": heading,
+    }
+
+
+def pose_table(rows: list[dict], poses: list[str]) -> list[dict]:
+    """Per pose source, a row of the table."""
+    table = []
+    for pose in poses:
+        mine = [r for r in rows if r["pose"] == pose]
+        final = np.array([r["final_error_m"] for r in mine])
+        heading = np.array([r["heading_error_deg"] for r in mine])
+        table.append(
+            {
+                "pose": pose,
+                "runs": len(mine),
+                "success_rate": sum(r["success"] for r in mine) / len(mine),
+                "collision_rate": sum(r["collided"] for r in mine) / len(mine),
+                "final_error_median_m": float(np.median(final)),
+                "final_error_p95_m": float(np.percentile(final, 95)),
+                "largest_error_median_m": float(np.median([r["largest_error_m"] for r in mine])),
+                "heading_error_median_deg": float(np.median(heading)),
+                "heading_error_p95_deg": float(np.percentile(heading, 95)),
+            }
+        )
+    return table
+
+
+def markdown(table: list[dict]) -> str:
+    """The table as Markdown."""
+
+    def cell(key: str, value) -> str:
+        if key.endswith("_rate"):
+            return f"{100 * value:.1f}%"
+        if key.endswith("_deg"):
+            return f"{value:.2f}"
+        return f"{value:.3f}" if isinstance(value, float) else str(value)
+
+    return markdown_table(table, COLUMNS, cell)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scenarios", nargs="*", help="scenario files (default: generated protocol worlds)")
+    parser.add_argument("--planner", default="vplane_plus")
+    parser.add_argument("--poses", default="odometry,ekf", help="sensors.pose values, comma-separated")
+    parser.add_argument("--count", type=int, default=20, help="protocol worlds, without scenario files")
+    parser.add_argument("--world-seed", type=int, default=0)
+    parser.add_argument("--seeds", default="0")
+    parser.add_argument("--noise", type=float, default=0.01, help="laser range noise (m)")
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--out", type=Path, default=Path("logs/localisation"))
+    args = parser.parse_args(argv)
+    poses = [p.strip() for p in args.poses.split(",")]
+    if set(poses) - set(POSES) or args.count < 1 or args.jobs < 1 or args.noise < 0:
+        print(f"error: bad arguments (poses are {', '.join(POSES)})", file=sys.stderr)
+        return 2
+    try:
+        seeds = parse_seeds(args.seeds)
+        out = prepare_out_dir(args.out)
+    except VPlaneError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    scenarios = args.scenarios
+    if not scenarios:
+        (out / "cases").mkdir(exist_ok=True)
+        scenarios = []
+        for case in generate_protocol(args.count, args.world_seed):
+            path = out / "cases" / f"{case.name}.toml"
+            path.write_text(case.toml(), encoding="utf-8")
+            scenarios.append(str(path))
+    jobs = [
+        (path, args.planner, pose, seed, args.noise) for pose in poses for path in scenarios for seed in seeds
+    ]
+    try:
+        with ProcessPoolExecutor(args.jobs) as pool:
+            rows = list(pool.map(run_one, jobs))
+    except VPlaneError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    table = pose_table(rows, poses)
+    write_csv(out / "localisation.csv", table, COLUMNS)
+    text = markdown(table)
+    write_atomically(out / "localisation.md", lambda tmp: tmp.write_text(text + "\n", encoding="utf-8"))
+    print(text)
+    print(f"wrote {out / 'localisation.csv'}\nwrote {out / 'localisation.md'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
