@@ -4,6 +4,7 @@ The fixture tests/data/barn/ is world 1 of BARN (world_1.world, path_1.npy), unc
 the MIT licence it is distributed under (see its README.md).
 """
 
+import copy
 import math
 import shutil
 import tomllib
@@ -13,8 +14,10 @@ import numpy as np
 import pytest
 
 from vplane_mj.cli import main
+from vplane_mj.errors import ScenarioError
 from vplane_mj.geometry.shapes import scene_footprints
 from vplane_mj.scenario import parse_document
+from vplane_mj.sim.metrics import path_quality
 from vplane_mj.worlds.barn_import import barn_path_length, import_worlds
 from vplane_mj.worlds.barn_layout import JACKAL_RADIUS_M, to_arena
 from vplane_mj.worlds.sdf import read_world_shapes
@@ -95,6 +98,30 @@ def test_barns_path_length_is_reported_beside_the_reference(tmp_path, capsys):
     [world] = import_worlds([SAMPLE / "world_1.world"])
     assert world.barn_path_m == pytest.approx(12.312, abs=1e-3)
     assert 10.0 < world.reference_m < world.barn_path_m
+
+
+def test_the_score_takes_its_ot_from_barns_own_path(world_1):
+    doc = copy.deepcopy(world_1[0])
+    assert doc["world"]["score_path_m"] == pytest.approx(12.312, abs=1e-3)
+    scenario = parse_document(doc, "barn_world_1.toml")
+    # reached in 8 s: BARN's OT is 12.312 / 2 m/s = 6.16 s, so T is clipped to 2 OT
+    quality = path_quality(scenario, JACKAL_RADIUS_M, True, 10.0, 8.0, 2.0)
+    assert quality["score_path_m"] == doc["world"]["score_path_m"] and quality["score_path_source"] == "world"
+    assert quality["score"] == pytest.approx(0.5)
+    later = path_quality(scenario, JACKAL_RADIUS_M, True, 10.0, 20.0, 2.0)
+    assert later["score"] == pytest.approx(12.312491 / 2.0 / 20.0)
+    del doc["world"]["score_path_m"]  # a world without BARN's path: the reference path's OT
+    plain = path_quality(parse_document(doc, "plain.toml"), JACKAL_RADIUS_M, True, 10.0, 20.0, 2.0)
+    assert plain["score_path_source"] == "reference" and plain["score_path_m"] == plain["reference_length_m"]
+    assert plain["score"] == pytest.approx(plain["reference_length_m"] / 2.0 / 20.0)
+
+
+def test_a_score_path_must_be_a_length(world_1):
+    doc = copy.deepcopy(world_1[0])
+    doc["world"]["score_path_m"] = 0.0
+    with pytest.raises(ScenarioError) as caught:
+        parse_document(doc, "bad.toml")
+    assert caught.value.key == "world.score_path_m" and "greater than 0" in caught.value.reason
 
 
 def test_barns_path_length_is_the_polyline_through_its_cells(tmp_path):

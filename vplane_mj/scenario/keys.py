@@ -45,6 +45,7 @@ TOP_FIELDS = {
 WORLD_FIELDS = {
     "size": Field("point", required=True, gt=0, le=MAX_ARENA_M),
     "border": Field("bool"),
+    "score_path_m": Field("number", gt=0, le=MAX_ARENA_M * 100),
 }
 
 ROBOT_FIELDS = {

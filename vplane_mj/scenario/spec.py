@@ -29,6 +29,9 @@ class WorldSpec:
     border: bool = True
     obstacles: tuple[Obstacle, ...] = ()
     moving: tuple[Moving, ...] = ()
+    score_path_m: float | None = None
+    """The path length (m) whose time at the top speed is the BARN score's OT, when the world
+    comes with its own (a BARN world's `path_N.npy`); None: the reference path's."""
 
     def static_indices(self) -> tuple[int, ...]:
         """Each static obstacle's index among the file's `[[world.obstacles]]`, in order."""

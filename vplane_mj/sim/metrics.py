@@ -129,6 +129,8 @@ class PathQuality(TypedDict):
     optimal_length_m: float | None
     path_ratio: float | None
     score: float | None
+    score_path_m: float | None
+    score_path_source: str | None
 
 
 def motion_quality(yaws: np.ndarray, path_length: float) -> MotionQuality:
@@ -166,15 +168,20 @@ def path_quality(
     """The reference shortest path to the goal (for a robot that needs `radius`, m, of room on
     each side), the part of it to the goal tolerance disc, the path length over that part, and
     the BARN score (`barn_score`), whose OT is the whole reference path over the top speed, as
-    BARN's own OT runs to the goal point."""
+    BARN's own OT runs to the goal point, or the world's own path (`WorldSpec.score_path_m`, a
+    BARN world's): `score_path_m` and `score_path_source` ("world" or "reference") say which."""
     reference = shortest_path_length(scenario, radius)
     optimal = None if reference is None else max(reference - scenario.robot.goal_tolerance, 0.0)
     ratio = path_length / optimal if time_to_goal is not None and optimal else None
+    own = scenario.world.score_path_m
+    score_path = reference if own is None else own
     return {
         "reference_length_m": reference,
         "optimal_length_m": optimal,
         "path_ratio": ratio,
-        "score": barn_score(success, reference, time_to_goal, top_speed_mps),
+        "score": barn_score(success, score_path, time_to_goal, top_speed_mps),
+        "score_path_m": score_path,
+        "score_path_source": "world" if own is not None else None if reference is None else "reference",
     }
 
 

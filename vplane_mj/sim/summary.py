@@ -66,6 +66,8 @@ class RunSummary:
     optimal_length_m: float | None = None
     path_ratio: float | None = None
     score: float | None = None
+    score_path_m: float | None = None
+    score_path_source: str | None = None
     final_distance_to_goal_m: float | None = None
     odometry_error_m: float | None = None
     odometry_error_max_m: float | None = None

@@ -10,9 +10,11 @@ than the Jackal's half diagonal to an obstacle is refused.
 
 BARN ships its own path with each world (`path_N.npy` beside `world_N.world`): the cells of the
 0.15 m grid its generator's A* went through. Its length (the polyline (-2, 3), the cells at
-Gazebo (0.15 r - 4.575, 0.15 c + 5.075), (-2, 13)) is the challenge's optimal path, and is
-reported beside the project's reference path for the Jackal; the scenario's score uses the
-latter, as for every other scenario (docs/barn.md says why).
+Gazebo (0.15 r - 4.575, 0.15 c + 5.075), (-2, 13)) is the challenge's optimal path: it is
+reported beside the project's reference path for the Jackal, and the scenario keeps it as
+`[world] score_path_m`, so that a run's score takes OT from it as BARN's `report_test.py`
+does (its length over the Jackal's 2 m/s). Without the path file the score's OT is the
+reference path's, as for every other scenario.
 """
 
 from __future__ import annotations
@@ -137,6 +139,8 @@ def import_world(path: Path) -> ImportedWorld:
     if path_file is not None:
         description += f"; BARN's own path ({path_file.name}) is {barn_path_m:.3f} m"
     document = layout_document(name, description, [obstacle(shape) for shape in shapes])
+    if barn_path_m is not None:
+        document["world"]["score_path_m"] = round(barn_path_m, 6)
     try:
         scenario = parse_document(document, source)
     except ScenarioError as exc:
