@@ -4,7 +4,7 @@ Generates `--count` worlds as `vplane-mj generate barn --protocol` does (seed `-
 4.2 x 14 m, 0.15 m posts, the Jackal, its 270-degree 720-beam laser), writes them to
 `OUT/cases/`, and runs each planner of `--planners` on each world for each seed of `--seeds`,
 with laser noise `--noise` (m, `sensors.noise_std`); `dwa` follows the map's shortest way to
-the goal (`PLANNER_SETTINGS`), as BARN's DWA follows its global plan. The runs go through
+the goal, as BARN's DWA follows its global plan (the Jackal profile's `planner_settings`). The runs go through
 `vplane_mj.bench.sweep.run_sweep`, so `OUT/bench.jsonl` journals them and the same command
 run again only does what is missing.
 
@@ -37,9 +37,6 @@ from vplane_mj.planning.registry import PLANNERS
 from vplane_mj.worlds.barn_protocol import generate_protocol
 
 PLANNER_ORDER = ("vplane_plus", "dwa", "vplane", "vfh", "apf", "vobs", "bug2")
-PLANNER_SETTINGS = {"dwa": ("planner.follow_way=1", "planner.clearance_weight=0.05")}
-"""Settings of a planner on these worlds: `dwa` aims along the map's shortest way to the goal,
-as BARN's DWA baseline follows the path of its global planner (move_base's navfn)."""
 COLUMNS = (
     "planner",
     "runs",
@@ -161,11 +158,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     scenarios = write_cases(out, args.count, args.world_seed)
     overrides = [f"sensors.noise_std={args.noise}"] if args.noise > 0 else []
-    jobs = [
-        job
-        for planner in planners
-        for job in plan_jobs(scenarios, [planner], seeds, [*overrides, *PLANNER_SETTINGS.get(planner, ())])
-    ]
+    jobs = plan_jobs(scenarios, planners, seeds, overrides)
     rows = run_sweep(jobs, out, args.jobs)
     table = planner_table(rows)
     write_csv(out / "barn_protocol.csv", table, COLUMNS)

@@ -22,7 +22,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from barn_protocol import PLANNER_SETTINGS, write_scenarios
+from barn_protocol import write_scenarios
 
 from vplane_mj.bench.sweep import plan_jobs, run_sweep
 from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
@@ -38,10 +38,9 @@ def children_cpu_s() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def sweep_row(label: str, scenarios: list[str], planner: str, jobs: int, settings: tuple[str, ...]) -> dict:
-    """One planner's sweep over `scenarios` with `settings` (`--set` style): its rows' success
-    and what it cost."""
-    planned = plan_jobs(scenarios, [planner], [0], ["sensors.noise_std=0.02", *settings])
+def sweep_row(label: str, scenarios: list[str], planner: str, jobs: int) -> dict:
+    """One planner's sweep over `scenarios`: its rows' success and what it cost."""
+    planned = plan_jobs(scenarios, [planner], [0], ["sensors.noise_std=0.02"])
     with tempfile.TemporaryDirectory() as tmp:
         cpu, wall = children_cpu_s(), time.perf_counter()
         rows = run_sweep(planned, Path(tmp), jobs)
@@ -96,8 +95,7 @@ def main(argv: list[str] | None = None) -> int:
     print("|---|---|---:|---:|---:|---:|---:|")
     for label, scenarios in sets.items():
         for planner in (name.strip() for name in args.planners.split(",")):
-            settings = PLANNER_SETTINGS.get(planner, ()) if label.startswith("protocol") else ()
-            row = sweep_row(label, scenarios, planner, args.jobs, settings)
+            row = sweep_row(label, scenarios, planner, args.jobs)
             table.append(row)
             print(
                 f"| {label} | `{planner}` | {row['runs']} | {row['success_rate']:.1%} | {row['wall_s']:.0f} "

@@ -433,8 +433,9 @@ def test_the_jackal_crosses_a_barn_protocol_world_at_full_speed_without_collisio
 
 
 def test_following_the_maps_way_it_crosses_a_world_where_the_goals_heading_is_trapped():
-    fox = jackal_run(0).summary
+    fox = jackal_run(0, "planner.follow_way=0", "planner.clearance_weight=0.2").summary  # Fox's aim
     assert fox.outcome == "stuck" and fox.collisions == 0 and fox.path_length_m < 3.0
-    way = jackal_run(0, "planner.follow_way=1", "planner.clearance_weight=0.05").summary
+    way = jackal_run(0).summary  # the Jackal's own settings: along the map's way
+    assert way.planner_params["follow_way"] == 1 and way.planner_params["clearance_weight"] == 0.05
     assert way.outcome == "reached" and way.collisions == 0 and way.min_clearance_m > 0.02
     assert 9.0 < way.path_length_m < 10.5 and way.score == 0.5  # within twice the optimal time

@@ -392,3 +392,22 @@ MEASURED_ROWS = {
 
 if __name__ == "__main__":  # python -m tests.test_profiles: the table of docs/robots.md
     print(measured_table())
+
+
+def test_a_ros_robots_dwa_follows_the_maps_way_unless_the_scenario_says_otherwise():
+    from vplane_mj.scenario import parse_document
+
+    def dwa_params(profile: str, planner: dict) -> dict:
+        doc = {
+            "format": 1,
+            "name": "open",
+            "world": {"size": [10.0, 10.0]},
+            "robot": {"profile": profile, "start": [2.0, 5.0], "goal": [8.0, 5.0]},
+            "planner": {"name": "dwa", **planner},
+        }
+        return dict(parse_document(doc, "open.toml").planner_params)
+
+    assert dwa_params("jackal", {}) == {"follow_way": 1, "clearance_weight": 0.05}
+    assert dwa_params("turtlebot3_burger", {})["follow_way"] == 1
+    assert dwa_params("jackal", {"follow_way": 0}) == {"follow_way": 0, "clearance_weight": 0.05}
+    assert dwa_params("default", {}) == {} and dwa_params("pioneer3dx", {}) == {}  # the planner's own

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import MappingProxyType
 
 from vplane_mj.errors import VPlaneError
@@ -57,7 +57,9 @@ class RobotProfile:
     `odometry_track_scale` multiplies the wheel separation in the robot's own wheel odometry (a
     skid-steer controller's `wheel_separation_multiplier`); `gyro_noise_radps` (rad/s, white)
     and `gyro_drift_radps` (rad/s per root second, the bias's random walk) are its IMU's gyro
-    at the model's `imu` site (`sensors.pose = "ekf"`).
+    at the model's `imu` site (`sensors.pose = "ekf"`). `planner_settings` are parameters a
+    planner runs with on this robot unless a scenario sets them: how the robot's own navigation
+    stack configures its counterpart (a ROS robot's DWA follows its global planner's path).
     """
 
     name: str
@@ -80,6 +82,7 @@ class RobotProfile:
     odometry_track_scale: float = 1.0
     gyro_noise_radps: float = 0.005
     gyro_drift_radps: float = 0.005
+    planner_settings: Mapping[str, Mapping[str, float]] = field(default_factory=lambda: MappingProxyType({}))
 
     def footprint_radius_m(self) -> float | None:
         """Radius (m) of the smallest disc about base_link's origin holding the outline."""
@@ -183,6 +186,7 @@ JACKAL = RobotProfile(
     sonar_mounts=None,
     sensor_height_m=0.199,
     odometry_track_scale=1.5,
+    planner_settings=_frozen({"dwa": _frozen({"follow_way": 1, "clearance_weight": 0.05})}),
     sources=_frozen(
         {
             "outline, mass, top speed": "Clearpath Robotics, Jackal UGV datasheet: 508 x 430 x 250 mm, "
@@ -192,6 +196,9 @@ JACKAL = RobotProfile(
             "0.37559 m, wheel base 0.262 m, chassis box 0.42 x 0.31 x 0.184 m, wheel 0.477 kg",
             "top turn rate": "jackal_control/config/control.yaml (https://github.com/jackal/jackal): "
             "angular max_velocity 4.0 rad/s (linear 2.0 m/s)",
+            "dwa settings": "BARN challenge stack (jackal_helper move_base): DWA follows navfn's global "
+            "path; here `follow_way` 1 and `clearance_weight` 0.05, chosen on generated protocol "
+            "worlds (docs/barn.md)",
             "navigation footprint": "BARN challenge stack (jackal_helper move_base): "
             "[[-0.21, -0.165], [-0.21, 0.165], [0.21, 0.165], [0.21, -0.165]], padding 0.1 m",
             "laser": "jackal_description/urdf/accessories/hokuyo_ust10.urdf.xacro: Hokuyo UST-10LX as "
@@ -367,6 +374,7 @@ TURTLEBOT3_BURGER = RobotProfile(
     ),
     sonar_mounts=None,
     sensor_height_m=0.149,
+    planner_settings=_frozen({"dwa": _frozen({"follow_way": 1, "clearance_weight": 0.05})}),
     sources=_frozen(
         {
             "size, mass, top speed, top turn rate": "ROBOTIS e-Manual, TurtleBot3 Specifications "
@@ -383,6 +391,8 @@ TURTLEBOT3_BURGER = RobotProfile(
             "(0.045 m above the axle); noise and drift chosen as the Jackal's",
             "navigation footprint": "turtlebot3_navigation/param/costmap_common_params_burger.yaml: "
             "[[-0.105, -0.105], [-0.105, 0.105], [0.041, 0.105], [0.041, -0.105]]",
+            "dwa settings": "turtlebot3_navigation (move_base): DWA follows the global planner's path; "
+            "here as the Jackal's",
             "turn acceleration": "turtlebot3_navigation/param/dwa_local_planner_params_burger.yaml: "
             "acc_lim_theta 3.2 rad/s^2",
             "acceleration": "chosen: 2.0 m/s^2, what the 0.05 N m motors deliver on rolling tyres; "

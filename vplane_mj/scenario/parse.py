@@ -35,7 +35,7 @@ def _build_scenario(doc: dict[str, Any], source: str, recorded: bool) -> Scenari
     run = read_run(doc)
     world = read_world(doc, run.seed)
     robot = read_robot(doc)
-    planner, params = read_planner(doc, recorded)
+    planner, params = read_planner(doc, recorded, robot.profile)
     scenario = Scenario(
         name=top["name"],
         description=top.get("description", ""),

@@ -150,8 +150,11 @@ def read_robot(doc: Mapping[str, Any]) -> RobotSpec:
     return RobotSpec(**values)
 
 
-def read_planner(doc: Mapping[str, Any], recorded: bool = False) -> tuple[str, Mapping[str, float]]:
-    """The planner's name and the parameters the file gives (checked against its dataclass).
+def read_planner(
+    doc: Mapping[str, Any], recorded: bool = False, profile: str = "default"
+) -> tuple[str, Mapping[str, float]]:
+    """The planner's name and the parameters the file gives (checked against its dataclass),
+    over those the robot's `profile` sets for that planner (`RobotProfile.planner_settings`).
 
     `recorded`: the scenario of a finished run (a log's metadata), whose planner was checked
     when it ran and need not be registered in this process; its parameters are kept as given.
@@ -170,7 +173,8 @@ def read_planner(doc: Mapping[str, Any], recorded: bool = False) -> tuple[str, M
                 "named on the command line (--planner module:Class) or registered in code"
             )
         raise Invalid("planner.name", reason)
-    overrides = {key: value for key, value in table.items() if key != "name"}
+    overrides = {**PROFILES[profile].planner_settings.get(name, {})}
+    overrides.update((key, value) for key, value in table.items() if key != "name")
     try:
         params = registry.PLANNERS[name].Params.checked(overrides, name)
     except ParamError as exc:
