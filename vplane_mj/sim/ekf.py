@@ -11,9 +11,9 @@ robot's encoders, which see its wheels skid as turning, would let it drift.
 Prediction over dt (the unicycle, along the heading halfway, m = yaw + w dt / 2):
     x' = x + v cos(m) dt,  y' = y + v sin(m) dt,  yaw' = yaw + w dt,  v' = v,  w' = w
 with process noise on v and w as accelerations of `accel_std` (m/s^2) and `turn_accel_std`
-(rad/s^2). Each measurement z = H s + noise, R diagonal, is folded in by the Kalman update
-in Joseph form (Bar-Shalom, Li and Kirubarajan, "Estimation with Applications to Tracking and
-Navigation", 2001, eq. 5.2.3-18).
+(rad/s^2). Each measurement z = H s + noise, R diagonal, is folded in by the Kalman update,
+its covariance in Joseph's form (Bar-Shalom, Li and Kirubarajan, "Estimation with Applications
+to Tracking and Navigation", 2001).
 """
 
 from __future__ import annotations
