@@ -262,6 +262,21 @@ def test_an_odometry_run_logs_the_believed_pose_and_its_error(tmp_path):
     error = metrics[-2]["odometry_error_m"]  # the last planner tick (the final tick has no belief)
     assert error == pytest.approx(math.dist(truth, (belief.x, belief.y)), abs=1e-9)
     assert 0.0 < error < 0.5
+    tfs = [m.message.transforms for m in iter_messages(tmp_path / "odometry.mcap", ("/tf",))]
+    drifts = [t[0] for t in tfs if t[0].child_frame_id == "odom"]
+    assert len(drifts) == len(beliefs)
+    # world -> odom carries the last belief onto the true pose: the transform of a pose in odom
+    drift, last = drifts[-1], beliefs[-1].pose
+    turn = 2 * math.atan2(drift.rotation.z, drift.rotation.w)
+    mapped = (
+        drift.translation.x + math.cos(turn) * last.position.x - math.sin(turn) * last.position.y,
+        drift.translation.y + math.sin(turn) * last.position.x + math.cos(turn) * last.position.y,
+    )
+    pose = list(iter_messages(tmp_path / "odometry.mcap", ("/robot/pose",)))[len(beliefs) - 1].message.pose
+    assert mapped == pytest.approx((pose.position.x, pose.position.y), abs=1e-9)
+    believed_yaw = 2 * math.atan2(last.orientation.z, last.orientation.w)
+    true_yaw = 2 * math.atan2(pose.orientation.z, pose.orientation.w)
+    assert math.remainder(turn + believed_yaw - true_yaw, math.tau) == pytest.approx(0.0, abs=1e-9)
 
 
 def test_metrics_json(run):

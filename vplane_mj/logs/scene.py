@@ -28,6 +28,7 @@ from vplane_mj.sim.world import OBSTACLE_HEIGHT_M
 WORLD_FRAME = "world"
 ROBOT_FRAME = "base_link"
 FOLLOW_FRAME = "base_link_xy"
+ODOM_FRAME = "odom"
 """At base_link's position with the world's orientation: a camera following it never turns."""
 ARROW_M_PER_UNIT = 0.5
 """Force arrow length (m) per unit of force magnitude."""

@@ -10,7 +10,7 @@ messages' own `timestamp` fields, is the integer nanosecond of *simulated* time,
 | topic | schema | when |
 |---|---|---|
 | `/robot/pose` | `foxglove.PoseInFrame` | every control tick, frame `world`, z = 0 |
-| `/tf` | `foxglove.FrameTransforms` | every tick, `world` -> `base_link` and `base_link_xy` |
+| `/tf` | `foxglove.FrameTransforms` | every tick, `world` -> `base_link`, `base_link_xy` (`odom`: below) |
 | `/scan` | `foxglove.LaserScan` | every tick, frame `base_link`, NaN where no echo (see below) |
 | `/world` | `foxglove.SceneUpdate` | once at time 0: arena, static obstacles, border, start, goal, robot |
 | `/world/moving` | `foxglove.SceneUpdate` | every tick, at least every 0.1 s, if any obstacle moves |
@@ -38,7 +38,9 @@ heading arrow, in frame `base_link`, frame-locked, so it moves with `/tf`); `/wo
 they stood at its time: the tick's `Tick.obstacles`, and where ticks are further apart than
 `MOVING_PERIOD_S`, their motions' places between them; `/tracks` `track_<id>`, the planner's
 moving tracks as it estimates them (in its own frame, the world's unless its pose comes
-from odometry). Entities that vanish are removed with `SceneUpdate.deletions`.
+from odometry). Entities that vanish are removed with `SceneUpdate.deletions`. Unless
+`sensors.pose = "truth"`, `/tf` also carries `world` -> `odom` at every tick (a message of its
+own): the frame of the pose estimate, placed so that the believed pose in it is the true pose.
 
 `/scan` holds the sensor's ranges from the robot's centre at the sensor's height, rounded to
 RANGE_STEP_M (a step that compresses: a 720-beam laser costs about 2 MB a minute at 20 Hz,
@@ -91,6 +93,7 @@ from vplane_mj.logs.scene import (
     FOLLOW_FRAME,
     FORCE_COLOURS,
     FORCE_STYLE,
+    ODOM_FRAME,
     ROBOT_FRAME,
     WORLD_FRAME,
     TrackMark,
@@ -347,7 +350,7 @@ class McapLog:
         else:  # never log a non-finite pose: repeat the last good one
             x, y, yaw = self._last_pose
         self._log_pose(ns, stamp, x, y, yaw)
-        self._log_belief(ns, stamp, tick.believed_pose)
+        self._log_belief(ns, stamp, tick.believed_pose, (x, y, yaw))
         self._log_scan(ns, stamp, tick.ranges)
         self._log_forces(ns, stamp, x, y, forces)
         self._log_virtual(ns, stamp, tick)
@@ -378,13 +381,33 @@ class McapLog:
         )
         self._tf_ch.log(fm.FrameTransforms(transforms=[robot, follow]), log_time=ns)
 
-    def _log_belief(self, ns: int, stamp: fm.Timestamp, belief: tuple[float, float, float] | None) -> None:
+    def _log_belief(
+        self,
+        ns: int,
+        stamp: fm.Timestamp,
+        belief: tuple[float, float, float] | None,
+        truth: tuple[float, float, float],
+    ) -> None:
+        """The believed pose on `/robot/odometry` (frame `world`), and on `/tf` the transform
+        `world` -> `odom` that puts the belief, a pose in the estimate's frame `odom`, on the true
+        pose `truth` (x, y m, yaw rad): yaw - believed yaw, and the shift that follows."""
         if self._odometry_ch is None or belief is None or not all(map(math.isfinite, belief)):
             return
         message = fm.PoseInFrame(
             timestamp=stamp, frame_id=WORLD_FRAME, pose=scene.pose(belief[0], belief[1], 0.0, belief[2])
         )
         self._odometry_ch.log(message, log_time=ns)
+        turn = truth[2] - belief[2]
+        c, s = math.cos(turn), math.sin(turn)
+        shift = (truth[0] - (c * belief[0] - s * belief[1]), truth[1] - (s * belief[0] + c * belief[1]))
+        drift = fm.FrameTransform(
+            timestamp=stamp,
+            parent_frame_id=WORLD_FRAME,
+            child_frame_id=ODOM_FRAME,
+            translation=fm.Vector3(x=shift[0], y=shift[1], z=0.0),
+            rotation=fm.Quaternion(x=0.0, y=0.0, z=math.sin(turn / 2), w=math.cos(turn / 2)),
+        )
+        self._tf_ch.log(fm.FrameTransforms(transforms=[drift]), log_time=ns)
 
     def _log_scan(self, ns: int, stamp: fm.Timestamp, ranges: np.ndarray) -> None:
         if self._scan_slots is not None:
