@@ -378,11 +378,13 @@ import json
 import sys
 import warnings
 from dataclasses import dataclass
+from pathlib import Path
 
 import vplane_mj
 from vplane_mj.planning import Decision, Planner, PlannerParams, param, register_planner
 
-with open("executions.txt", "a") as executions:  # a line each time this file runs
+# a line each time this file runs, beside it whatever the directory it runs in
+with open(Path(__file__).with_name("executions.txt"), "a") as executions:
     executions.write("ran\\n")
 
 
