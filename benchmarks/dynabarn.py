@@ -29,10 +29,10 @@ from pathlib import Path
 
 import numpy as np
 
-from vplane_mj.bench.report import markdown_table
+from vplane_mj.bench.report import markdown_table, write_table
 from vplane_mj.bench.sweep import parse_seeds, plan_jobs, run_sweep
 from vplane_mj.errors import VPlaneError
-from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
+from vplane_mj.files import prepare_out_dir, write_atomically
 from vplane_mj.planning.registry import PLANNERS
 from vplane_mj.worlds.dynabarn_generate import generate_dynabarn
 from vplane_mj.worlds.dynabarn_layout import DIFFICULTIES
@@ -186,12 +186,11 @@ def main(argv: list[str] | None = None) -> int:
     overrides = [f"sensors.noise_std={args.noise}"] if args.noise > 0 else []
     rows = run_sweep(plan_jobs(scenarios, planners, seeds, overrides), out, args.jobs)
     table = planner_table(rows)
-    write_csv(out / "dynabarn.csv", table, COLUMNS)
     text = markdown([*table, *published_rows()])
-    write_atomically(out / "dynabarn.md", lambda tmp: tmp.write_text(text + "\n", encoding="utf-8"))
+    written = write_table(out, "dynabarn", table, COLUMNS, text)
     plot(table, out / "dynabarn.png")
     print(text)
-    print(f"wrote {out / 'dynabarn.csv'}\nwrote {out / 'dynabarn.md'}\nwrote {out / 'dynabarn.png'}")
+    print("\n".join(f"wrote {path}" for path in [*written, out / "dynabarn.png"]))
     return 0
 
 

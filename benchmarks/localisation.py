@@ -25,10 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
-from vplane_mj.bench.report import markdown_table
+from vplane_mj.bench.report import markdown_table, write_table
 from vplane_mj.bench.sweep import parse_seeds
 from vplane_mj.errors import VPlaneError
-from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
+from vplane_mj.files import prepare_out_dir
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.loop import Run
 from vplane_mj.worlds.barn_protocol import generate_protocol
@@ -144,11 +144,10 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     table = pose_table(rows, poses)
-    write_csv(out / "localisation.csv", table, COLUMNS)
     text = markdown(table)
-    write_atomically(out / "localisation.md", lambda tmp: tmp.write_text(text + "\n", encoding="utf-8"))
+    written = write_table(out, "localisation", table, COLUMNS, text)
     print(text)
-    print(f"wrote {out / 'localisation.csv'}\nwrote {out / 'localisation.md'}")
+    print("\n".join(f"wrote {path}" for path in written))
     return 0
 
 

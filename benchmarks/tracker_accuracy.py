@@ -29,10 +29,10 @@ from pathlib import Path
 
 import numpy as np
 
-from vplane_mj.bench.report import markdown_table
+from vplane_mj.bench.report import markdown_table, write_table
 from vplane_mj.bench.sweep import parse_seeds
 from vplane_mj.errors import VPlaneError
-from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
+from vplane_mj.files import prepare_out_dir
 from vplane_mj.scenario import parse_document
 from vplane_mj.sim.loop import Run, Tick
 from vplane_mj.sim.sensors import scan_bearings
@@ -178,11 +178,10 @@ def main(argv: list[str] | None = None) -> int:
         )
         for third in (*DIFFICULTIES, "all")
     ]
-    write_csv(out / "tracker_accuracy.csv", table, COLUMNS)
     text = markdown(table)
-    write_atomically(out / "tracker_accuracy.md", lambda tmp: tmp.write_text(text + "\n", encoding="utf-8"))
+    written = write_table(out, "tracker_accuracy", table, COLUMNS, text)
     print(text)
-    print(f"wrote {out / 'tracker_accuracy.csv'}\nwrote {out / 'tracker_accuracy.md'}")
+    print("\n".join(f"wrote {path}" for path in written))
     return 0
 
 

@@ -393,6 +393,17 @@ def markdown_table(rows: list[dict], columns: tuple[str, ...], cell: Callable[[s
     return "\n".join(lines)
 
 
+def write_table(
+    out_dir: Path, stem: str, table: list[dict], columns: tuple[str, ...], text: str
+) -> list[Path]:
+    """A benchmark's table as `stem`.csv (`columns`) and, as the Markdown `text`, `stem`.md in
+    `out_dir`, each written whole; their paths."""
+    return [
+        write_csv(out_dir / f"{stem}.csv", table, columns),
+        write_atomically(out_dir / f"{stem}.md", lambda tmp: tmp.write_text(text + "\n", encoding="utf-8")),
+    ]
+
+
 def write_outputs(rows: list[dict], table: list[dict], out_dir: Path, jobs: list[Job]) -> list[Path]:
     """bench.csv (one row per run), bench.json (rows and table), the figures and bench.html."""
     columns = sorted({key for row in rows for key in row if not isinstance(row[key], dict | list)})
