@@ -15,11 +15,10 @@ A candidate is a motion: a command (speed and turn rate) held for a while, a dod
 the robot makes for where its planner is going (the aim: the goal, or a point of its way) as
 the heading controller drives it. The command asked for stays when its motion meets no moving
 track within the horizon. Otherwise the candidates (speeds forward, standing and backing, turn
-rates either way, held half a second or longer) are ranked by
-how much nearer they take the robot to where its planner is going (the aim: the goal, or a
-point of its way) before they meet a track, by how soon they would meet one and how deep into
+rates either way, held half a second or longer) are ranked by how much nearer they take the
+robot to the aim before they meet a track, by how soon they would meet one and how deep into
 it within the first second, and a little by the room they keep and by keeping the last
-evasion's heading. Standing still is no refuge from an obstacle that comes on. Only a robot
+evasion's command. Standing still is no refuge from an obstacle that comes on. Only a robot
 that some moving track can reach within the horizon is checked: in a world that stands still
 nothing changes.
 """
@@ -50,6 +49,7 @@ DOUBT_CAP_M, DOUBT_CAP_MPS = 0.1, 0.2
 track that coasts unseen behind the robot grows doubtful, and a disc grown by all of its doubt
 would cover the robot and leave no motion clear of anything."""
 HIT_EXPONENT = 2.0
+"""The power of (1 - t / horizon) in what meeting a track at t costs (HIT_WEIGHT)."""
 ROOM_WEIGHT = 0.2
 """What room up to ROOM_CAP_M over the horizon earns, against a whole horizon's progress."""
 NEAR_S = 1.0

@@ -488,10 +488,11 @@ class Governor:
             return command
         pose = (float(obs.position[0]), float(obs.position[1]), float(obs.yaw))
         candidates = evasion.candidates(command)
-        if math.isinf(evasion.risks(candidates[:1], pose, self.drive.ramp, threat, aim)[0, 0]):
+        asked = evasion.risks(candidates[:1], pose, self.drive.ramp, threat, aim)
+        if math.isinf(asked[0, 0]):
             evasion.kept = None
             return command  # the command asked for meets no track: the others need no check
-        risks = evasion.risks(candidates, pose, self.drive.ramp, threat, aim)
+        risks = np.vstack((asked, evasion.risks(candidates[1:], pose, self.drive.ramp, threat, aim)))
         ranking = evasion.ranking(candidates, risks)
         chosen = ranking[0]
         for index in ranking:
