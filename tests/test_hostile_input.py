@@ -31,6 +31,7 @@ from vplane_mj import run
 from vplane_mj.cli import main
 from vplane_mj.geometry.reference import shortest_path
 from vplane_mj.logs.reader import read_log
+from vplane_mj.logs.writer import METADATA_NAME
 from vplane_mj.planning import register_planner, registry
 from vplane_mj.planning.params import Param
 from vplane_mj.robots.facts import robot_radius_m
@@ -1074,3 +1075,23 @@ def test_a_mistaken_name_in_a_file_is_blamed_on_the_file_with_the_closest_known_
     where = f"{table}.{key}" if table else key
     assert code == 2 and err.startswith(f"error: {scenario}: {where}: "), err
     assert err.rstrip().endswith(hint), err
+
+
+def test_file_names_that_are_not_utf8_work_and_are_shown_with_escapes(tmp_path):
+    """Linux gives such names as bytes (Python keeps them with lone surrogates): the run works,
+    its messages and its log's metadata show the bytes as backslash escapes."""
+    name = os.fsdecode(b"caf\xe9")
+    scenario = tmp_path / f"{name}.toml"
+    scenario.write_text(load_scenario("single_box").to_toml(), encoding="utf-8")
+    out = tmp_path / f"out-{name}"
+    done = subprocess.run(
+        [sys.executable, "-m", "vplane_mj", "run", str(scenario), "--out", str(out), "--no-render"],
+        capture_output=True,
+        env={**os.environ, "PYTHONIOENCODING": "utf-8"},
+        timeout=300,
+    )
+    assert done.returncode == 0 and b"Traceback" not in done.stderr
+    assert b"wrote " + os.fsencode(tmp_path) + b"/out-caf\\xe9/single_box-vplane-0.mcap" in done.stdout
+    log = read_log(out / "single_box-vplane-0.mcap")
+    assert log.metadata[METADATA_NAME]["scenario_source"].endswith("caf\\xe9.toml")
+    assert log.summary == json.loads((out / "single_box-vplane-0.json").read_text())

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import vplane_mj
 from vplane_mj.errors import VPlaneError
-from vplane_mj.files import DEFAULT_OUT, prepare_out_dir, write_atomically
+from vplane_mj.files import DEFAULT_OUT, prepare_out_dir, printable_path, write_atomically
 from vplane_mj.planning.plugins import PlannerError
 from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
 from vplane_mj.terminal import Interrupted, signals_raise_interrupted
@@ -63,7 +63,8 @@ def _choose_gl_backend(args: argparse.Namespace) -> None:
 class _PipeSafeOutput:
     """stdout that outlives its reader (`vplane-mj run ... | head -1`): the command still
     finishes its work and returns its own exit status; what it prints after the reader has
-    gone is discarded instead of ending it with a BrokenPipeError."""
+    gone is discarded instead of ending it with a BrokenPipeError. File names that are not
+    UTF-8 are printed with backslash escapes."""
 
     def __init__(self, stream):
         self._stream = stream
@@ -71,6 +72,8 @@ class _PipeSafeOutput:
     def write(self, text: str) -> int:
         try:
             return self._stream.write(text)
+        except UnicodeEncodeError:  # a file name that is not UTF-8
+            return self._stream.write(printable_path(text))
         except BrokenPipeError:
             self._discard_from_now_on()
             return len(text)

@@ -57,6 +57,12 @@ def output_directory(path: Path) -> Iterator[Path]:
         raise
 
 
+def printable_path(path: str | os.PathLike[str]) -> str:
+    """`path` as text that any stream and file format can carry: bytes of the name that are not
+    UTF-8 (which Python keeps as lone surrogates) shown as backslash escapes, e.g. `caf\\xe9`."""
+    return os.fsencode(path).decode("utf-8", "backslashreplace")
+
+
 def write_atomically(path: Path, write: Callable[[Path], object]) -> Path:
     """Let `write` fill a temporary file beside `path`, then rename it into place (what
     `write` returns is ignored)."""
