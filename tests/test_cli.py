@@ -251,12 +251,12 @@ def start_long_run(tmp_path):
 
 
 def wait_for_partial_log(tmp_path, process, seconds=60.0):
-    """Wait until the run has flushed a few simulated seconds of log."""
-    partial = tmp_path / ".paper_c_escape-apf-0.mcap.partial"
+    """Wait until the run has flushed a few simulated seconds of log (`.NAME.mcap.PID-RANDOM.partial`)."""
     deadline = time.monotonic() + seconds
     while time.monotonic() < deadline and process.poll() is None:
-        if partial.exists() and partial.stat().st_size > 20_000:
-            return partial
+        for partial in tmp_path.glob(f".paper_c_escape-apf-0.mcap.{process.pid}-*.partial"):
+            if partial.stat().st_size > 20_000:
+                return partial
         time.sleep(0.05)
     raise AssertionError("the run did not start writing its log")
 

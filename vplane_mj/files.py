@@ -8,6 +8,7 @@ import csv
 import io
 import json
 import os
+import secrets
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -63,10 +64,15 @@ def printable_path(path: str | os.PathLike[str]) -> str:
     return os.fsencode(path).decode("utf-8", "backslashreplace")
 
 
+def partial_path(path: Path) -> Path:
+    """A temporary name beside `path` that no other writer uses: `.NAME.PID-RANDOM.partial`."""
+    return path.with_name(f".{path.name}.{os.getpid()}-{secrets.token_hex(4)}.partial")
+
+
 def write_atomically(path: Path, write: Callable[[Path], object]) -> Path:
-    """Let `write` fill a temporary file beside `path`, then rename it into place (what
-    `write` returns is ignored)."""
-    temporary = path.with_name(f".{path.name}.partial")
+    """Let `write` fill a temporary file beside `path` (`partial_path`), then rename it into place
+    (what `write` returns is ignored); the temporary file is removed if anything fails."""
+    temporary = partial_path(path)
     try:
         write(temporary)
         os.replace(temporary, path)

@@ -16,7 +16,15 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from vplane_mj.errors import VPlaneError
-from vplane_mj.files import DEFAULT_OUT, prepare_out_dir, write_atomically, write_json
+from vplane_mj.files import (
+    DEFAULT_OUT,
+    partial_path,
+    prepare_out_dir,
+    printable_path,
+    write_atomically,
+    write_json,
+)
+from vplane_mj.locks import exclusive
 from vplane_mj.planning.events import Event, EventKind
 from vplane_mj.scenario import Scenario, load_scenario
 from vplane_mj.sim.loop import RunResult, Tick, run_scenario
@@ -102,7 +110,9 @@ def run(
     log is closed cleanly and kept; files are always whole or absent. A planner whose code
     raises does not make `run` raise: the run ends with outcome `error`, `summary.message`
     names the exception and where, `summary.traceback` holds the planner's traceback, and
-    the files are written as for any run (the log up to the failing tick).
+    the files are written as for any run (the log up to the failing tick). While another
+    process writes the same files (same `out`, name, planner and seed), `run` refuses with an
+    OutputBusy naming it, before anything is written.
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(os.fspath(scenario))
@@ -113,22 +123,31 @@ def run(
         return _record(scenario, run_scenario(scenario, (recorder,)), recorder, {})
     base = output_base(scenario, prepare_out_dir(Path(out)))
     files: dict[str, Path] = {}
-    result = _simulate(scenario, base, log, recorder, files)
-    try:
-        files["summary"] = write_json(base.with_suffix(".json"), result.summary.to_dict())
-        if render:
-            from vplane_mj.viz.render import render_top_view, run_caption, write_png
-
-            image = render_top_view(scenario, result.track(), run_caption(result.summary))
-            files["render"] = write_atomically(base.with_suffix(".png"), lambda tmp: write_png(image, tmp))
-        if video:
-            from vplane_mj.viz.video import write_video
-
-            files["video"] = write_video(files["log"], base.with_suffix(".mp4"))
-    except Interrupted as exc:
-        exc.written = dict(files)
-        raise
+    what = f"{printable_path(base)}.*: this run's files"
+    with exclusive(base.with_name(f".{base.name}.lock"), what, "wait for it to end or choose another --out"):
+        result = _simulate(scenario, base, log, recorder, files)
+        try:
+            _write_outputs(scenario, result, base, render, video, files)
+        except Interrupted as exc:
+            exc.written = dict(files)
+            raise
     return _record(scenario, result, recorder, files)
+
+
+def _write_outputs(
+    scenario: Scenario, result: RunResult, base: Path, render: bool, video: bool, files: dict[str, Path]
+) -> None:
+    """The files made after the run: its summary, with `render` the render, with `video` the video."""
+    files["summary"] = write_json(base.with_suffix(".json"), result.summary.to_dict())
+    if render:
+        from vplane_mj.viz.render import render_top_view, run_caption, write_png
+
+        image = render_top_view(scenario, result.track(), run_caption(result.summary))
+        files["render"] = write_atomically(base.with_suffix(".png"), lambda tmp: write_png(image, tmp))
+    if video:
+        from vplane_mj.viz.video import write_video
+
+        files["video"] = write_video(files["log"], base.with_suffix(".mp4"))
 
 
 def _simulate(
@@ -158,14 +177,13 @@ def _simulate(
 def _open_log(scenario: Scenario, target: Path) -> McapLog:
     """An MCAP log written under a temporary name beside `target` (renamed when finished).
 
-    A process killed outright leaves that `.partial` file: its flushed part (all but
+    A process killed outright leaves that `.NAME.mcap.PID-RANDOM.partial` file: its flushed part (all but
     about the last simulated second) is readable with `vplane_mj.logs.reader.read_log`.
     """
     from vplane_mj.logs.writer import McapLog
     from vplane_mj.sim.sensors import scan_bearings
 
-    partial = target.with_name(f".{target.name}.partial")
-    return McapLog(partial, scenario, scan_bearings(scenario), {})
+    return McapLog(partial_path(target), scenario, scan_bearings(scenario), {})
 
 
 def _finish_log(log: McapLog, target: Path, summary: dict | None) -> Path:
