@@ -57,3 +57,27 @@ def test_a_killed_run_leaves_a_stale_lock_that_the_next_run_takes_over(tmp_path,
     assert main([*RUN, "--set", "run.time_limit_s=5", "--out", str(tmp_path)]) == 1
     assert not stale.exists() and leftover.read_bytes() == b"a killed run's log"
     assert read_log(tmp_path / "paper_c_escape-apf-0.mcap").summary["outcome"] == "timeout"
+
+
+BENCH = ["bench", "single_box", "--planners", "apf,vplane", "--seeds", "0-1", "--jobs", "1"]
+
+
+def test_a_sweep_into_a_folder_another_sweep_holds_is_refused(tmp_path, capsys):
+    with exclusive(tmp_path / ".bench.lock", "the test's sweep", "none"):
+        assert main([*BENCH, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert f"the folder of a sweep: in use by pid {os.getpid()}" in err and "--wait" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_sweeps_that_wait_for_each_other_run_every_job_once(tmp_path):
+    with exclusive(tmp_path / ".bench.lock", "the test's sweep", "none"):
+        sweeps = [cli_process(*BENCH, "--out", str(tmp_path), "--wait") for _ in range(2)]
+        for waiting in sweeps:
+            assert "the folder of a sweep: waiting for pid" in waiting.stderr.readline()
+    errs = [waiting.communicate(timeout=600)[1] for waiting in sweeps]
+    assert [waiting.returncode for waiting in sweeps] == [0, 0]
+    assert sorted("4 to run" in err for err in errs) == [False, True]
+    assert any("4 already done, 0 to run" in err for err in errs)
+    journal = [json.loads(line) for line in (tmp_path / "bench.jsonl").read_text().splitlines()]
+    assert len(journal) == 4 and len({row["key"] for row in journal}) == 4

@@ -165,6 +165,11 @@ def _add_bench(commands) -> None:
     )
     sweep.add_argument("--scheduler", metavar="ADDRESS", help="run on this Dask scheduler ([dask] extra)")
     sweep.add_argument("--out", type=Path, help=f"output directory (default {DEFAULT_OUT}/)")
+    sweep.add_argument(
+        "--wait",
+        action="store_true",
+        help="if another sweep writes into the output directory, wait for it to end (default: refuse)",
+    )
     sweep.set_defaults(handler=_bench, draws=False)
 
 
@@ -330,7 +335,14 @@ def _bench(args: argparse.Namespace) -> int:
         with signals_raise_interrupted(), warnings.catch_warnings():
             warnings.simplefilter("ignore", SweepErrorWarning)  # the runs in error are listed below
             result = sweep(
-                args.scenarios, planners, seeds, tuple(args.set), args.jobs, args.scheduler, out_dir
+                args.scenarios,
+                planners,
+                seeds,
+                tuple(args.set),
+                args.jobs,
+                args.scheduler,
+                out_dir,
+                wait=args.wait,
             )
     except Interrupted as exc:
         end_of_progress_bar = "\n" if sys.stderr.isatty() else ""

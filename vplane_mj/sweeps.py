@@ -6,6 +6,7 @@ cluster, the table and the report); the command line's `bench` is this call with
 from __future__ import annotations
 
 import os
+import sys
 import tempfile
 import warnings
 from collections.abc import Iterable, Sequence
@@ -22,7 +23,8 @@ from vplane_mj.bench.sweep import (
     summarize,
 )
 from vplane_mj.errors import VPlaneError
-from vplane_mj.files import DEFAULT_OUT, output_directory
+from vplane_mj.files import DEFAULT_OUT, output_directory, printable_path
+from vplane_mj.locks import exclusive
 from vplane_mj.planning import registry
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.plugins import PlannerError, is_import_spec
@@ -71,6 +73,7 @@ def sweep(
     out: str | os.PathLike[str] | None = DEFAULT_OUT,
     *,
     report: bool = True,
+    wait: bool = False,
 ) -> SweepResult:
     """Run every scenario (a Scenario, or a file or a built-in scenario's name) with every
     planner (default: all of them; a name, an import spec `module:Class` or `file.py:Class`, or
@@ -83,7 +86,9 @@ def sweep(
     `bench.jsonl` in `out` and the same sweep again runs only what is missing; with `report`
     the table and figures are written too (bench.csv, bench.json, bench.png,
     bench-scenarios.png, bench.html). `out=None` keeps nothing: the journal goes to a
-    temporary directory and no report is written.
+    temporary directory and no report is written. One sweep at a time writes into a folder: while
+    another holds it (its lock file `.bench.lock`), an OutputBusy names that sweep, or with `wait`
+    the sweep waits for it to end and then runs only the jobs it left.
     """
     workers = (os.cpu_count() or 1) if jobs is None else jobs
     if workers < 1:
@@ -107,10 +112,18 @@ def sweep(
             result = sweep_into(Path(scratch), report=False)
     else:
         with output_directory(Path(out)) as out_dir:
-            result = sweep_into(out_dir, report)
+            what = f"{printable_path(out_dir)}: the folder of a sweep"
+            remedy = "wait for it (--wait) or choose another --out"
+            with exclusive(out_dir / ".bench.lock", what, remedy, wait, _say):
+                result = sweep_into(out_dir, report)
     if result.errors:
         warnings.warn(_errors_warning(result), SweepErrorWarning, stacklevel=2)
     return result
+
+
+def _say(line: str) -> None:
+    """Tell the user (on stderr) what the sweep waits for."""
+    print(line, file=sys.stderr)
 
 
 def _errors_warning(result: SweepResult) -> str:
