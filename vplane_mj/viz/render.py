@@ -98,8 +98,7 @@ def render_top_view(scenario, track: Track, caption: str = "") -> np.ndarray:
     mujoco.mj_forward(model, data)
     height, width = model.vis.global_.offheight, model.vis.global_.offwidth
     model.vis.global_.offwidth = width + LEGEND_PX
-    extra = 0 if places is None else places.shape[1] * (MAX_TRACE_SEGMENTS + OUTLINE_SEGMENTS + 4)
-    scene = mujoco.MjvScene(model, maxgeom=MAX_PATH_SEGMENTS + 500 + extra)
+    scene = mujoco.MjvScene(model, maxgeom=_scene_capacity(model, track, places))
     camera = mujoco.MjvCamera()
     camera.type, camera.fixedcamid = mujoco.mjtCamera.mjCAMERA_FIXED, model.camera("top").id
     options = mujoco.MjvOption()
@@ -124,6 +123,18 @@ def render_top_view(scenario, track: Track, caption: str = "") -> np.ndarray:
         context.free()
         gl.free()
     return np.flipud(image)
+
+
+def _scene_capacity(model: mujoco.MjModel, track: Track, places: np.ndarray | None) -> int:
+    """Geoms the render's scene holds: all that MuJoCo may draw of the model (its geoms, sites,
+    tendons, cameras and lights), and every marker `_add_track` and `_add_moving` add."""
+    drawn = model.ngeom + model.nsite + model.ntendon + model.ncam + model.nlight
+    markers = (
+        2 + len(track.planes) + len(track.objectives) + MAX_PATH_SEGMENTS + 1 + len(track.collision_points)
+    )
+    if places is not None:
+        markers += places.shape[1] * (MAX_TRACE_SEGMENTS + 1 + OUTLINE_SEGMENTS + 2)
+    return drawn + markers
 
 
 def run_caption(summary: RunSummary) -> str:
@@ -318,8 +329,6 @@ def _png_chunk(kind: bytes, data: bytes) -> bytes:
 
 
 def _add_disc(scene: mujoco.MjvScene, center, radius: float, rgba, z: float = MARKER_HEIGHT_M) -> None:
-    if scene.ngeom >= scene.maxgeom:
-        return
     mujoco.mjv_initGeom(
         scene.geoms[scene.ngeom],
         type=mujoco.mjtGeom.mjGEOM_CYLINDER,
@@ -334,8 +343,6 @@ def _add_disc(scene: mujoco.MjvScene, center, radius: float, rgba, z: float = MA
 def _add_segment(
     scene: mujoco.MjvScene, a, b, rgba, width: float = 4.0, z: float = MARKER_HEIGHT_M + 0.01
 ) -> None:
-    if scene.ngeom >= scene.maxgeom:
-        return
     geom = scene.geoms[scene.ngeom]
     mujoco.mjv_initGeom(
         geom,
