@@ -567,6 +567,7 @@ SHIPPED = [
     "paper_h_avoid",
     "paper_h_escape",
     "single_box",
+    "walled_goal",
 ]
 """The scenarios the package ships (docs/scenarios.md), sorted by name."""
 
