@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj.geometry.polyline import PathSimplifier, distances_to_segment
+from vplane_mj.geometry.polyline import PathSimplifier, distances_to_segment, douglas_peucker
 
 
 def simplify(points: np.ndarray, tolerance_m: float = 0.01, max_pending: int = 200) -> np.ndarray:
@@ -81,3 +81,29 @@ def test_one_or_no_position():
     simplifier = PathSimplifier(0.01)
     simplifier.add(1.0, 2.0)
     assert simplifier.polyline() == [(1.0, 2.0)]
+
+
+def test_a_capped_polyline_keeps_its_vertex_count_and_its_bound_on_a_long_winding_path():
+    """A random walk of 20,000 positions (about 600 m of turns) under a cap of 300 vertices."""
+    rng = np.random.default_rng(3)
+    heading = np.cumsum(rng.normal(0.0, 0.15, 20_000))
+    points = np.cumsum(0.03 * np.column_stack((np.cos(heading), np.sin(heading))), axis=0)
+    simplifier = PathSimplifier(0.01, max_vertices=300)
+    most = 0
+    for x, y in points:
+        simplifier.add(x, y)
+        most = max(most, len(simplifier.polyline()))
+    polyline = np.array(simplifier.polyline())
+    assert len(simplify(points)) > 2500  # uncapped, the path needs eight times the cap
+    assert most <= 301  # the vertices, and the newest position held back
+    assert 0.01 < simplifier.within_m < 2.0
+    assert deviation(points, polyline) <= simplifier.within_m + 1e-12
+    assert polyline[0] == pytest.approx(points[0]) and polyline[-1] == pytest.approx(points[-1])
+    newest = points[-100:]  # the latest stretch keeps the fine tolerance
+    assert deviation(newest, polyline[-(len(polyline) // 4) :]) <= 0.01 + 1e-12
+
+
+def test_douglas_peucker_keeps_the_ends_and_the_corners_beyond_its_tolerance():
+    points = np.array([[0, 0], [1, 0.004], [2, 0], [2, 1], [2.003, 2], [2, 3]], dtype=float)
+    np.testing.assert_array_equal(douglas_peucker(points, 0.01), [0, 2, 5])
+    np.testing.assert_array_equal(douglas_peucker(points, 0.001), [0, 1, 2, 3, 4, 5])

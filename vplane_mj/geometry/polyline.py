@@ -22,12 +22,25 @@ class PathSimplifier:
     becomes a vertex. A straight run is one edge, a curve of radius r gets a vertex about
     every 2 sqrt(2 r tolerance) metres. At most `max_pending` positions are held back (a
     vertex is made then), which bounds the work per position.
+
+    With `max_vertices`, the polyline drawn never has more vertices: when the fine polyline
+    (all the vertices above, kept) grows past it, its older part is drawn simplified again
+    (Douglas-Peucker) with the coarse tolerance, doubled until that part takes at most half of
+    `max_vertices`; the newest quarter stays fine. Every position then lies within
+    `within_m` (the fine tolerance plus the coarse one) of the polyline drawn.
     """
 
-    def __init__(self, tolerance_m: float, max_pending: int = 200):
+    def __init__(self, tolerance_m: float, max_pending: int = 200, max_vertices: int | None = None):
         self.tolerance_m = float(tolerance_m)
         self.max_pending = int(max_pending)
+        self.max_vertices = max_vertices
+        self.within_m = self.tolerance_m
+        """How far (m) any position added may lie from the polyline drawn."""
         self._vertices: list[tuple[float, float]] = []
+        # The drawn polyline's coarse part, in place of the fine vertices before _coarse_end.
+        self._coarse: list[tuple[float, float]] = []
+        self._coarse_end = 0
+        self._coarse_m = 2.0 * self.tolerance_m
         # The positions held back, relative to the last vertex: _rel_x[:_held], _rel_y[:_held].
         self._rel_x = np.empty(self.max_pending)
         self._rel_y = np.empty(self.max_pending)
@@ -44,11 +57,31 @@ class PathSimplifier:
         if held and (held >= self.max_pending or self._beyond_tolerance(held, point)):
             self._vertices.append(self._newest)
             held = 0
+            if self.max_vertices is not None and self._drawn_count() >= self.max_vertices:
+                self._coarsen_older()
         ax, ay = self._vertices[-1]
         self._rel_x[held] = point[0] - ax
         self._rel_y[held] = point[1] - ay
         self._newest = point
         self._held = held + 1
+
+    def _drawn_count(self) -> int:
+        """The vertices of the polyline drawn, the newest position held back left out."""
+        return len(self._coarse) + len(self._vertices) - self._coarse_end
+
+    def _coarsen_older(self) -> None:
+        """Draw all but the newest quarter of `max_vertices` fine vertices coarse: Douglas-Peucker
+        with the coarse tolerance, doubled until they take at most half of `max_vertices`."""
+        assert self.max_vertices is not None
+        end = len(self._vertices) - self.max_vertices // 4
+        older = np.array(self._vertices[: end + 1])  # to the first fine vertex after them
+        kept = older[douglas_peucker(older, self._coarse_m)]
+        while len(kept) > self.max_vertices // 2:
+            self._coarse_m *= 2.0
+            kept = older[douglas_peucker(older, self._coarse_m)]
+        self._coarse = [(float(x), float(y)) for x, y in kept[:-1]]
+        self._coarse_end = end
+        self.within_m = self.tolerance_m + self._coarse_m
 
     def _beyond_tolerance(self, held: int, point: tuple[float, float]) -> bool:
         """Whether a held-back position is farther than the tolerance from the edge from the
@@ -60,7 +93,27 @@ class PathSimplifier:
         return kernels.beyond_tolerance(self._rel_x, self._rel_y, held, dx, dy, self.tolerance_m**2)
 
     def polyline(self) -> list[tuple[float, float]]:
-        """The vertices from the first position to the newest one."""
-        if not self._held:
-            return list(self._vertices)
-        return [*self._vertices, self._newest]
+        """The vertices drawn from the first position to the newest one."""
+        drawn = [*self._coarse, *self._vertices[self._coarse_end :]]
+        return [*drawn, self._newest] if self._held else drawn
+
+
+def douglas_peucker(points: np.ndarray, tolerance_m: float) -> np.ndarray:
+    """Indices of the vertices of `points` (N, 2; m) that Douglas-Peucker keeps: the first, the
+    last, and recursively the farthest from the chord between two kept ones while it lies more
+    than `tolerance_m` from it. Every dropped point lies within `tolerance_m` of the polyline
+    through the kept ones, in the part between the two kept vertices around it."""
+    kept = np.zeros(len(points), dtype=bool)
+    kept[[0, -1]] = True
+    spans = [(0, len(points) - 1)]
+    while spans:
+        first, last = spans.pop()
+        if last - first < 2:
+            continue
+        gaps = distances_to_segment(points[first + 1 : last], points[first], points[last])
+        farthest = int(np.argmax(gaps))
+        if gaps[farthest] > tolerance_m:
+            middle = first + 1 + farthest
+            kept[middle] = True
+            spans += [(first, middle), (middle, last)]
+    return np.flatnonzero(kept)
