@@ -199,6 +199,19 @@ def test_localisation_sets_the_ekf_beside_wheel_odometry(tmp_path):
     assert (tmp_path / "loc" / "localisation.csv").is_file()
 
 
+def test_log_growth_reports_the_size_per_simulated_minute(tmp_path):
+    out = run_benchmark("log_growth.py", *("--minutes", "0.5,2", "--out", "growth"), cwd=tmp_path)
+    (half,) = table_rows(out, "0.5")
+    (two,) = table_rows(out, "2")
+    assert number(half[4]) == 1.0 and 0.8 < number(two[4]) < 1.1  # MB per minute over the shortest's
+    assert number(half[5]) < number(two[5])  # the path's vertices
+    assert (tmp_path / "growth" / "log_growth.csv").is_file()
+    refused = subprocess.run(
+        [sys.executable, str(BENCHMARKS / "log_growth.py"), "--minutes", "0"], capture_output=True, text=True
+    )
+    assert refused.returncode == 2 and "--minutes: positive numbers" in refused.stderr
+
+
 def test_sweep_rate_counts_runs_per_core_minute_of_each_planners_sweep(tmp_path):
     out = run_benchmark(
         "sweep_rate.py", *("--worlds", "2", "--planners", "apf,vplane", "--out", "rate"), cwd=tmp_path

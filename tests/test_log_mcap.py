@@ -347,6 +347,32 @@ def test_the_latest_path_message_before_any_time_holds_the_whole_path_up_to_then
     assert len(paths[-1].message.entities[0].lines[0].points) < 100  # about 4 m travelled
 
 
+def test_the_log_grows_linearly_with_the_run_and_every_path_message_stays_whole(tmp_path):
+    """vfh looks for a way to the walled-in goal as long as the run lasts (830 m of turns in 30
+    minutes): bytes per simulated minute as in one minute, whole paths after any seek."""
+    sizes = {}
+    for minutes in (1, 30):
+        scenario = load_scenario("walled_goal", ["planner.name=vfh", f"run.time_limit_s={60 * minutes}"])
+        path = tmp_path / f"walled_goal-{minutes}.mcap"
+        with McapLog(path, scenario, scan_bearings(scenario), {}) as log:
+            summary = run_scenario(scenario, (log,)).summary
+            log.close(summary.to_dict())
+        assert summary.outcome == "timeout" and summary.path_length_m > 13 * minutes
+        sizes[minutes] = path.stat().st_size / minutes
+    assert sizes[30] <= 1.1 * sizes[1]  # bytes per simulated minute
+    contents = read_log(path)
+    paths = list(iter_messages(path, ("/path",)))
+    times = np.array([p.log_time_ns for p in paths])
+    assert 1800 <= len(paths) <= 1802 and np.all(np.diff(times) > 0)  # every second, and at close
+    for seek_ns in np.linspace(0, contents.times_ns[-1], 5).astype(np.int64)[1:]:
+        update = paths[np.searchsorted(times, seek_ns, side="right") - 1]  # what a viewer keeps
+        polyline = np.array([(p.x, p.y) for p in update.message.entities[0].lines[0].points])
+        travelled = contents.positions[contents.times_ns <= update.log_time_ns]
+        assert seek_ns - update.log_time_ns <= time_ns(FLUSH_PERIOD_S)
+        assert polyline[0] == pytest.approx(travelled[0]) and polyline[-1] == pytest.approx(travelled[-1])
+        assert distances_to_polyline(travelled, polyline).max() <= PATH_TOLERANCE_M + 1e-9
+
+
 def distances_to_polyline(points: np.ndarray, polyline: np.ndarray) -> np.ndarray:
     """Distance from each point to the nearest edge (or the single vertex) of `polyline`."""
     if len(polyline) == 1:

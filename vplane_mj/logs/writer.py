@@ -29,7 +29,8 @@ Entity ids: `/forces` `attractive`, `repulsive`, `virtual`,
 planner's list); `/path` `path` (one line strip from the start to the robot, replaced
 by every message, so that the latest message before any time, all a viewer keeps of a
 scene topic after a seek, shows the whole path up to then; simplified to within
-`PATH_TOLERANCE_M` of every logged pose, which keeps it a few hundred points long);
+`PATH_TOLERANCE_M` of every logged pose, which keeps it a few hundred points long, and
+never longer than `PATH_MAX_VERTICES`: beyond, its older part is drawn coarser);
 `/world` `arena`, `border`, `obstacle_<i>` (i the obstacle's index in the scenario file),
 `start`, `goal` (frame `world`) and `robot`
 (a round robot as a disc of `robot_radius_m`, another as its footprint polygon, with a
@@ -67,6 +68,12 @@ A tick's messages are written with the rest of its simulated second, just before
 Crash safety: the writer is flushed (open chunk finished and written to disk) about
 once per simulated second, so a process killed with SIGKILL loses at most about the
 last second; `vplane_mj.logs.reader.read_log` recovers every complete chunk of such a file.
+
+Size: the `/path` messages are held back and written every `PATH_CHUNK_PERIOD_S` in a chunk of
+their own (log times earlier than the chunks before it, which MCAP readers sort by), where
+compression stores their common part once. Written with the rest, every message would cost
+the whole path, and the log would grow as the square of the run's length. A killed run loses
+at most the last `PATH_CHUNK_PERIOD_S` of `/path` (its poses only the last second).
 """
 
 from __future__ import annotations
@@ -112,6 +119,10 @@ SUMMARY_METADATA_NAME = "summary"
 EVENTS_DATA_TOPIC = "/run/events"
 FLUSH_PERIOD_S = 1.0
 """Simulated time between two writer flushes (and /path updates)."""
+PATH_CHUNK_PERIOD_S = 30.0
+"""Simulated time between two writes of the `/path` messages held back, in a chunk of their own."""
+PATH_MAX_VERTICES = 5000
+"""The most vertices of a `/path` message: beyond, its older part is drawn coarser."""
 RANGE_STEP_M = 1.0 / 1024
 """`/scan` ranges are rounded to this step (m), finer than any sensor's noise: a binary fraction
 leaves the low bytes of each number zero, which the chunks' compression then removes."""
@@ -211,7 +222,8 @@ class McapLog:
         self._closed = False
 
         self._context = foxglove.Context()
-        options = MCAPWriteOptions(compression=MCAPCompression.Zstd, compression_threads=0)
+        # Chunks end at the flushes alone, so that one chunk holds all the /path messages held back.
+        options = MCAPWriteOptions(compression=MCAPCompression.Zstd, compression_threads=0, chunk_size=None)
         self._writer = foxglove.open_mcap(
             self.path, allow_overwrite=allow_overwrite, context=self._context, writer_options=options
         )
@@ -247,7 +259,9 @@ class McapLog:
         self._virtual_state: tuple[tuple[float, ...] | None, tuple[tuple[float, ...], ...]] = (None, ())
         self._shown_planes = 0
         self._virtual_shown: tuple[np.ndarray | None, list[tuple[np.ndarray, np.ndarray]]] = (None, [])
-        self._path = PathSimplifier(PATH_TOLERANCE_M)
+        self._path = PathSimplifier(PATH_TOLERANCE_M, max_vertices=PATH_MAX_VERTICES)
+        self._held_paths: list[tuple[fm.SceneUpdate, int]] = []  # /path messages not yet written
+        self._next_path_chunk_s = PATH_CHUNK_PERIOD_S
         self._scan_pose = scene.pose(0.0, 0.0, PROFILES[scenario.robot.profile].sensor_height_m)
         self._scan_slots, self._scan_angles = scan_slots(self.bearings)
         self._path_dirty = False
@@ -296,6 +310,10 @@ class McapLog:
             self._writer.flush()
             while self._next_flush_s <= tick.time_s + 1e-9:
                 self._next_flush_s += FLUSH_PERIOD_S
+            if tick.time_s >= self._next_path_chunk_s - 1e-9:
+                self._write_held_paths()
+                while self._next_path_chunk_s <= tick.time_s + 1e-9:
+                    self._next_path_chunk_s += PATH_CHUNK_PERIOD_S
 
     def on_event(self, time_s: float, event: Event) -> None:
         if self._closed:
@@ -321,6 +339,7 @@ class McapLog:
             self._write_pending()
             if self._path_dirty:
                 self._log_path(self._last_ns)
+            self._write_held_paths()
             if summary is not None:
                 text = json.dumps(_json_safe(summary), allow_nan=False, default=str)
                 self._writer.write_metadata(SUMMARY_METADATA_NAME, {"json": text})
@@ -533,14 +552,24 @@ class McapLog:
 
     # -- the path ----------------------------------------------------------------------------
     def _log_path(self, ns: int) -> None:
-        """Log the path from the start to the newest pose as the one entity `path`.
+        """Hold back a message of the path from the start to the newest pose as the one entity
+        `path` (written by `_write_held_paths`).
 
         Each message replaces the previous one, so a viewer that keeps only the latest
         message of the topic (after a seek) still draws the whole path up to its time.
         """
         entity = scene.path_entity(scene.stamp(ns), self._path.polyline())
-        self._path_ch.log(fm.SceneUpdate(entities=[entity]), log_time=ns)
+        self._held_paths.append((fm.SceneUpdate(entities=[entity]), ns))
         self._path_dirty = False
+
+    def _write_held_paths(self) -> None:
+        """Write the `/path` messages held back as one chunk: each repeats the one before it and
+        adds a few vertices, which the chunk's compression stores once, so that the log grows
+        with the path's length, not with its square."""
+        for update, ns in self._held_paths:
+            self._path_ch.log(update, log_time=ns)
+        self._held_paths.clear()
+        self._writer.flush()
 
 
 SCAN_SLOT_RAD = math.radians(1.0)
