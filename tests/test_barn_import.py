@@ -14,10 +14,11 @@ import numpy as np
 import pytest
 
 from vplane_mj.cli import main
-from vplane_mj.errors import ScenarioError
+from vplane_mj.errors import ScenarioError, WorldFileError
 from vplane_mj.geometry.shapes import scene_footprints
 from vplane_mj.scenario import parse_document
 from vplane_mj.sim.metrics import path_quality
+from vplane_mj.worlds import sdf
 from vplane_mj.worlds.barn_import import barn_path_length, import_worlds
 from vplane_mj.worlds.barn_layout import JACKAL_RADIUS_M, to_arena
 from vplane_mj.worlds.sdf import read_world_shapes
@@ -287,3 +288,9 @@ def test_a_start_the_jackal_would_overlap_is_refused(tmp_path, capsys, gazebo_y,
     assert main(["import", "barn", str(world), "--out", str(tmp_path / "out")]) == 2
     assert f"error: {world}: {reason}" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_world_file_is_read_up_to_a_bound(monkeypatch):
+    monkeypatch.setattr(sdf, "MAX_WORLD_BYTES", 1000)
+    with pytest.raises(WorldFileError, match="is larger than 1000 bytes: not a world of BARN or DynaBARN"):
+        read_world_shapes(SAMPLE / "world_1.world")

@@ -38,9 +38,8 @@ from vplane_mj.worlds.barn_import import WORLD_FILE, world_files
 from vplane_mj.worlds.dynabarn_layout import DIFFICULTIES, layout_document, moving_cylinder, to_arena
 from vplane_mj.worlds.dynabarn_plugins import PluginAnimation, read_plugin
 from vplane_mj.worlds.families import Case
+from vplane_mj.worlds.sdf import ElementReader
 
-MAX_WORLD_BYTES = 16 * 1024 * 1024
-"""The largest world file read (bytes); DynaBARN's are 20 to 40 kB."""
 WALLS = ("back_wall", "top_wall", "bottom_wall")
 """DynaBARN's static walls, left out of the scenario."""
 INCLUDES = ("model://ground_plane", "model://sun")
@@ -79,25 +78,8 @@ class ImportedDynaWorld:
     static_left_out: int
 
 
-class _Reader:
-    """Reads one world file; every error names `source` and the element."""
-
-    def __init__(self, source: str):
-        self.source = source
-
-    def fail(self, element: str, reason: str) -> WorldFileError:
-        return WorldFileError(self.source, element, reason)
-
-    def numbers(self, node: ET.Element, where: str, count: int, meaning: str) -> list[float]:
-        """The `count` finite numbers of an element's text."""
-        text = (node.text or "").strip()
-        try:
-            values = [float(token) for token in text.split()]
-        except ValueError:
-            values = []
-        if len(values) != count or not all(math.isfinite(value) for value in values):
-            raise self.fail(where, f"must be {count} finite numbers ({meaning}), got {text!r}")
-        return values
+class _Reader(ElementReader):
+    """Reads one DynaBARN world file's models."""
 
     def centred(self, owner: ET.Element, where: str) -> None:
         """`owner`'s `<pose>`, if any, must not move the cylinder off its model's origin nor tilt it."""
@@ -125,12 +107,7 @@ class _Reader:
         if len(shapes) != 1 or shapes[0].tag != "cylinder":
             got = ", ".join(f"<{shape.tag}>" for shape in shapes) or "nothing"
             raise self.fail(f"{where}/geometry", f"must be one <cylinder> (a moving model), got {got}")
-        node = shapes[0].find("radius")
-        if node is None:
-            raise self.fail(f"{where}/geometry/cylinder", "has no <radius>")
-        (radius,) = self.numbers(node, f"{where}/geometry/cylinder/radius", 1, "metres")
-        if radius <= 0:
-            raise self.fail(f"{where}/geometry/cylinder/radius", f"must be greater than 0, got {radius:g}")
+        (radius,) = self.positive(shapes[0], "radius", f"{where}/geometry/cylinder", 1, "metres")
         return radius
 
     def wall(self, model: ET.Element, where: str) -> None:
@@ -209,18 +186,7 @@ def read_world_models(path: Path, source: str | None = None) -> tuple[list[Movin
 
     `source` names the file in errors (default: the path)."""
     reader = _Reader(source or str(path))
-    try:
-        with path.open("rb") as file:
-            data = file.read(MAX_WORLD_BYTES + 1)
-    except OSError as exc:
-        raise reader.fail("", f"cannot read the file: {exc.strerror or exc}") from None
-    if len(data) > MAX_WORLD_BYTES:
-        raise reader.fail("", f"is larger than {MAX_WORLD_BYTES} bytes: not a DynaBARN world")
-    try:
-        root = ET.fromstring(data.replace(*GAZEBO_EMPTY_FRAME))
-    except ET.ParseError as exc:
-        raise reader.fail("", f"not well-formed XML: {exc}") from None
-    return reader.world(root)
+    return reader.world(reader.parse(reader.file_bytes(path).replace(*GAZEBO_EMPTY_FRAME)))
 
 
 def plugin_path(world: Path, model: MovingModel, plugins: Path | None) -> Path:

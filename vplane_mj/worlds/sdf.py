@@ -9,8 +9,9 @@ Anything else (a mesh, a sphere, a non-static model, an `<include>`, a pose rela
 frame, a malformed file or number) is a WorldFileError naming the file and the element, as an
 XPath below `<world>`, e.g. `model[@name='m']/link[@name='link']/collision[@name='c']/geometry`.
 
-The file is parsed with xml.etree.ElementTree: it never fetches external entities or DTDs, and
-its expat (2.4.1 or later) refuses the exponential entity expansion of a "billion laughs" file.
+The file, at most MAX_WORLD_BYTES, is parsed with xml.etree.ElementTree: it never fetches
+external entities or DTDs, and its expat (2.4.1 or later) refuses the exponential entity
+expansion of a "billion laughs" file. `ElementReader` is what the DynaBARN importer shares.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ from pathlib import Path
 
 from vplane_mj.errors import WorldFileError
 
+MAX_WORLD_BYTES = 16 * 1024 * 1024
+"""The largest world file read (bytes); BARN's are about 0.5 MB, DynaBARN's 20 to 40 kB."""
 _TILT_TOLERANCE_RAD = 1e-6
 """Largest roll or pitch (rad) of a pose that still counts as upright."""
 _UNSUPPORTED_WORLD_CHILDREN = frozenset({"include", "actor", "population", "road", "frame", "joint"})
@@ -57,14 +60,32 @@ class _Pose:
         return _Pose(x, y, self.yaw + inner.yaw)
 
 
-class _Reader:
-    """Reads one file; every error names `source` and the element."""
+class ElementReader:
+    """Reads one file's elements; every error names `source` and the element."""
 
     def __init__(self, source: str):
         self.source = source
 
     def fail(self, element: str, reason: str) -> WorldFileError:
         return WorldFileError(self.source, element, reason)
+
+    def file_bytes(self, path: Path) -> bytes:
+        """The file's bytes, at most MAX_WORLD_BYTES."""
+        try:
+            with path.open("rb") as file:
+                data = file.read(MAX_WORLD_BYTES + 1)
+        except OSError as exc:
+            raise self.fail("", f"cannot read the file: {exc.strerror or exc}") from None
+        if len(data) > MAX_WORLD_BYTES:
+            raise self.fail("", f"is larger than {MAX_WORLD_BYTES} bytes: not a world of BARN or DynaBARN")
+        return data
+
+    def parse(self, data: bytes) -> ET.Element:
+        """The root element of an XML document."""
+        try:
+            return ET.fromstring(data)
+        except ET.ParseError as exc:
+            raise self.fail("", f"not well-formed XML: {exc}") from None
 
     def numbers(self, node: ET.Element, where: str, count: int, meaning: str) -> list[float]:
         """The `count` finite numbers of an element's text."""
@@ -86,6 +107,10 @@ class _Reader:
         if min(values) <= 0:
             raise self.fail(f"{where}/{tag}", f"must be greater than 0, got {(node.text or '').strip()!r}")
         return values
+
+
+class _Reader(ElementReader):
+    """Reads one BARN world file's shapes."""
 
     def pose(self, owner: ET.Element, where: str) -> _Pose:
         """The planar pose of `owner`'s `<pose>` child (none: the identity); it must be upright
@@ -192,10 +217,4 @@ def read_world_shapes(path: Path, source: str | None = None) -> list[WorldShape]
 
     `source` names the file in errors (default: the path)."""
     reader = _Reader(source or str(path))
-    try:
-        root = ET.parse(path).getroot()
-    except ET.ParseError as exc:
-        raise reader.fail("", f"not well-formed XML: {exc}") from None
-    except OSError as exc:
-        raise reader.fail("", f"cannot read the file: {exc.strerror or exc}") from None
-    return reader.world(root)
+    return reader.world(reader.parse(reader.file_bytes(path)))
