@@ -6,6 +6,7 @@ the MIT licence it is distributed under (see its README.md).
 
 import copy
 import math
+import os
 import shutil
 import tomllib
 from pathlib import Path
@@ -244,6 +245,14 @@ BAD = {
         "include",
         "<include> is not supported",
     ),
+    "a 1 MB model name": (
+        _sdf(_model("x" * 2**20, "", _cylinder(-1))),
+        "model[@name='"
+        + "x" * 80
+        + "'... (1048576 characters)]/link[@name='link']/collision[@name='collision']"
+        "/geometry/cylinder/radius",
+        "must be greater than 0",
+    ),
 }
 
 
@@ -261,7 +270,7 @@ def test_a_world_that_cannot_be_converted_exits_2_naming_file_and_element_and_wr
     assert main(["import", "barn", str(inputs), "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert err.startswith(f"error: {bad}: {element}: " if element else f"error: {bad}: ")
-    assert reason in err and "Traceback" not in err
+    assert reason in err and "Traceback" not in err and len(err) < 600
     assert not out.exists()
 
 
@@ -288,6 +297,33 @@ def test_a_start_the_jackal_would_overlap_is_refused(tmp_path, capsys, gazebo_y,
     assert main(["import", "barn", str(world), "--out", str(tmp_path / "out")]) == 2
     assert f"error: {world}: {reason}" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+def _imports_nothing(capsys, *args: Path) -> str:
+    """Import `args` into tmp/out, which must exit 2 and write nothing: what it printed on stderr."""
+    out = args[-1]
+    assert main(["import", "barn", *map(str, args[:-1]), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and not out.exists()
+    return err
+
+
+def test_a_file_name_that_is_not_utf8_imports_and_is_shown_escaped(tmp_path, capsys):
+    world = Path(os.fsdecode(os.fsencode(tmp_path) + b"/w\xff.world"))
+    shutil.copy(SAMPLE / "world_1.world", world)
+    out = Path(os.fsdecode(os.fsencode(tmp_path) + b"/out\xe9"))
+    assert main(["import", "barn", str(SAMPLE / "world_1.world"), str(world), "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert f"wrote {tmp_path}/out\\xe9/barn_w_.toml" in printed
+    document = tomllib.loads((out / "barn_w_.toml").read_text(encoding="utf-8"))
+    assert document["description"].startswith("BARN world w\\xff.world (Gazebo)")
+
+
+def test_a_bad_world_of_a_name_that_is_not_utf8_exits_2_naming_it_escaped(tmp_path, capsys):
+    bad = Path(os.fsdecode(os.fsencode(tmp_path) + b"/w\xff.world"))
+    bad.write_text("<sdf>")
+    err = _imports_nothing(capsys, SAMPLE / "world_1.world", bad, tmp_path / "out")
+    assert err.startswith(f"error: {tmp_path}/w\\xff.world: not well-formed XML")
 
 
 def test_a_world_file_is_read_up_to_a_bound(monkeypatch):

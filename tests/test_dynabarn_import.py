@@ -9,6 +9,7 @@ addresses read off its disassembly (file offsets equal addresses in its .text an
 
 import json
 import math
+import os
 import shutil
 import struct
 from pathlib import Path
@@ -291,3 +292,38 @@ def test_the_command_writes_the_scenario_and_refuses_an_altered_plugin_writing_n
     assert not refused.exists()
     assert main(["import", "barn", str(WORLD), "--plugins", str(plugins), "--out", str(refused)]) == 2
     assert "--plugins" in capsys.readouterr().err
+
+
+def _imports_nothing(capsys, *args: Path) -> str:
+    """Import `args` into the last one, which must exit 2 and write nothing: what it printed on stderr."""
+    out = args[-1]
+    command = ["import", "dynabarn", *map(str, args[:-1]), "--plugins", str(SAMPLE / "plugins")]
+    assert main([*command, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and len(err) < 600 and not out.exists()
+    return err
+
+
+def test_a_long_name_is_cut_in_messages(tmp_path, capsys, fake_plugins):
+    name = "x" * 2**20
+    world = _world(
+        tmp_path, WORLD.read_text().replace("'easylibobs_51'>", f"'{name}'><link name='link'/>", 1)
+    )
+    err = _imports_nothing(capsys, world, tmp_path / "out")
+    element = "model[@name='" + "x" * 80 + "'... (1048576 characters)]"
+    assert err.startswith(f"error: {world}: {element}: must have one link with one collision, got 2 and 1")
+
+
+def test_a_file_name_that_is_not_utf8_imports_and_is_shown_escaped(tmp_path, capsys, fake_plugins):
+    world = Path(os.fsdecode(os.fsencode(tmp_path) + b"/w\xff.world"))
+    shutil.copy(WORLD, world)
+    out = tmp_path / "out"
+    assert (
+        main(["import", "dynabarn", str(world), "--plugins", str(SAMPLE / "plugins"), "--out", str(out)]) == 0
+    )
+    assert f"wrote {out / 'dynabarn_w_.toml'}" in capsys.readouterr().out
+    description = load_scenario(str(out / "dynabarn_w_.toml")).description
+    assert description.startswith("DynaBARN world w\\xff.world (Gazebo)")
+    world.write_text("<sdf>")
+    err = _imports_nothing(capsys, world, tmp_path / "refused")
+    assert err.startswith(f"error: {tmp_path}/w\\xff.world: not well-formed XML")

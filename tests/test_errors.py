@@ -1,6 +1,9 @@
-"""The one "did you mean" of every message about an unknown name."""
+"""The one "did you mean" of every message about an unknown name, and how messages show what
+came from outside."""
 
-from vplane_mj.errors import closest, did_you_mean
+import os
+
+from vplane_mj.errors import closest, cut, did_you_mean, readable, shown
 
 PLANNERS = ["apf", "bug2", "dwa", "vfh", "vobs", "vplane", "vplane_plus"]
 
@@ -18,3 +21,16 @@ def test_nothing_is_suggested_when_nothing_is_close_or_the_name_is_known():
     assert closest("anything", []) is None
     assert did_you_mean("zzzz", PLANNERS) == ""
     assert did_you_mean("dwaa", PLANNERS) == "; did you mean 'dwa'?"
+
+
+def test_a_path_that_is_not_utf8_or_not_printable_is_shown_with_escapes():
+    assert readable(os.fsdecode(b"worlds/w\xff.world")) == "worlds/w\\xff.world"
+    assert readable("a\nb\x1b[31m") == "a\\nb\\x1b[31m"
+    assert readable("\ud800 caf\u00e9") == "\\ud800 caf\u00e9"  # a surrogate of no byte; printable text kept
+
+
+def test_a_long_name_is_cut_with_its_length():
+    assert shown("crate") == "'crate'" and cut("crate") == "crate"
+    assert shown("x" * 81) == "'" + "x" * 80 + "'... (81 characters)"
+    assert cut("y" * 100) == "y" * 80 + "... (100 characters)"
+    assert shown("a\x00") == "'a\\x00'"

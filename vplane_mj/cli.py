@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import vplane_mj
-from vplane_mj.errors import VPlaneError
+from vplane_mj.errors import VPlaneError, readable
 from vplane_mj.files import DEFAULT_OUT, prepare_out_dir, printable_path, write_atomically
 from vplane_mj.planning.plugins import PlannerError
 from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
@@ -391,7 +391,8 @@ def _generate(args: argparse.Namespace) -> int:
 
 def _import(args: argparse.Namespace) -> int:
     """Convert BARN's or DynaBARN's world files into scenario files of their layout: every file
-    (and every plugin) is read and converted before anything is written."""
+    (and every plugin) is read and converted, and every scenario file rendered as UTF-8, before
+    anything is written."""
     lines: list[str]
     if args.source == "dynabarn":
         from vplane_mj.worlds import dynabarn_import
@@ -405,11 +406,12 @@ def _import(args: argparse.Namespace) -> int:
 
         static = barn_import.import_worlds(args.paths)
         cases, lines = [world.case for world in static], [barn_import.report_line(w) for w in static]
+    texts = [case.toml().encode("utf-8") for case in cases]
     out_dir = prepare_out_dir(args.out)
-    for case, line in zip(cases, lines, strict=True):
+    for case, text, line in zip(cases, texts, lines, strict=True):
         print(line)
-        path = write_atomically(out_dir / f"{case.name}.toml", partial(Path.write_text, data=case.toml()))
-        print(f"wrote {path}")
+        path = write_atomically(out_dir / f"{case.name}.toml", partial(Path.write_bytes, data=text))
+        print(f"wrote {readable(str(path))}")
     return 0
 
 

@@ -1,7 +1,9 @@
 """The project's exceptions: every user-facing failure derives from VPlaneError. And the closest
 known name to one the user mistyped, for a message's "did you mean ...?": one helper for every
 message about an unknown name (planners, planner parameters, scenario keys, obstacle kinds,
-scenarios, families, robot profiles), so that each says it the same way."""
+scenarios, families, robot profiles), so that each says it the same way. And how a message
+shows what came from outside: a file's path readably (`readable`), a name or a text read from a
+file quoted and cut to a readable length (`shown`), any other long text cut (`cut`)."""
 
 from __future__ import annotations
 
@@ -10,6 +12,8 @@ from collections.abc import Iterable
 
 CLOSENESS = 0.6
 """The least `difflib.SequenceMatcher` ratio (0 to 1) at which a known name is suggested."""
+SHOWN_CHARS = 80
+"""The most characters of a name or a text from an input a message shows."""
 
 
 class VPlaneError(Exception):
@@ -40,7 +44,8 @@ class WorldFileError(VPlaneError):
         self.source = source
         self.element = element
         self.reason = reason
-        super().__init__(f"{source}: {element}: {reason}" if element else f"{source}: {reason}")
+        shown_source = readable(source)
+        super().__init__(f"{shown_source}: {element}: {reason}" if element else f"{shown_source}: {reason}")
 
 
 def closest(word: str, known: Iterable[str]) -> str | None:
@@ -55,3 +60,30 @@ def did_you_mean(word: str, known: Iterable[str]) -> str:
     closest to `word`, or "" when none is close."""
     match = closest(word, known)
     return f"; did you mean {match!r}?" if match is not None else ""
+
+
+def readable(text: str) -> str:
+    """`text` (a file's path) as any terminal prints it: the bytes of a name that are not UTF-8
+    (which Python holds as lone surrogates) as `\\xNN`, and every other character that cannot
+    be printed (a control, a lone surrogate of no byte) as Python's backslash escape."""
+    try:
+        text = text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    except UnicodeEncodeError:  # a surrogate that stands for no byte
+        text = text.encode("utf-8", "backslashreplace").decode("utf-8")
+    return "".join(char if char.isprintable() else repr(char)[1:-1] for char in text)
+
+
+def _rest(text: str) -> str:
+    """What `cut` and `shown` put after the first SHOWN_CHARS characters of a longer text."""
+    return "" if len(text) <= SHOWN_CHARS else f"... ({len(text)} characters)"
+
+
+def cut(text: str) -> str:
+    """`text`, or its first SHOWN_CHARS characters, an ellipsis and its length."""
+    return text[:SHOWN_CHARS] + _rest(text)
+
+
+def shown(text: str) -> str:
+    """A name or a text read from a file, for a message: quoted with Python's repr (so with
+    backslash escapes for what cannot be printed), cut as `cut` cuts it."""
+    return repr(text[:SHOWN_CHARS]) + _rest(text)

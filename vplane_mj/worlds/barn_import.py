@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from vplane_mj.errors import ScenarioError, WorldFileError
+from vplane_mj.errors import ScenarioError, WorldFileError, readable
 from vplane_mj.geometry.shapes import scene_footprints
 from vplane_mj.scenario import parse_document
 from vplane_mj.worlds.barn_layout import (
@@ -135,7 +135,9 @@ def import_world(path: Path) -> ImportedWorld:
     name = scenario_name(path)
     path_file = barn_path_file(path)
     barn_path_m = None if path_file is None else barn_path_length(path_file)
-    description = f"BARN world {path.name} (Gazebo), {len(shapes)} obstacles in the challenge's layout"
+    description = (
+        f"BARN world {readable(path.name)} (Gazebo), {len(shapes)} obstacles in the challenge's layout"
+    )
     if path_file is not None:
         description += f"; BARN's own path ({path_file.name}) is {barn_path_m:.3f} m"
     document = layout_document(name, description, [obstacle(shape) for shape in shapes])

@@ -32,13 +32,13 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
-from vplane_mj.errors import ScenarioError, WorldFileError
+from vplane_mj.errors import ScenarioError, WorldFileError, cut, readable, shown
 from vplane_mj.scenario import parse_document
 from vplane_mj.worlds.barn_import import WORLD_FILE, world_files
 from vplane_mj.worlds.dynabarn_layout import DIFFICULTIES, layout_document, moving_cylinder, to_arena
 from vplane_mj.worlds.dynabarn_plugins import PluginAnimation, read_plugin
 from vplane_mj.worlds.families import Case
-from vplane_mj.worlds.sdf import ElementReader
+from vplane_mj.worlds.sdf import ElementReader, step
 
 WALLS = ("back_wall", "top_wall", "bottom_wall")
 """DynaBARN's static walls, left out of the scenario."""
@@ -98,14 +98,15 @@ class _Reader(ElementReader):
         if len(links) != 1 or len(collisions) != 1:
             reason = f"must have one link with one collision, got {len(links)} and {len(collisions)}"
             raise self.fail(where, reason)
-        link_where = f"{where}/link[@name={links[0].get('name', '')!r}]"
-        where = f"{link_where}/collision[@name={collisions[0].get('name', '')!r}]"
+        link_where = f"{where}/link[@name={shown(links[0].get('name', ''))}]"
+        where = f"{link_where}/collision[@name={shown(collisions[0].get('name', ''))}]"
         self.centred(links[0], link_where)
         self.centred(collisions[0], where)
         geometry = collisions[0].find("geometry")
         shapes = [] if geometry is None else list(geometry)
         if len(shapes) != 1 or shapes[0].tag != "cylinder":
-            got = ", ".join(f"<{shape.tag}>" for shape in shapes) or "nothing"
+            got = ", ".join(f"<{cut(shape.tag)}>" for shape in shapes[:3]) or "nothing"
+            got += f" and {len(shapes) - 3} more" if len(shapes) > 3 else ""
             raise self.fail(f"{where}/geometry", f"must be one <cylinder> (a moving model), got {got}")
         (radius,) = self.positive(shapes[0], "radius", f"{where}/geometry/cylinder", 1, "metres")
         return radius
@@ -126,7 +127,7 @@ class _Reader(ElementReader):
         name = model.get("name")
         if not name:
             raise self.fail("model", "has no name")
-        where = f"model[@name={name!r}]"
+        where = step(model)
         for tag in ("model", "include"):
             if model.find(tag) is not None:
                 raise self.fail(f"{where}/{tag}", f"<{tag}> inside a model is not supported")
@@ -141,7 +142,7 @@ class _Reader(ElementReader):
             raise self.fail(where, f"must have one <plugin>, got {len(plugins)}")
         filename = plugins[0].get("filename", "")
         if not PLUGIN_FILE.fullmatch(filename):
-            reason = f"filename must name a DynaBARN plugin easylibobs_N.so, got {filename!r}"
+            reason = f"filename must name a DynaBARN plugin easylibobs_N.so, got {shown(filename)}"
             raise self.fail(f"{where}/plugin", reason)
         return MovingModel(name, where, filename, self.radius(model, where))
 
@@ -149,7 +150,7 @@ class _Reader(ElementReader):
         uri = node.find("uri")
         text = "" if uri is None else (uri.text or "").strip()
         if text not in INCLUDES:
-            raise self.fail("include/uri", f"{text!r} is not supported: only {' and '.join(INCLUDES)}")
+            raise self.fail("include/uri", f"{shown(text)} is not supported: only {' and '.join(INCLUDES)}")
 
     def world(self, root: ET.Element) -> tuple[list[MovingModel], int]:
         """The world's moving models and the number of walls left out."""
@@ -170,7 +171,7 @@ class _Reader(ElementReader):
                 found = self.model(child)
                 name = child.get("name", "")
                 if name in names:
-                    raise self.fail(f"model[@name={name!r}]", "a second model of this name")
+                    raise self.fail(step(child), "a second model of this name")
                 names.add(name)
                 if found is None:
                     walls += 1
@@ -196,7 +197,7 @@ def plugin_path(world: Path, model: MovingModel, plugins: Path | None) -> Path:
     for place in places:
         if (place / model.plugin).is_file():
             return place / model.plugin
-    reason = f"its plugin {model.plugin} is in none of: {', '.join(str(place) for place in places)}"
+    reason = f"its plugin {model.plugin} is in none of: {', '.join(readable(str(place)) for place in places)}"
     raise WorldFileError(str(world), f"{model.element}/plugin", reason)
 
 
@@ -243,7 +244,9 @@ def import_world(
     ]
     name = scenario_name(path)
     third = difficulty(path)
-    description = f"DynaBARN world {path.name} (Gazebo), {len(models)} cylinders moved by their plugins"
+    description = (
+        f"DynaBARN world {readable(path.name)} (Gazebo), {len(models)} cylinders moved by their plugins"
+    )
     if third is not None:
         description += f"; DynaBARN's {third} third"
     document = layout_document(name, description, obstacles)

@@ -7,7 +7,8 @@ pose is the one the world's `<state>` block gives for it, where it gives one (th
 uses), else the model's own `<pose>`; it is composed with the link's and the collision's poses.
 Anything else (a mesh, a sphere, a non-static model, an `<include>`, a pose relative to another
 frame, a malformed file or number) is a WorldFileError naming the file and the element, as an
-XPath below `<world>`, e.g. `model[@name='m']/link[@name='link']/collision[@name='c']/geometry`.
+XPath below `<world>`, e.g. `model[@name='m']/link[@name='link']/collision[@name='c']/geometry`. Names in
+messages are cut to a readable length (`vplane_mj.errors.shown`).
 
 The file, at most MAX_WORLD_BYTES, is parsed with xml.etree.ElementTree: it never fetches
 external entities or DTDs, and its expat (2.4.1 or later) refuses the exponential entity
@@ -21,7 +22,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
-from vplane_mj.errors import WorldFileError
+from vplane_mj.errors import WorldFileError, cut, shown
 
 MAX_WORLD_BYTES = 16 * 1024 * 1024
 """The largest world file read (bytes); BARN's are about 0.5 MB, DynaBARN's 20 to 40 kB."""
@@ -60,6 +61,12 @@ class _Pose:
         return _Pose(x, y, self.yaw + inner.yaw)
 
 
+def step(node: ET.Element) -> str:
+    """One step of an XPath: the element's tag, with its name (quoted) when it has one, both cut."""
+    name = node.get("name")
+    return cut(node.tag) if name is None else f"{cut(node.tag)}[@name={shown(name)}]"
+
+
 class ElementReader:
     """Reads one file's elements; every error names `source` and the element."""
 
@@ -95,7 +102,7 @@ class ElementReader:
         except ValueError:
             values = []
         if len(values) != count or not all(math.isfinite(v) for v in values):
-            raise self.fail(where, f"must be {count} finite numbers ({meaning}), got {text!r}")
+            raise self.fail(where, f"must be {count} finite numbers ({meaning}), got {shown(text)}")
         return values
 
     def positive(self, parent: ET.Element, tag: str, where: str, count: int, meaning: str) -> list[float]:
@@ -105,7 +112,8 @@ class ElementReader:
             raise self.fail(where, f"has no <{tag}>")
         values = self.numbers(node, f"{where}/{tag}", count, meaning)
         if min(values) <= 0:
-            raise self.fail(f"{where}/{tag}", f"must be greater than 0, got {(node.text or '').strip()!r}")
+            text = (node.text or "").strip()
+            raise self.fail(f"{where}/{tag}", f"must be greater than 0, got {shown(text)}")
         return values
 
 
@@ -121,7 +129,8 @@ class _Reader(ElementReader):
         where = f"{where}/pose"
         frame = node.get("relative_to") or node.get("frame")
         if frame:
-            raise self.fail(where, f"is relative to the frame {frame!r}: only poses in the parent's frame")
+            reason = f"is relative to the frame {shown(frame)}: only poses in the parent's frame"
+            raise self.fail(where, reason)
         x, y, _, roll, pitch, yaw = self.numbers(node, where, 6, "x y z roll pitch yaw")
         if max(abs(roll), abs(pitch)) > _TILT_TOLERANCE_RAD:
             raise self.fail(where, f"is tilted (roll {roll:g}, pitch {pitch:g} rad): only upright shapes")
@@ -133,7 +142,7 @@ class _Reader(ElementReader):
         text = "" if node is None else (node.text or "").strip().lower()
         if text not in ("1", "true"):
             if text not in ("", "0", "false"):
-                raise self.fail(f"{where}/static", f"must be true, false, 1 or 0, got {text!r}")
+                raise self.fail(f"{where}/static", f"must be true, false, 1 or 0, got {shown(text)}")
             raise self.fail(where, "is not static: only static models can be imported")
 
     def state_poses(self, world: ET.Element) -> dict[str, _Pose]:
@@ -141,7 +150,7 @@ class _Reader(ElementReader):
         poses: dict[str, _Pose] = {}
         for state in world.findall("state"):
             for model in state.findall("model"):
-                where = f"state/model[@name={model.get('name', '')!r}]"
+                where = f"state/model[@name={shown(model.get('name', ''))}]"
                 scale = model.find("scale")
                 if scale is not None and self.numbers(scale, f"{where}/scale", 3, "x y z") != [1, 1, 1]:
                     raise self.fail(f"{where}/scale", "scaled models are not supported")
@@ -157,7 +166,7 @@ class _Reader(ElementReader):
         if len(shapes) != 1:
             raise self.fail(where, f"must hold exactly one shape, got {len(shapes)}")
         shape = shapes[0]
-        where_shape = f"{where}/{shape.tag}"
+        where_shape = f"{where}/{cut(shape.tag)}"
         if shape.tag == "cylinder":
             (radius,) = self.positive(shape, "radius", where_shape, 1, "metres")
             return WorldShape("cylinder", pose.x, pose.y, pose.yaw, where_shape, radius=radius)
@@ -169,14 +178,13 @@ class _Reader(ElementReader):
             if normal is None or self.numbers(normal, f"{where_shape}/normal", 3, "x y z")[:2] == [0, 0]:
                 return None
             raise self.fail(f"{where_shape}/normal", "a plane that is not horizontal is not supported")
-        raise self.fail(where_shape, f"<{shape.tag}> is not supported: only <cylinder> and <box>")
+        raise self.fail(where_shape, f"<{cut(shape.tag)}> is not supported: only <cylinder> and <box>")
 
     def model(self, model: ET.Element, state_pose: _Pose | None) -> list[WorldShape]:
         """The shapes of one static model's collisions."""
-        name = model.get("name")
-        if not name:
+        if not model.get("name"):
             raise self.fail("model", "has no name")
-        where = f"model[@name={name!r}]"
+        where = step(model)
         self.static(model, where)
         for tag in ("model", "include"):
             if model.find(tag) is not None:
@@ -184,10 +192,10 @@ class _Reader(ElementReader):
         model_pose = state_pose if state_pose is not None else self.pose(model, where)
         shapes = []
         for link in model.findall("link"):
-            where_link = f"{where}/link[@name={link.get('name', '')!r}]"
+            where_link = f"{where}/link[@name={shown(link.get('name', ''))}]"
             link_pose = model_pose.then(self.pose(link, where_link))
             for collision in link.findall("collision"):
-                where_collision = f"{where_link}/collision[@name={collision.get('name', '')!r}]"
+                where_collision = f"{where_link}/collision[@name={shown(collision.get('name', ''))}]"
                 pose = link_pose.then(self.pose(collision, where_collision))
                 shape = self.geometry(collision, where_collision, pose)
                 if shape is not None:
@@ -197,7 +205,7 @@ class _Reader(ElementReader):
     def world(self, root: ET.Element) -> list[WorldShape]:
         """Every shape of the file's one world."""
         if root.tag != "sdf":
-            raise self.fail(root.tag, "the root element must be <sdf>")
+            raise self.fail(cut(root.tag), "the root element must be <sdf>")
         worlds = root.findall("world")
         if len(worlds) != 1:
             raise self.fail("sdf", f"must hold exactly one <world>, got {len(worlds)}")
