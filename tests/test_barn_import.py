@@ -245,6 +245,35 @@ BAD = {
         "include",
         "<include> is not supported",
     ),
+    "an include inside a link": (
+        _sdf(
+            _model(
+                "post",
+                "",
+                _link("<include><uri>model://rock</uri></include>", "", "<box><size>1 1 1</size></box>"),
+            )
+        ),
+        "model[@name='post']/link[@name='link']/include",
+        "<include> is not supported inside another element",
+    ),
+    "a model inside a link": (
+        _sdf(
+            _model("post", "", _link(_model("rock", "", _cylinder(0.1)), "", "<box><size>1 1 1</size></box>"))
+        ),
+        "model[@name='post']/link[@name='link']/model[@name='rock']",
+        "<model> is not supported inside another element",
+    ),
+    "an include 1000 elements deep": (
+        _sdf(
+            _model(
+                "post",
+                "",
+                _link("<a>" * 1000 + "<include/>" + "</a>" * 1000, "", "<box><size>1 1 1</size></box>"),
+            )
+        ),
+        "model[@name='post']/link[@name='link']/a/a/...(995 steps).../a/a/a/include",
+        "<include> is not supported inside another element",
+    ),
     "a 1 MB model name": (
         _sdf(_model("x" * 2**20, "", _cylinder(-1))),
         "model[@name='"

@@ -304,6 +304,37 @@ def _imports_nothing(capsys, *args: Path) -> str:
     return err
 
 
+FIRST_LINK = "model[@name='easylibobs_51']/link[@name='link']"
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "element", "reason"),
+    [
+        (
+            "<self_collide>0</self_collide>",
+            "<include><uri>model://sun</uri></include>",
+            f"{FIRST_LINK}/include",
+            "<include> is not supported inside another element",
+        ),
+        (
+            "<self_collide>0</self_collide>",
+            "<model name='rock'/>",
+            f"{FIRST_LINK}/model[@name='rock']",
+            "<model> is not supported inside another element",
+        ),
+    ],
+    ids=["include-in-link", "model-in-link"],
+)
+def test_a_hostile_world_exits_2_naming_file_and_element_and_writes_nothing(
+    tmp_path, capsys, fake_plugins, old, new, element, reason
+):
+    text = WORLD.read_text()
+    assert old in text
+    world = _world(tmp_path, text.replace(old, new, 1))
+    err = _imports_nothing(capsys, world, tmp_path / "out")
+    assert err.startswith(f"error: {world}: {element}: ") and reason in err
+
+
 def test_a_long_name_is_cut_in_messages(tmp_path, capsys, fake_plugins):
     name = "x" * 2**20
     world = _world(

@@ -11,10 +11,10 @@ given (`plugins`), else in `plugins/` beside the world file, else beside it.
 The world's three walls (`back_wall`, `top_wall`, `bottom_wall`: static boxes) are left out,
 since the layout is an open plane without walls, as the BARN challenge runs DynaBARN. Its two
 `<include>`s of `model://ground_plane` and `model://sun` are allowed; any other include, an
-actor, a world plugin, any other model (one without a plugin that is not a wall, a moving one
-that is not one cylinder) is a WorldFileError naming the file and the element, as an XPath
-below `<world>`. Other children of `<world>` (physics, scene, lights) place no obstacle and are
-ignored.
+include or a model inside another element, an actor, a world plugin, any other model (one
+without a plugin that is not a wall, a moving one that is not one cylinder) is a WorldFileError
+naming the file and the element, as an XPath below `<world>`. Other children of `<world>`
+(physics, scene, lights) place no obstacle and are ignored.
 
 DynaBARN's world files are not well-formed XML as they stand: its walls carry `<pose frame=>`,
 an attribute without a quoted value, which Gazebo's lenient TinyXML reads as an empty one. That
@@ -128,9 +128,6 @@ class _Reader(ElementReader):
         if not name:
             raise self.fail("model", "has no name")
         where = step(model)
-        for tag in ("model", "include"):
-            if model.find(tag) is not None:
-                raise self.fail(f"{where}/{tag}", f"<{tag}> inside a model is not supported")
         plugins = model.findall("plugin")
         if not plugins:
             if name not in WALLS:
@@ -159,6 +156,7 @@ class _Reader(ElementReader):
         worlds = root.findall("world")
         if len(worlds) != 1:
             raise self.fail("sdf", f"must hold exactly one <world>, got {len(worlds)}")
+        self.refuse_nested(worlds[0])
         moving: list[MovingModel] = []
         names: set[str] = set()
         walls = 0

@@ -5,10 +5,11 @@ What `vplane-mj import barn` needs from BARN's worlds, read strictly: every `<mo
 standing upright (roll and pitch 0); a horizontal `<plane>` (the ground) is skipped. A model's
 pose is the one the world's `<state>` block gives for it, where it gives one (the pose Gazebo
 uses), else the model's own `<pose>`; it is composed with the link's and the collision's poses.
-Anything else (a mesh, a sphere, a non-static model, an `<include>`, a pose relative to another
-frame, a malformed file or number) is a WorldFileError naming the file and the element, as an
-XPath below `<world>`, e.g. `model[@name='m']/link[@name='link']/collision[@name='c']/geometry`. Names in
-messages are cut to a readable length (`vplane_mj.errors.shown`).
+Anything else (a mesh, a sphere, a non-static model, an `<include>` anywhere, a `<model>` inside
+another element than `<world>`, a pose relative to another frame, a malformed file or number) is
+a WorldFileError naming the file and the element, as an XPath below `<world>`, e.g.
+`model[@name='m']/link[@name='link']/collision[@name='c']/geometry`. Names in messages are cut
+to a readable length (`vplane_mj.errors.shown`), and an XPath longer than XPATH_STEPS steps.
 
 The file, at most MAX_WORLD_BYTES, is parsed with xml.etree.ElementTree: it never fetches
 external entities or DTDs, and its expat (2.4.1 or later) refuses the exponential entity
@@ -17,6 +18,7 @@ expansion of a "billion laughs" file. `ElementReader` is what the DynaBARN impor
 
 from __future__ import annotations
 
+import collections
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -30,6 +32,11 @@ _TILT_TOLERANCE_RAD = 1e-6
 """Largest roll or pitch (rad) of a pose that still counts as upright."""
 _UNSUPPORTED_WORLD_CHILDREN = frozenset({"include", "actor", "population", "road", "frame", "joint"})
 """Children of `<world>` that may hold or move obstacles this reader cannot take."""
+XPATH_STEPS = 8
+"""The most steps of an XPath a message shows: the first and the last half, the rest elided."""
+_NESTED_REFUSED = frozenset({"include", "model"})
+"""Elements refused below `<world>`'s own children (`<state>`'s models aside): they would hold
+obstacles where no reader looks."""
 
 
 @dataclass(frozen=True)
@@ -67,6 +74,35 @@ def step(node: ET.Element) -> str:
     return cut(node.tag) if name is None else f"{cut(node.tag)}[@name={shown(name)}]"
 
 
+def xpath(world: ET.Element, target: ET.Element) -> str:
+    """The XPath of `target` below `world`, each step named as `step` names it, the middle steps
+    of a path longer than XPATH_STEPS elided."""
+    parents = {child: parent for parent in world.iter() for child in parent}
+    nodes = [target]
+    while parents[nodes[-1]] is not world:
+        nodes.append(parents[nodes[-1]])
+    nodes.reverse()
+    half = XPATH_STEPS // 2
+    if len(nodes) <= XPATH_STEPS:
+        return "/".join(map(step, nodes))
+    elided = f"...({len(nodes) - XPATH_STEPS} steps)..."
+    return "/".join([*map(step, nodes[:half]), elided, *map(step, nodes[-half:])])
+
+
+def nested_element(world: ET.Element) -> ET.Element | None:
+    """The first `<include>` or `<model>` below `<world>`'s own children (a `<model>` of the
+    `<state>` block aside), or None."""
+    pending = collections.deque((child, True) for child in world)
+    while pending:
+        node, on_top = pending.popleft()
+        for child in node:
+            state_model = on_top and node.tag == "state" and child.tag == "model"
+            if child.tag in _NESTED_REFUSED and not state_model:
+                return child
+            pending.append((child, False))
+    return None
+
+
 class ElementReader:
     """Reads one file's elements; every error names `source` and the element."""
 
@@ -93,6 +129,12 @@ class ElementReader:
             return ET.fromstring(data)
         except ET.ParseError as exc:
             raise self.fail("", f"not well-formed XML: {exc}") from None
+
+    def refuse_nested(self, world: ET.Element) -> None:
+        """No `<include>` or `<model>` may stand below `<world>`'s own children."""
+        nested = nested_element(world)
+        if nested is not None:
+            raise self.fail(xpath(world, nested), f"<{nested.tag}> is not supported inside another element")
 
     def numbers(self, node: ET.Element, where: str, count: int, meaning: str) -> list[float]:
         """The `count` finite numbers of an element's text."""
@@ -186,9 +228,6 @@ class _Reader(ElementReader):
             raise self.fail("model", "has no name")
         where = step(model)
         self.static(model, where)
-        for tag in ("model", "include"):
-            if model.find(tag) is not None:
-                raise self.fail(f"{where}/{tag}", f"<{tag}> inside a model is not supported")
         model_pose = state_pose if state_pose is not None else self.pose(model, where)
         shapes = []
         for link in model.findall("link"):
@@ -213,6 +252,7 @@ class _Reader(ElementReader):
         for child in world:
             if child.tag in _UNSUPPORTED_WORLD_CHILDREN:
                 raise self.fail(child.tag, f"<{child.tag}> is not supported: only <model> elements")
+        self.refuse_nested(world)
         poses = self.state_poses(world)
         shapes = []
         for model in world.findall("model"):
