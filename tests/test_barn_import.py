@@ -216,24 +216,25 @@ BAD = {
     "a negative radius": (
         _sdf(_model("post", "", _cylinder(-0.1))),
         COLLISION.format("post") + "/cylinder/radius",
-        "must be greater than 0, got '-0.1'",
+        "must be greater than 0 and at most 1000 m, got '-0.1'",
     ),
     "a non-numeric pose": (
         _sdf(_model("post", "<pose>1 2 x 0 0 0</pose>", _cylinder(0.1))),
         "model[@name='post']/pose",
-        "must be 6 finite numbers (x y z roll pitch yaw), got '1 2 x 0 0 0'",
+        "must be 6 numbers (x y z roll pitch yaw) in decimal or scientific notation, each within "
+        "+-10000, got '1 2 x 0 0 0'",
     ),
     "a pose of five numbers": (
         _sdf(_model("post", "", _link("<pose>1 2 0 0 0</pose>", "", "<box><size>1 1 1</size></box>"))),
         "model[@name='post']/link[@name='link']/pose",
-        "must be 6 finite numbers",
+        "must be 6 numbers",
     ),
     "a non-finite state pose": (
         _sdf(
             _model("post", "", _cylinder(0.1)), state="<model name='post'><pose>nan 0 0 0 0 0</pose></model>"
         ),
         "state/model[@name='post']/pose",
-        "must be 6 finite numbers",
+        "must be 6 numbers",
     ),
     "a tilted box": (
         _sdf(_model("ramp", "<pose>0 0 0 0.3 0 0</pose>", _link("", "", "<box><size>1 1 1</size></box>"))),
@@ -273,6 +274,29 @@ BAD = {
         ),
         "model[@name='post']/link[@name='link']/a/a/...(995 steps).../a/a/a/include",
         "<include> is not supported inside another element",
+    ),
+    "a number with an underscore": (
+        _sdf(_model("post", "", _cylinder("0.0_75"))),
+        COLLISION.format("post") + "/cylinder/radius",
+        "must be a number (metres) in decimal or scientific notation, each within +-10000, got '0.0_75'",
+    ),
+    "a yaw of 1e300": (
+        _sdf(
+            _model("crate", "<pose>-1 8 0 0 0 1e300</pose>", _link("", "", "<box><size>1 1 1</size></box>"))
+        ),
+        "model[@name='crate']/pose",
+        "must be 6 numbers (x y z roll pitch yaw) in decimal or scientific notation, each within "
+        "+-10000, got '-1 8 0 0 0 1e300'",
+    ),
+    "a position 2 km away": (
+        _sdf(_model("post", "<pose>2000 8 0 0 0 0</pose>", _cylinder(0.1))),
+        "model[@name='post']/pose",
+        "x, y and z must lie within +-1000 m, got 2000, 8, 0",
+    ),
+    "a box 2 km long": (
+        _sdf(_model("crate", "", _link("", "", "<box><size>2e3 1 1</size></box>"))),
+        COLLISION.format("crate") + "/box/size",
+        "must be greater than 0 and at most 1000 m, got '2e3 1 1'",
     ),
     "a 1 MB model name": (
         _sdf(_model("x" * 2**20, "", _cylinder(-1))),
@@ -353,6 +377,21 @@ def test_a_bad_world_of_a_name_that_is_not_utf8_exits_2_naming_it_escaped(tmp_pa
     bad.write_text("<sdf>")
     err = _imports_nothing(capsys, SAMPLE / "world_1.world", bad, tmp_path / "out")
     assert err.startswith(f"error: {tmp_path}/w\\xff.world: not well-formed XML")
+
+
+def test_angles_are_wrapped(tmp_path):
+    world = tmp_path / "world_5.world"
+    world.write_text(
+        _sdf(
+            _model(
+                "crate",
+                "<pose>1 2 0 6.283185307179586 0 7</pose>",
+                _link("", "", "<box><size>1 1 1</size></box>"),
+            )
+        )
+    )
+    (crate,) = read_world_shapes(world)
+    assert crate.yaw == pytest.approx(7 - 2 * math.pi)
 
 
 def test_a_world_file_is_read_up_to_a_bound(monkeypatch):

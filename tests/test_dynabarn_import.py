@@ -305,6 +305,7 @@ def _imports_nothing(capsys, *args: Path) -> str:
 
 
 FIRST_LINK = "model[@name='easylibobs_51']/link[@name='link']"
+RADIUS = f"{FIRST_LINK}/collision[@name='collision']/geometry/cylinder/radius"
 
 
 @pytest.mark.parametrize(
@@ -322,8 +323,21 @@ FIRST_LINK = "model[@name='easylibobs_51']/link[@name='link']"
             f"{FIRST_LINK}/model[@name='rock']",
             "<model> is not supported inside another element",
         ),
+        (
+            "<radius>0.5000</radius>",
+            "<radius>0.5_000</radius>",
+            RADIUS,
+            "must be a number (metres) in decimal or scientific notation, each within +-10000, got '0.5_000'",
+        ),
+        ("<radius>0.5000</radius>", "<radius>1e300</radius>", RADIUS, "got '1e300'"),
+        (
+            "<radius>0.5000</radius>",
+            "<radius>2e3</radius>",
+            RADIUS,
+            "must be greater than 0 and at most 1000 m",
+        ),
     ],
-    ids=["include-in-link", "model-in-link"],
+    ids=["include-in-link", "model-in-link", "underscore", "radius-1e300", "radius-2-km"],
 )
 def test_a_hostile_world_exits_2_naming_file_and_element_and_writes_nothing(
     tmp_path, capsys, fake_plugins, old, new, element, reason

@@ -14,7 +14,8 @@ since the layout is an open plane without walls, as the BARN challenge runs Dyna
 include or a model inside another element, an actor, a world plugin, any other model (one
 without a plugin that is not a wall, a moving one that is not one cylinder) is a WorldFileError
 naming the file and the element, as an XPath below `<world>`. Other children of `<world>`
-(physics, scene, lights) place no obstacle and are ignored.
+(physics, scene, lights) place no obstacle and are ignored. Numbers and their ranges, names in
+messages and the file's size are checked as `vplane_mj.worlds.sdf` checks BARN's worlds.
 
 DynaBARN's world files are not well-formed XML as they stand: its walls carry `<pose frame=>`,
 an attribute without a quoted value, which Gazebo's lenient TinyXML reads as an empty one. That
@@ -44,7 +45,7 @@ WALLS = ("back_wall", "top_wall", "bottom_wall")
 """DynaBARN's static walls, left out of the scenario."""
 INCLUDES = ("model://ground_plane", "model://sun")
 """The only `<include>`s allowed."""
-PLUGIN_FILE = re.compile(r"easylibobs_\d+\.so")
+PLUGIN_FILE = re.compile(r"easylibobs_[0-9]+\.so")
 """A DynaBARN plugin's file name."""
 WORLDS_PER_DIFFICULTY = 20
 """DynaBARN's worlds 0-19 are easy, 20-39 medium, 40-59 hard."""
@@ -86,7 +87,7 @@ class _Reader(ElementReader):
         node = owner.find("pose")
         if node is None:
             return
-        x, y, _, roll, pitch, _ = self.numbers(node, f"{where}/pose", 6, "x y z roll pitch yaw")
+        x, y, _, roll, pitch, _ = self.pose_numbers(node, f"{where}/pose")
         if node.get("relative_to") or node.get("frame") or any((x, y, roll, pitch)):
             reason = "moves or tilts the cylinder off its model's origin, which the animation places"
             raise self.fail(f"{where}/pose", reason)

@@ -6,10 +6,15 @@ standing upright (roll and pitch 0); a horizontal `<plane>` (the ground) is skip
 pose is the one the world's `<state>` block gives for it, where it gives one (the pose Gazebo
 uses), else the model's own `<pose>`; it is composed with the link's and the collision's poses.
 Anything else (a mesh, a sphere, a non-static model, an `<include>` anywhere, a `<model>` inside
-another element than `<world>`, a pose relative to another frame, a malformed file or number) is
-a WorldFileError naming the file and the element, as an XPath below `<world>`, e.g.
-`model[@name='m']/link[@name='link']/collision[@name='c']/geometry`. Names in messages are cut
-to a readable length (`vplane_mj.errors.shown`), and an XPath longer than XPATH_STEPS steps.
+another element than `<world>`, a pose relative to another frame, a malformed file or number, a
+number out of its range) is a WorldFileError naming the file and the element, as an XPath below
+`<world>`, e.g. `model[@name='m']/link[@name='link']/collision[@name='c']/geometry`.
+
+Numbers are read as SDF writes them, in plain decimal or scientific notation (not Python's
+`float`, which also takes `0.0_75`, `nan` or `infinity`); each must lie within +-NUMBER_LIMIT,
+positions within +-POSITION_LIMIT_M and sizes in (0, SIZE_LIMIT_M]. Angles are wrapped to
+[-pi, pi]. Names in messages are cut to a readable length (`vplane_mj.errors.shown`), and an
+XPath longer than XPATH_STEPS steps.
 
 The file, at most MAX_WORLD_BYTES, is parsed with xml.etree.ElementTree: it never fetches
 external entities or DTDs, and its expat (2.4.1 or later) refuses the exponential entity
@@ -20,14 +25,25 @@ from __future__ import annotations
 
 import collections
 import math
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
 from vplane_mj.errors import WorldFileError, cut, shown
+from vplane_mj.scenario.keys import MAX_OBSTACLE_M
 
 MAX_WORLD_BYTES = 16 * 1024 * 1024
 """The largest world file read (bytes); BARN's are about 0.5 MB, DynaBARN's 20 to 40 kB."""
+NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+"""A number as SDF writes one: decimal or scientific notation, ASCII digits only (unambiguous,
+so that matching takes time linear in the token's length)."""
+NUMBER_LIMIT = 1e4
+"""The largest magnitude of any number read (angles in rad, positions in m, unitless values)."""
+POSITION_LIMIT_M = MAX_OBSTACLE_M
+"""The largest magnitude of a pose's x, y or z (m): a scenario's obstacle coordinates' bound."""
+SIZE_LIMIT_M = MAX_OBSTACLE_M
+"""The largest radius or box side (m): a scenario's obstacle sizes' bound."""
 _TILT_TOLERANCE_RAD = 1e-6
 """Largest roll or pitch (rad) of a pose that still counts as upright."""
 _UNSUPPORTED_WORLD_CHILDREN = frozenset({"include", "actor", "population", "road", "frame", "joint"})
@@ -65,7 +81,7 @@ class _Pose:
         """This pose composed with `inner`, a pose given in this pose's frame."""
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         x, y = self.x + c * inner.x - s * inner.y, self.y + s * inner.x + c * inner.y
-        return _Pose(x, y, self.yaw + inner.yaw)
+        return _Pose(x, y, math.remainder(self.yaw + inner.yaw, math.tau))
 
 
 def step(node: ET.Element) -> str:
@@ -137,26 +153,41 @@ class ElementReader:
             raise self.fail(xpath(world, nested), f"<{nested.tag}> is not supported inside another element")
 
     def numbers(self, node: ET.Element, where: str, count: int, meaning: str) -> list[float]:
-        """The `count` finite numbers of an element's text."""
+        """The `count` numbers of an element's text, each within +-NUMBER_LIMIT."""
         text = (node.text or "").strip()
-        try:
-            values = [float(token) for token in text.split()]
-        except ValueError:
-            values = []
-        if len(values) != count or not all(math.isfinite(v) for v in values):
-            raise self.fail(where, f"must be {count} finite numbers ({meaning}), got {shown(text)}")
-        return values
+        tokens = text.split()
+        if len(tokens) == count and all(NUMBER.fullmatch(token) for token in tokens):
+            values = [float(token) for token in tokens]
+            if all(abs(value) <= NUMBER_LIMIT for value in values):
+                return values
+        numbers = "a number" if count == 1 else f"{count} numbers"
+        reason = (
+            f"must be {numbers} ({meaning}) in decimal or scientific notation, each within "
+            f"+-{NUMBER_LIMIT:g}, got {shown(text)}"
+        )
+        raise self.fail(where, reason)
 
     def positive(self, parent: ET.Element, tag: str, where: str, count: int, meaning: str) -> list[float]:
-        """The `count` numbers of the required child `tag`, each greater than 0."""
+        """The `count` sizes (m) of the required child `tag`, each in (0, SIZE_LIMIT_M]."""
         node = parent.find(tag)
         if node is None:
             raise self.fail(where, f"has no <{tag}>")
         values = self.numbers(node, f"{where}/{tag}", count, meaning)
-        if min(values) <= 0:
+        if not all(0 < value <= SIZE_LIMIT_M for value in values):
             text = (node.text or "").strip()
-            raise self.fail(f"{where}/{tag}", f"must be greater than 0, got {shown(text)}")
+            reason = f"must be greater than 0 and at most {SIZE_LIMIT_M:g} m, got {shown(text)}"
+            raise self.fail(f"{where}/{tag}", reason)
         return values
+
+    def pose_numbers(self, node: ET.Element, where: str) -> list[float]:
+        """A `<pose>`'s x, y, z (m, each within +-POSITION_LIMIT_M) and roll, pitch, yaw (rad,
+        wrapped to [-pi, pi])."""
+        values = self.numbers(node, where, 6, "x y z roll pitch yaw")
+        if max(abs(value) for value in values[:3]) > POSITION_LIMIT_M:
+            x, y, z = values[:3]
+            reason = f"x, y and z must lie within +-{POSITION_LIMIT_M:g} m, got {x:g}, {y:g}, {z:g}"
+            raise self.fail(where, reason)
+        return values[:3] + [math.remainder(angle, math.tau) for angle in values[3:]]
 
 
 class _Reader(ElementReader):
@@ -173,7 +204,7 @@ class _Reader(ElementReader):
         if frame:
             reason = f"is relative to the frame {shown(frame)}: only poses in the parent's frame"
             raise self.fail(where, reason)
-        x, y, _, roll, pitch, yaw = self.numbers(node, where, 6, "x y z roll pitch yaw")
+        x, y, _, roll, pitch, yaw = self.pose_numbers(node, where)
         if max(abs(roll), abs(pitch)) > _TILT_TOLERANCE_RAD:
             raise self.fail(where, f"is tilted (roll {roll:g}, pitch {pitch:g} rad): only upright shapes")
         return _Pose(x, y, yaw)
