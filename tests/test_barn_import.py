@@ -5,6 +5,7 @@ the MIT licence it is distributed under (see its README.md).
 """
 
 import copy
+import io
 import math
 import os
 import shutil
@@ -130,6 +131,8 @@ def test_barns_path_length_is_the_polyline_through_its_cells(tmp_path):
     path = tmp_path / "path_9.npy"
     np.save(path, np.array([[15, 0], [15, 29]]))  # Gazebo (-2.325, 5.075) and (-2.325, 9.425)
     expected = math.hypot(0.325, 2.075) + 4.35 + math.hypot(0.325, 3.575)
+    assert barn_path_length(path) == pytest.approx(expected)
+    np.save(path, np.asfortranarray(np.array([[15, 0], [15, 29]], dtype=">i2")))  # column-major, big-endian
     assert barn_path_length(path) == pytest.approx(expected)
 
 
@@ -377,6 +380,70 @@ def test_a_bad_world_of_a_name_that_is_not_utf8_exits_2_naming_it_escaped(tmp_pa
     bad.write_text("<sdf>")
     err = _imports_nothing(capsys, SAMPLE / "world_1.world", bad, tmp_path / "out")
     assert err.startswith(f"error: {tmp_path}/w\\xff.world: not well-formed XML")
+
+
+def _npy(header: dict, data: bytes = b"") -> bytes:
+    """An .npy file (format 1.0) of this header and these data bytes."""
+    buffer = io.BytesIO()
+    np.lib.format.write_array_header_1_0(buffer, header)
+    return buffer.getvalue() + data
+
+
+@pytest.mark.parametrize(
+    ("content", "reason"),
+    [
+        (
+            _npy({"descr": "<i8", "fortran_order": False, "shape": (2**40, 2)}),
+            "must hold 1 to 10000 (row, column) integer pairs, its header declares int64 of shape "
+            "(1099511627776, 2)",
+        ),
+        (
+            _npy({"descr": "|O", "fortran_order": False, "shape": (1, 2)}, b"\x80\x04N."),
+            "its header declares object of shape (1, 2)",
+        ),
+        (
+            _npy(
+                {"descr": "<f8", "fortran_order": False, "shape": (1, 2)}, np.array([np.nan, 0.0]).tobytes()
+            ),
+            "its header declares float64 of shape (1, 2)",
+        ),
+        (
+            _npy({"descr": "<i8", "fortran_order": False, "shape": (37, 2)}, bytes(16)),
+            "holds 16 bytes of data",
+        ),
+        (b"\x93NUMPY\x03\x00", "cannot read BARN's path: .npy format version 3.0, not 1.0 or 2.0"),
+        (b"PK\x03\x04" + bytes(26), "cannot read BARN's path: the magic string is not correct"),
+    ],
+    ids=["huge-shape", "pickle", "floats", "truncated", "version-3", "not-npy"],
+)
+def test_a_path_file_whose_header_is_not_barns_exits_2_before_reading_its_data(
+    tmp_path, capsys, content, reason
+):
+    shutil.copy(SAMPLE / "world_1.world", tmp_path / "world_1.world")
+    (tmp_path / "path_1.npy").write_bytes(content)
+    err = _imports_nothing(capsys, tmp_path, tmp_path / "out")
+    assert err.startswith(f"error: {tmp_path / 'path_1.npy'}: ") and reason in err
+
+
+@pytest.mark.parametrize(
+    ("cells", "reason"),
+    [
+        (
+            np.array([[9, 0], [2**64 - 1, 0], [9, 1]], dtype=np.uint64),  # 5.5e18 m there and back
+            "cell 1 (row 18446744073709551615, column 0)",
+        ),
+        (np.array([[15, 0], [30, 1]]), "cell 1 (row 30, column 1)"),
+        (np.array([[15, -1]], dtype=np.int8), "cell 0 (row 15, column -1)"),
+    ],
+    ids=["2.8e18-m-away", "row-30", "column-minus-1"],
+)
+def test_a_path_off_barns_grid_exits_2(tmp_path, capsys, cells, reason):
+    shutil.copy(SAMPLE / "world_1.world", tmp_path / "world_1.world")
+    np.save(tmp_path / "path_1.npy", cells)
+    err = _imports_nothing(capsys, tmp_path, tmp_path / "out")
+    assert err.startswith(
+        f"error: {tmp_path / 'path_1.npy'}: {reason} is off BARN's grid: rows and columns are 0 to 29"
+    )
 
 
 def test_angles_are_wrapped(tmp_path):

@@ -14,7 +14,9 @@ Gazebo (0.15 r - 4.575, 0.15 c + 5.075), (-2, 13)) is the challenge's optimal pa
 reported beside the project's reference path for the Jackal, and the scenario keeps it as
 `[world] score_path_m`, so that a run's score takes OT from it as BARN's `report_test.py`
 does (its length over the Jackal's 2 m/s). Without the path file the score's OT is the
-reference path's, as for every other scenario.
+reference path's, as for every other scenario. The path file is read strictly: its .npy header
+first (integers, shape (N, 2), N at most MAX_PATH_CELLS), never a pickle, and every cell must
+lie on BARN's 30 x 30 grid.
 """
 
 from __future__ import annotations
@@ -22,11 +24,11 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, BinaryIO
 
 import numpy as np
 
-from vplane_mj.errors import ScenarioError, WorldFileError, readable
+from vplane_mj.errors import ScenarioError, WorldFileError, cut, readable
 from vplane_mj.geometry.shapes import scene_footprints
 from vplane_mj.scenario import parse_document
 from vplane_mj.worlds.barn_layout import (
@@ -45,6 +47,11 @@ WORLD_FILE = re.compile(r"world_(\d+)\.world")
 """How BARN names its world files; `path_N.npy` beside one is its path."""
 BARN_PATH_START_M, BARN_PATH_END_M = (-2.0, 3.0), (-2.0, 13.0)
 """The ends of BARN's optimal-path polyline, in Gazebo's frame (m)."""
+BARN_GRID_CELLS = 30
+"""BARN's grid is this many cells of 0.15 m on a side: a path cell's row and column are 0 to 29."""
+MAX_PATH_CELLS = 10_000
+"""The most cells a path_N.npy may hold, far more than a path on BARN's grid needs (at most 46
+in the 250 training worlds)."""
 
 
 @dataclass(frozen=True)
@@ -99,15 +106,64 @@ def barn_path_file(world: Path) -> Path | None:
     return path if path is not None and path.is_file() else None
 
 
+def npy_header(file: BinaryIO) -> tuple[tuple[int, ...], bool, np.dtype]:
+    """The shape, Fortran order and dtype an .npy file's header declares (format 1.0 or 2.0);
+    a ValueError if it is not one."""
+    version = np.lib.format.read_magic(file)
+    if version == (1, 0):
+        return np.lib.format.read_array_header_1_0(file)
+    if version == (2, 0):
+        return np.lib.format.read_array_header_2_0(file)
+    raise ValueError(f".npy format version {version[0]}.{version[1]}, not 1.0 or 2.0")
+
+
+def path_header_error(dtype: np.dtype, shape: tuple[int, ...]) -> str | None:
+    """Why an .npy header cannot be BARN's path (None: it can): it must declare N (row,
+    column) integer pairs, 1 <= N <= MAX_PATH_CELLS."""
+    if dtype.kind not in "iu" or len(shape) != 2 or shape[1] != 2 or not 1 <= shape[0] <= MAX_PATH_CELLS:
+        return (
+            f"must hold 1 to {MAX_PATH_CELLS} (row, column) integer pairs, its header declares "
+            f"{cut(str(dtype))} of shape {cut(str(shape))}"
+        )
+    return None
+
+
+def off_grid_error(cells: np.ndarray) -> str | None:
+    """Why BARN's path cells do not all lie on its grid (None: they do)."""
+    off = np.flatnonzero(((cells < 0) | (cells >= BARN_GRID_CELLS)).any(axis=1))
+    if not off.size:
+        return None
+    row, column = cells[off[0]]
+    last = BARN_GRID_CELLS - 1
+    return f"cell {off[0]} (row {row}, column {column}) is off BARN's grid: rows and columns are 0 to {last}"
+
+
+def read_barn_path(path: Path) -> np.ndarray:
+    """BARN's path cells, (row, column) pairs on its grid, from a path_N.npy file: its header is
+    checked before any data is read, and no pickle is ever loaded."""
+    source = str(path)
+    try:
+        with path.open("rb") as file:
+            shape, fortran_order, dtype = npy_header(file)
+            reason = path_header_error(dtype, shape)
+            if reason is not None:
+                raise WorldFileError(source, "", reason)
+            size = shape[0] * shape[1] * dtype.itemsize
+            data = file.read(size + 1)
+    except (OSError, ValueError) as exc:
+        raise WorldFileError(source, "", f"cannot read BARN's path: {cut(str(exc))}") from None
+    if len(data) != size:
+        raise WorldFileError(source, "", f"holds {len(data)} bytes of data, its header declares {size}")
+    cells = np.frombuffer(data, dtype).reshape(shape, order="F" if fortran_order else "C")
+    reason = off_grid_error(cells)
+    if reason is not None:
+        raise WorldFileError(source, "", reason)
+    return cells
+
+
 def barn_path_length(path: Path) -> float:
     """Length (m) of BARN's optimal-path polyline for the (row, column) cells in `path`."""
-    try:
-        cells = np.load(path, allow_pickle=False)
-    except (OSError, ValueError) as exc:
-        raise WorldFileError(str(path), "", f"cannot read BARN's path: {exc}") from None
-    if cells.ndim != 2 or cells.shape[1] != 2 or not len(cells) or cells.dtype.kind not in "iu":
-        reason = f"must hold (row, column) integer pairs, got {cells.dtype} array of shape {cells.shape}"
-        raise WorldFileError(str(path), "", reason)
+    cells = read_barn_path(path).astype(float)
     gazebo = np.column_stack([0.15 * cells[:, 0] - 0.075 - 4.5, 0.15 * cells[:, 1] + 0.075 + 5.0])
     polyline = np.vstack([BARN_PATH_START_M, gazebo, BARN_PATH_END_M])
     return float(np.sum(np.hypot(*np.diff(polyline, axis=0).T)))
