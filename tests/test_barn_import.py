@@ -446,6 +446,22 @@ def test_a_path_off_barns_grid_exits_2(tmp_path, capsys, cells, reason):
     )
 
 
+def test_two_files_of_one_world_number_exit_2_naming_both(tmp_path, capsys):
+    for name in ("world_1.world", "world_01.world"):
+        shutil.copy(SAMPLE / "world_1.world", tmp_path / name)
+    err = _imports_nothing(capsys, tmp_path, tmp_path / "out")
+    first, second = tmp_path / "world_01.world", tmp_path / "world_1.world"  # in the order of their names
+    assert err == f"error: {second}: has the world number 1, as {first} does\n"
+
+
+def test_two_files_of_one_scenario_name_exit_2_naming_both(tmp_path, capsys):
+    for name in ("Crate.world", "crate.world"):
+        shutil.copy(SAMPLE / "world_1.world", tmp_path / name)
+    first, second = tmp_path / "Crate.world", tmp_path / "crate.world"
+    err = _imports_nothing(capsys, first, second, tmp_path / "out")
+    assert err == f"error: {second}: has the scenario name 'barn_crate', as {first} does\n"
+
+
 def test_angles_are_wrapped(tmp_path):
     world = tmp_path / "world_5.world"
     world.write_text(

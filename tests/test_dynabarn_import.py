@@ -359,6 +359,14 @@ def test_a_long_name_is_cut_in_messages(tmp_path, capsys, fake_plugins):
     assert err.startswith(f"error: {world}: {element}: must have one link with one collision, got 2 and 1")
 
 
+def test_two_files_of_one_world_number_exit_2_naming_both(tmp_path, capsys, fake_plugins):
+    for name in ("world_0.world", "world_00.world"):
+        shutil.copy(WORLD, tmp_path / name)
+    err = _imports_nothing(capsys, tmp_path, tmp_path / "out")
+    first, second = tmp_path / "world_0.world", tmp_path / "world_00.world"  # in the order of their names
+    assert err == f"error: {second}: has the world number 0, as {first} does\n"
+
+
 def test_a_file_name_that_is_not_utf8_imports_and_is_shown_escaped(tmp_path, capsys, fake_plugins):
     world = Path(os.fsdecode(os.fsencode(tmp_path) + b"/w\xff.world"))
     shutil.copy(WORLD, world)

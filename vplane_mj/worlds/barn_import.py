@@ -17,11 +17,15 @@ does (its length over the Jackal's 2 m/s). Without the path file the score's OT 
 reference path's, as for every other scenario. The path file is read strictly: its .npy header
 first (integers, shape (N, 2), N at most MAX_PATH_CELLS), never a pickle, and every cell must
 lie on BARN's 30 x 30 grid.
+
+Every input is read and converted before anything is written; two files of the same world
+number (world_01.world and world_1.world) or of the same scenario name are refused.
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, BinaryIO
@@ -43,7 +47,7 @@ from vplane_mj.worlds.sdf import WorldShape, read_world_shapes
 if TYPE_CHECKING:
     from vplane_mj.scenario import Scenario
 
-WORLD_FILE = re.compile(r"world_(\d+)\.world")
+WORLD_FILE = re.compile(r"world_([0-9]+)\.world")
 """How BARN names its world files; `path_N.npy` beside one is its path."""
 BARN_PATH_START_M, BARN_PATH_END_M = (-2.0, 3.0), (-2.0, 13.0)
 """The ends of BARN's optimal-path polyline, in Gazebo's frame (m)."""
@@ -64,24 +68,50 @@ class ImportedWorld:
     reference_m: float | None
 
 
-def world_files(paths: list[Path]) -> list[Path]:
+def world_number(path: Path) -> int | None:
+    """N of a file named world_N.world, else None."""
+    match = WORLD_FILE.fullmatch(path.name)
+    return int(match.group(1)) if match else None
+
+
+def directory_worlds(directory: Path) -> list[Path]:
+    """The world_N.world files of a directory, in the order of N (then of their names)."""
+    numbered = []
+    for candidate in directory.iterdir():
+        number = world_number(candidate)
+        if number is not None and candidate.is_file():
+            numbered.append((number, candidate.name, candidate))
+    if not numbered:
+        raise WorldFileError(str(directory), "", "holds no world_N.world file")
+    return [candidate for _, _, candidate in sorted(numbered)]
+
+
+def refuse_shared(files: list[Path], key: Callable[[Path], object], what: str) -> None:
+    """A WorldFileError naming both files when two share a `key` (None: no key), `what` it is."""
+    first: dict[object, Path] = {}
+    for path in files:
+        value = key(path)
+        if value is None:
+            continue
+        if value in first:
+            reason = f"has {what} {value!r}, as {readable(str(first[value]))} does"
+            raise WorldFileError(str(path), "", reason)
+        first[value] = path
+
+
+def world_files(paths: list[Path], scenario: Callable[[Path], str]) -> list[Path]:
     """The world files `paths` name: each a file, or a directory of world_N.world files (in
-    the order of N)."""
+    the order of N); no two of one world number or of one `scenario` name."""
     files: list[Path] = []
     for path in paths:
         if path.is_dir():
-            numbered = {}
-            for candidate in path.iterdir():
-                match = WORLD_FILE.fullmatch(candidate.name)
-                if match and candidate.is_file():
-                    numbered[int(match.group(1))] = candidate
-            if not numbered:
-                raise WorldFileError(str(path), "", "holds no world_N.world file")
-            files.extend(numbered[n] for n in sorted(numbered))
+            files.extend(directory_worlds(path))
         elif path.is_file():
             files.append(path)
         else:
             raise WorldFileError(str(path), "", "no such file or directory")
+    refuse_shared(files, world_number, "the world number")
+    refuse_shared(files, scenario, "the scenario name")
     return files
 
 
@@ -209,14 +239,7 @@ def import_world(path: Path) -> ImportedWorld:
 
 def import_worlds(paths: list[Path]) -> list[ImportedWorld]:
     """Every world `paths` name, converted, or the first error: nothing is written here."""
-    files = world_files(paths)
-    first: dict[str, Path] = {}
-    for path in files:
-        name = scenario_name(path)
-        if name in first:
-            raise WorldFileError(str(path), "", f"gives the scenario name {name!r}, as {first[name]} does")
-        first[name] = path
-    return [import_world(path) for path in files]
+    return [import_world(path) for path in world_files(paths, scenario_name)]
 
 
 def report_line(world: ImportedWorld) -> str:

@@ -15,7 +15,8 @@ include or a model inside another element, an actor, a world plugin, any other m
 without a plugin that is not a wall, a moving one that is not one cylinder) is a WorldFileError
 naming the file and the element, as an XPath below `<world>`. Other children of `<world>`
 (physics, scene, lights) place no obstacle and are ignored. Numbers and their ranges, names in
-messages and the file's size are checked as `vplane_mj.worlds.sdf` checks BARN's worlds.
+messages and the file's size are checked as `vplane_mj.worlds.sdf` checks BARN's worlds, and
+world numbers and scenario names must be distinct as in `vplane_mj.worlds.barn_import`.
 
 DynaBARN's world files are not well-formed XML as they stand: its walls carry `<pose frame=>`,
 an attribute without a quoted value, which Gazebo's lenient TinyXML reads as an empty one. That
@@ -35,7 +36,7 @@ from pathlib import Path
 
 from vplane_mj.errors import ScenarioError, WorldFileError, cut, readable, shown
 from vplane_mj.scenario import parse_document
-from vplane_mj.worlds.barn_import import WORLD_FILE, world_files
+from vplane_mj.worlds.barn_import import world_files, world_number
 from vplane_mj.worlds.dynabarn_layout import DIFFICULTIES, layout_document, moving_cylinder, to_arena
 from vplane_mj.worlds.dynabarn_plugins import PluginAnimation, read_plugin
 from vplane_mj.worlds.families import Case
@@ -207,10 +208,9 @@ def scenario_name(path: Path) -> str:
 
 def difficulty(path: Path) -> str | None:
     """DynaBARN's difficulty third of world_N.world (N in 0-59), else None."""
-    match = WORLD_FILE.fullmatch(path.name)
-    number = int(match.group(1)) if match else -1
+    number = world_number(path)
     thirds = len(DIFFICULTIES) * WORLDS_PER_DIFFICULTY
-    return DIFFICULTIES[number // WORLDS_PER_DIFFICULTY] if 0 <= number < thirds else None
+    return DIFFICULTIES[number // WORLDS_PER_DIFFICULTY] if number is not None and number < thirds else None
 
 
 def mean_speed(animations: list[PluginAnimation]) -> float:
@@ -260,13 +260,7 @@ def import_worlds(paths: list[Path], plugins: Path | None = None) -> list[Import
     """Every world `paths` name (files, or directories of world_N.world files), converted, or
     the first error: nothing is written here. `plugins`: the folder of the plugins, if not
     beside the worlds."""
-    files = world_files(paths)
-    first: dict[str, Path] = {}
-    for path in files:
-        name = scenario_name(path)
-        if name in first:
-            raise WorldFileError(str(path), "", f"gives the scenario name {name!r}, as {first[name]} does")
-        first[name] = path
+    files = world_files(paths, scenario_name)
     read: dict[Path, PluginAnimation] = {}
     return [import_world(path, plugins, read) for path in files]
 
