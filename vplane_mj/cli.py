@@ -13,8 +13,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import vplane_mj
-from vplane_mj.errors import VPlaneError, readable
-from vplane_mj.files import DEFAULT_OUT, prepare_out_dir, printable_path, write_atomically
+from vplane_mj.errors import VPlaneError, readable, without_surrogates
+from vplane_mj.files import DEFAULT_OUT, prepare_out_dir, write_atomically
 from vplane_mj.planning.plugins import PlannerError
 from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
 from vplane_mj.terminal import Interrupted, signals_raise_interrupted
@@ -73,7 +73,7 @@ class _PipeSafeOutput:
         try:
             return self._stream.write(text)
         except UnicodeEncodeError:  # a file name that is not UTF-8
-            return self._stream.write(printable_path(text))
+            return self._stream.write(without_surrogates(text))
         except BrokenPipeError:
             self._discard_from_now_on()
             return len(text)

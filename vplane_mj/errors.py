@@ -8,6 +8,7 @@ file quoted and cut to a readable length (`shown`), any other long text cut (`cu
 from __future__ import annotations
 
 import difflib
+import os
 from collections.abc import Iterable
 
 CLOSENESS = 0.6
@@ -62,15 +63,21 @@ def did_you_mean(word: str, known: Iterable[str]) -> str:
     return f"; did you mean {match!r}?" if match is not None else ""
 
 
-def readable(text: str) -> str:
+def readable(text: str | os.PathLike[str]) -> str:
     """`text` (a file's path) as any terminal prints it: the bytes of a name that are not UTF-8
     (which Python holds as lone surrogates) as `\\xNN`, and every other character that cannot
     be printed (a control, a lone surrogate of no byte) as Python's backslash escape."""
-    try:
-        text = text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
-    except UnicodeEncodeError:  # a surrogate that stands for no byte
-        text = text.encode("utf-8", "backslashreplace").decode("utf-8")
+    text = without_surrogates(os.fspath(text))
     return "".join(char if char.isprintable() else repr(char)[1:-1] for char in text)
+
+
+def without_surrogates(text: str) -> str:
+    """`text` with the lone surrogates Python holds for bytes of a name that are not UTF-8 as
+    `\\xNN`, and any other lone surrogate as `\\udcNN`: text that encodes as UTF-8."""
+    try:
+        return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    except UnicodeEncodeError:  # a surrogate that stands for no byte
+        return text.encode("utf-8", "backslashreplace").decode("utf-8")
 
 
 def _rest(text: str) -> str:

@@ -58,12 +58,6 @@ def output_directory(path: Path) -> Iterator[Path]:
         raise
 
 
-def printable_path(path: str | os.PathLike[str]) -> str:
-    """`path` as text that any stream and file format can carry: bytes of the name that are not
-    UTF-8 (which Python keeps as lone surrogates) shown as backslash escapes, e.g. `caf\\xe9`."""
-    return os.fsencode(path).decode("utf-8", "backslashreplace")
-
-
 def partial_path(path: Path) -> Path:
     """A temporary name beside `path` that no other writer uses: `.NAME.PID-RANDOM.partial`."""
     return path.with_name(f".{path.name}.{os.getpid()}-{secrets.token_hex(4)}.partial")

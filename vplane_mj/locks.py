@@ -18,8 +18,7 @@ import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
-from vplane_mj.errors import VPlaneError
-from vplane_mj.files import printable_path
+from vplane_mj.errors import VPlaneError, readable
 
 
 class OutputBusy(VPlaneError):
@@ -57,7 +56,7 @@ def _acquire(path: Path, what: str, remedy: str, wait: bool, on_wait: Callable[[
         try:
             descriptor = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
         except OSError as exc:
-            raise VPlaneError(f"{printable_path(path)}: cannot create the lock file: {exc.strerror}") from exc
+            raise VPlaneError(f"{readable(path)}: cannot create the lock file: {exc.strerror}") from exc
         try:
             fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:

@@ -15,12 +15,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from vplane_mj.errors import VPlaneError
+from vplane_mj.errors import VPlaneError, readable
 from vplane_mj.files import (
     DEFAULT_OUT,
     partial_path,
     prepare_out_dir,
-    printable_path,
     write_atomically,
     write_json,
 )
@@ -123,7 +122,7 @@ def run(
         return _record(scenario, run_scenario(scenario, (recorder,)), recorder, {})
     base = output_base(scenario, prepare_out_dir(Path(out)))
     files: dict[str, Path] = {}
-    what = f"{printable_path(base)}.*: this run's files"
+    what = f"{readable(base)}.*: this run's files"
     with exclusive(base.with_name(f".{base.name}.lock"), what, "wait for it to end or choose another --out"):
         result = _simulate(scenario, base, log, recorder, files)
         try:

@@ -22,8 +22,8 @@ from vplane_mj.bench.sweep import (
     run_sweep,
     summarize,
 )
-from vplane_mj.errors import VPlaneError
-from vplane_mj.files import DEFAULT_OUT, output_directory, printable_path
+from vplane_mj.errors import VPlaneError, readable
+from vplane_mj.files import DEFAULT_OUT, output_directory
 from vplane_mj.locks import exclusive
 from vplane_mj.planning import registry
 from vplane_mj.planning.base import Planner
@@ -112,7 +112,7 @@ def sweep(
             result = sweep_into(Path(scratch), report=False)
     else:
         with output_directory(Path(out)) as out_dir:
-            what = f"{printable_path(out_dir)}: the folder of a sweep"
+            what = f"{readable(out_dir)}: the folder of a sweep"
             remedy = "wait for it (--wait) or choose another --out"
             with exclusive(out_dir / ".bench.lock", what, remedy, wait, _say):
                 result = sweep_into(out_dir, report)

@@ -21,8 +21,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from vplane_mj.errors import ScenarioError, did_you_mean
-from vplane_mj.files import data_dir, printable_path
+from vplane_mj.errors import ScenarioError, did_you_mean, readable
+from vplane_mj.files import data_dir
 from vplane_mj.scenario.build import CODE_SOURCE, box, build_scenario, cup, cylinder, h_shape, wall
 from vplane_mj.scenario.fields import Field
 from vplane_mj.scenario.keys import (
@@ -83,10 +83,10 @@ def resolve_path(ref: str) -> Path:
             if candidate.is_file():
                 return candidate
     if ref and path.is_dir():
-        raise ScenarioError(printable_path(ref), "", "is a directory, not a scenario file")
+        raise ScenarioError(readable(ref), "", "is a directory, not a scenario file")
     builtin = [builtin.stem for builtin in _builtin_paths()]
     reason = f"no such file or built-in scenario (built-in: {', '.join(builtin) or 'none'})"
-    raise ScenarioError(printable_path(ref), "", reason + _closest_scenario(ref, builtin))
+    raise ScenarioError(readable(ref), "", reason + _closest_scenario(ref, builtin))
 
 
 def _closest_scenario(ref: str, builtin: list[str]) -> str:
@@ -117,10 +117,10 @@ def load_scenario(ref: str, overrides: Sequence[str | Override] = ()) -> Scenari
     """Read, parse, override and validate the scenario `ref` (a path or a scenario name).
 
     The source named in messages and logs is `ref` itself when it is a path, else the file
-    found, as `printable_path` shows it.
+    found, as `readable` shows it.
     """
     path = resolve_path(ref)
-    source = printable_path(ref if path == Path(ref) else path)
+    source = readable(ref if path == Path(ref) else path)
     return parse_scenario(_read_text(path, source), source, overrides)
 
 
