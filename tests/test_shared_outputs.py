@@ -8,7 +8,7 @@ import sys
 import pytest
 
 from vplane_mj.cli import main
-from vplane_mj.locks import exclusive
+from vplane_mj.files import exclusive
 from vplane_mj.logs.reader import read_log
 
 RUN = ["run", "paper_c_escape", "--planner", "apf", "--set", "planner.patience_s=1000", "--no-render"]

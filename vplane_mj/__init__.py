@@ -42,7 +42,7 @@ _EXPORTS = {
         "wall",
     ),
     "vplane_mj.errors": ("VPlaneError",),
-    "vplane_mj.locks": ("OutputBusy",),
+    "vplane_mj.files": ("OutputBusy",),
     "vplane_mj.sim.summary": ("Outcome", "RunSummary"),
     "vplane_mj.planning.events": ("EventKind",),
     "vplane_mj.runner": ("RunEvent", "RunRecord", "Trajectory", "run"),
@@ -77,7 +77,7 @@ __all__ = [
 
 if TYPE_CHECKING:
     from vplane_mj.errors import VPlaneError
-    from vplane_mj.locks import OutputBusy
+    from vplane_mj.files import OutputBusy
     from vplane_mj.planning.events import EventKind
     from vplane_mj.runner import RunEvent, RunRecord, Trajectory, run
     from vplane_mj.scenario import (

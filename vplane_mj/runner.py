@@ -18,12 +18,12 @@ import numpy as np
 from vplane_mj.errors import VPlaneError, readable
 from vplane_mj.files import (
     DEFAULT_OUT,
+    exclusive,
     partial_path,
     prepare_out_dir,
     write_atomically,
     write_json,
 )
-from vplane_mj.locks import exclusive
 from vplane_mj.planning.events import Event, EventKind
 from vplane_mj.scenario import Scenario, load_scenario
 from vplane_mj.sim.loop import RunResult, Tick, run_scenario

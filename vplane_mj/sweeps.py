@@ -23,8 +23,7 @@ from vplane_mj.bench.sweep import (
     summarize,
 )
 from vplane_mj.errors import VPlaneError, readable
-from vplane_mj.files import DEFAULT_OUT, output_directory
-from vplane_mj.locks import exclusive
+from vplane_mj.files import DEFAULT_OUT, exclusive, output_directory
 from vplane_mj.planning import registry
 from vplane_mj.planning.base import Planner
 from vplane_mj.planning.plugins import PlannerError, is_import_spec
