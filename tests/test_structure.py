@@ -22,6 +22,8 @@ def test_no_function_is_longer_than_80_lines():
     assert not long, "functions longer than 80 lines:\n" + "\n".join(long)
 
 
-def test_at_most_eight_modules_stand_at_the_top_of_the_package():
+def test_at_most_nine_modules_stand_at_the_top_of_the_package():
+    """The entry points, the API's two modules, and the bottom layers (errors, files, terminal,
+    version): everything else lives in a package of its concern."""
     top = sorted(path.name for path in PACKAGE.glob("*.py"))
-    assert len(top) <= 8, top
+    assert len(top) <= 9, top

@@ -18,13 +18,13 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
 
-from vplane_mj import __version__
 from vplane_mj.bench.job import Job
 from vplane_mj.files import write_atomically
 from vplane_mj.planning.registry import command_line_spec
 from vplane_mj.robots.profiles import PROFILES
 from vplane_mj.sim.failure import FailureKind, RunFailure, failure_of
 from vplane_mj.sim.summary import Outcome, RunSummary
+from vplane_mj.version import __version__
 
 FAILURE_KEY = "failure"
 """The row key that says why a run has no summary of its own (a FailureKind)."""

@@ -91,7 +91,6 @@ from foxglove import channels as fc
 from foxglove import messages as fm
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 
-from vplane_mj import __version__
 from vplane_mj.geometry.polyline import PathSimplifier
 from vplane_mj.logs import scene
 from vplane_mj.logs.scene import (
@@ -111,6 +110,7 @@ from vplane_mj.robots.facts import robot_body
 from vplane_mj.robots.profiles import PROFILES
 from vplane_mj.scenario import Scenario
 from vplane_mj.sim.loop import Tick
+from vplane_mj.version import __version__
 
 METADATA_NAME = "vplane_mj"
 """Name of the metadata record with the scenario, seed, planner and versions."""

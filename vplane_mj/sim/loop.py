@@ -23,7 +23,6 @@ from typing import Protocol
 import mujoco
 import numpy as np
 
-from vplane_mj import __version__
 from vplane_mj.errors import VPlaneError
 from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.perception.tracker import Track as TrackedObstacle
@@ -41,6 +40,7 @@ from vplane_mj.sim.sensors import range_sensor
 from vplane_mj.sim.summary import Outcome, RunSummary
 from vplane_mj.sim.world import build_model
 from vplane_mj.terminal import Interrupted
+from vplane_mj.version import __version__
 
 EXTERNAL_PLANNER = "external"
 """The summary's planner name of a run whose decisions come from outside the package."""
