@@ -140,6 +140,47 @@ def test_invalid_scenario_file_is_named_with_key_and_reason(tmp_path, capsys):
     assert list(out_dir.iterdir()) == []
 
 
+ABSURD_SCENARIO = """
+format = 1
+name = "absurd"
+[world]
+size = [4.0, 4.0]
+[robot]
+start = [0.5, 0.5]
+goal = [3.5, 3.5]
+{robot}
+[sensors]
+{sensors}
+[run]
+{run}
+"""
+
+
+@pytest.mark.parametrize(
+    "keys, key, fragment",
+    [
+        ({"sensors": 'kind = "laser"\nrate_hz = 0.001'}, "sensors.rate_hz", "at least run.control_hz / 10"),
+        (
+            {"robot": 'profile = "turtlebot3_burger"', "run": "control_hz = 100"},
+            "run.control_hz",
+            "that is 50 Hz",
+        ),
+        ({"run": "time_limit_s = 1e6"}, "run.time_limit_s", "at most 86400"),
+        ({"robot": "goal_tolerance = 1e6"}, "robot.goal_tolerance", "at most 5"),
+        ({"robot": "start_yaw_deg = 1e300"}, "robot.start_yaw_deg", "at most 360"),
+    ],
+)
+def test_an_absurd_rate_or_limit_is_exit_2_naming_file_and_key(tmp_path, capsys, keys, key, fragment):
+    """Values that would run but mean nothing (one laser scan in 1,000 s, say) are refused."""
+    path = tmp_path / "absurd.toml"
+    path.write_text(ABSURD_SCENARIO.format(**{"robot": "", "sensors": "", "run": "", **keys}))
+    out_dir = tmp_path / "out"
+    code, _, err = run_cli(capsys, "run", str(path), "--planner", "vplane_plus", "--out", str(out_dir))
+    assert code == 2
+    assert err.startswith(f"error: {path}: {key}: ") and fragment in err, err
+    assert not out_dir.exists()
+
+
 def test_a_missing_output_directory_is_created_with_its_parents(tmp_path, capsys):
     out_dir = tmp_path / "results" / "today"
     code, out, _ = run_cli(capsys, "run", "open_field", "--planner", "apf", "--no-log", "--out", str(out_dir))

@@ -707,6 +707,7 @@ AT_THE_EDGE = [
     ["planner.attract_gain=1e6", "planner.repulse_gain=1e6"],
     ["sensors.noise_std=10", "sensors.count=128", "sensors.rays_per_sonar=15", "sensors.range_max=20"],
     ["run.control_hz=1", "run.physics_dt_s=0.01"],
+    ["run.control_hz=200", "sensors.rate_hz=20"],  # the slowest sensor for the fastest control
     ["world.size=[150, 4]", "name=" + "a" * 100],
     [  # a 1 km cup with 1 mm walls, far outside the arena
         "world.obstacles[1].width=1000",

@@ -28,6 +28,15 @@ MAX_ARENA_M = 150.0
 """The largest side of the arena (m): the top camera that renders runs cannot see wider than 180 m."""
 MAX_NOISE_STD_M = 10.0
 """The largest sonar noise (m): more is meaningless, and huge readings overflow the sonar map."""
+MAX_GOAL_TOLERANCE_M = 5.0
+"""The widest goal disc (m): five times BARN's 1 m; wider, a run "reaches" a goal it never nears."""
+MAX_YAW_DEG = 360.0
+"""A start yaw lies within +-MAX_YAW_DEG (deg): more turns mean nothing, and huge angles lose precision."""
+MAX_TIME_LIMIT_S = 24 * 3600.0
+"""The longest run (s of simulated time): a day; a longer limit is a slip, not an experiment."""
+MAX_TICKS_PER_SCAN = 10
+"""The planner decides at most this many times per sensor reading (`[run] control_hz` over
+`[sensors] rate_hz`): more, and it steers on one stale scan into what it has not seen."""
 MIN_OBSTACLE_M, MAX_OBSTACLE_M = 0.001, 1000.0
 """Obstacle sizes and thicknesses (m) lie in [MIN_OBSTACLE_M, MAX_OBSTACLE_M], coordinates within
 +-MAX_OBSTACLE_M: beyond these a size or a thickness can vanish in floating point (MuJoCo rejects
@@ -51,9 +60,9 @@ WORLD_FIELDS = {
 ROBOT_FIELDS = {
     "profile": Field("str", choices=tuple(PROFILES)),
     "start": Field("point", required=True),
-    "start_yaw_deg": Field("number", attr="start_yaw", convert=math.radians),
+    "start_yaw_deg": Field("number", ge=-MAX_YAW_DEG, le=MAX_YAW_DEG, attr="start_yaw", convert=math.radians),
     "goal": Field("point", required=True),
-    "goal_tolerance": Field("number", gt=0),
+    "goal_tolerance": Field("number", gt=0, le=MAX_GOAL_TOLERANCE_M),
     "wheel_friction": Field("number", ge=0.01, le=5),
     "motor_gain": Field("pair", gt=0, le=2),
     "motor_bias_nm": Field("pair"),
@@ -78,7 +87,7 @@ SENSOR_FIELDS = {
     "beams": Field("int", ge=2, le=2048),
     "range_min": Field("number", ge=0, le=MAX_LASER_RANGE_M),
     "range_max": Field("number", gt=0.2, le=MAX_LASER_RANGE_M),
-    "rate_hz": Field("number", gt=0, le=100),
+    "rate_hz": Field("number", gt=0, le=100),  # and at least control_hz / MAX_TICKS_PER_SCAN
 }
 KIND_KEYS = {
     "sonar": ("count", "rays_per_sonar", "beam_deg", "crosstalk", "dead"),
@@ -108,7 +117,7 @@ robot, say): a 16-sonar ring as the default robot's, a 360-degree laser of 1-deg
 
 RUN_FIELDS = {
     "seed": Field("int", ge=0, lt=2**32),
-    "time_limit_s": Field("number", gt=0),
+    "time_limit_s": Field("number", gt=0, le=MAX_TIME_LIMIT_S),
     "physics_dt_s": Field("number", ge=0.0005, le=0.01),
     "control_hz": Field("number", ge=1, le=200),  # one control tick is simulated whole
 }

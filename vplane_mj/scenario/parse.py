@@ -16,7 +16,15 @@ from vplane_mj.errors import ScenarioError
 from vplane_mj.scenario.fields import Invalid
 from vplane_mj.scenario.overrides import Override, apply_override
 from vplane_mj.scenario.placement import check_placement
-from vplane_mj.scenario.sections import read_planner, read_robot, read_run, read_sensors, read_top, read_world
+from vplane_mj.scenario.sections import (
+    check_sensor_rate,
+    read_planner,
+    read_robot,
+    read_run,
+    read_sensors,
+    read_top,
+    read_world,
+)
 from vplane_mj.scenario.spec import Scenario
 
 
@@ -30,12 +38,15 @@ def _freeze(value: Any) -> Any:
 
 
 def _build_scenario(doc: dict[str, Any], source: str, recorded: bool) -> Scenario:
-    """Validate a parsed document section by section, then the start and goal placement."""
+    """Validate a parsed document section by section, the sensor's rate against the control
+    rate, then the start and goal placement."""
     top = read_top(doc)
     run = read_run(doc)
     world = read_world(doc, run.seed)
     robot = read_robot(doc)
     planner, params = read_planner(doc, recorded, robot.profile)
+    sensors = read_sensors(doc, robot.profile)
+    check_sensor_rate(doc, sensors, run)
     scenario = Scenario(
         name=top["name"],
         description=top.get("description", ""),
@@ -44,7 +55,7 @@ def _build_scenario(doc: dict[str, Any], source: str, recorded: bool) -> Scenari
         robot=robot,
         planner=planner,
         planner_params=params,
-        sensors=read_sensors(doc, robot.profile),
+        sensors=sensors,
         run=run,
         raw=_freeze(doc),
     )

@@ -5,7 +5,7 @@ and name, an obstacle's shape (and a moving one's motion, `motion.py`), the plan
 parameters against its table, a motor bias within the torque limit of the profile's model,
 the sensor's keys against its kind and its defaults from the robot's profile, dead sonars
 within the ring, a laser's range limits in order, a control period of at least one physics
-step.
+step, a sensor that reads at least a tenth as often as the planner decides.
 """
 
 from __future__ import annotations
@@ -38,6 +38,7 @@ from vplane_mj.scenario.keys import (
     MAX_NAME_LENGTH,
     MAX_OBSTACLE_M,
     MAX_SONAR_RANGE_M,
+    MAX_TICKS_PER_SCAN,
     NAME_PATTERN,
     OBSTACLE_KINDS,
     ROBOT_FIELDS,
@@ -228,3 +229,24 @@ def read_run(doc: Mapping[str, Any]) -> RunSpec:
         )
         raise Invalid("run.control_hz", reason)
     return run
+
+
+def check_sensor_rate(doc: Mapping[str, Any], sensors: SensorSpec, run: RunSpec) -> None:
+    """The planner decides at most MAX_TICKS_PER_SCAN times per sensor reading. The error names
+    `sensors.rate_hz` when the file gives it, else `run.control_hz` (the rate is then the robot
+    profile's)."""
+    if run.control_hz <= MAX_TICKS_PER_SCAN * sensors.rate_hz:
+        return
+    if "rate_hz" in sub_table(doc, "sensors"):
+        least = run.control_hz / MAX_TICKS_PER_SCAN
+        reason = (
+            f"must be at least run.control_hz / {MAX_TICKS_PER_SCAN} ({run.control_hz:g} Hz / "
+            f"{MAX_TICKS_PER_SCAN}), that is {least:g} Hz, got {sensors.rate_hz!r}"
+        )
+        raise Invalid("sensors.rate_hz", reason)
+    most = MAX_TICKS_PER_SCAN * sensors.rate_hz
+    reason = (
+        f"must be at most {MAX_TICKS_PER_SCAN} x the sensor's rate_hz ({sensors.rate_hz:g} Hz, "
+        f"its default for this robot), that is {most:g} Hz, got {run.control_hz!r}"
+    )
+    raise Invalid("run.control_hz", reason)
