@@ -55,9 +55,10 @@ def test_a_slow_laser_is_read_only_at_its_rate():
     # The Burger's laser turns at 5 Hz; the planner runs at 20 Hz and sees each scan four times.
     scenario = load_scenario("paper_c_escape", ["robot.profile=turtlebot3_burger", "run.time_limit_s=2"])
     run = Run(scenario)
-    scans = []
+    scans, stamps = [], []
     while (observation := run.observe()) is not None:
         scans.append((observation.time_s, observation.ranges.copy()))
+        stamps.append(observation.scan_time_s)
         run.apply(run.planner.step(observation))
     changes = [
         t
@@ -66,6 +67,7 @@ def test_a_slow_laser_is_read_only_at_its_rate():
     ]
     assert len(scans) >= 39
     assert changes == pytest.approx([0.2 * k for k in range(1, len(changes) + 1)], abs=1e-6)
+    assert sorted(set(stamps)) == pytest.approx([0.0, *changes], abs=1e-6)  # each tick says which scan
 
 
 def test_the_pioneer_sonars_show_on_a_one_degree_scan(tmp_path):

@@ -26,6 +26,10 @@ class Observation:
     (`perception.tracker`: each one's estimated disc and velocity, in the same frame as
     `position`), and `moving_echoes` (beams,) marks the echoes of the tracks that move (None:
     none is known to); `static_ranges` leaves those out.
+
+    `scan_time_s` is when the sensor took `ranges` (s; None: at `time_s`). A sensor slower
+    than the control rate hands one scan to several ticks, each with the pose of its own
+    tick: a planner that maps should fold a scan once, at the pose of the tick it came with.
     """
 
     time_s: float
@@ -39,6 +43,7 @@ class Observation:
     velocity: tuple[float, float] = (0.0, 0.0)
     tracks: tuple[Track, ...] = ()
     moving_echoes: np.ndarray | None = None
+    scan_time_s: float | None = None
 
     def static_ranges(self) -> np.ndarray:
         """`ranges` without the echoes of moving tracks (NaN there): what a map of the obstacles

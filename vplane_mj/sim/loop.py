@@ -189,6 +189,7 @@ class Run:
         self.goal = np.asarray(scenario.robot.goal, float)
         self.tolerance = scenario.robot.goal_tolerance
         self.ranges = np.full(len(self.sensor.bearings), np.nan)
+        self.scan_time_s = 0.0  # when the sensor took `ranges` (s)
         self.next_scan_s = 0.0
         self.tracker = Tracker() if scenario.sensors.kind == "laser" else None
         self.tracks: tuple[TrackedObstacle, ...] = ()
@@ -288,6 +289,7 @@ class Run:
             self.drive.wheel_velocity(),
             self.tracks,
             self.moving_echoes,
+            self.scan_time_s,
         )
         return self._observation
 
@@ -362,6 +364,7 @@ class Run:
         scanned = time_s >= self.next_scan_s - 1e-9
         if scanned:
             self.ranges = self.sensor.read(float(self.position[0]), float(self.position[1]), self.yaw)
+            self.scan_time_s = time_s
             while self.next_scan_s <= time_s + 1e-9:
                 self.next_scan_s += 1.0 / self.sensor.rate_hz
         self.yaws.append(self.yaw)
