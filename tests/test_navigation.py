@@ -119,3 +119,56 @@ def test_a_rotated_trap_gives_the_same_outcome(unrotated_trap, angle):
     assert base.success and turned.success
     assert turned.escapes == base.escapes
     assert turned.path_length_m == pytest.approx(base.path_length_m, rel=0.2)
+
+
+WALLED_GOAL = """
+format = 1
+name = "walled_goal"
+description = "The goal inside a closed square of walls: no way leads to it"
+[world]
+size = [10.0, 10.0]
+[[world.obstacles]]
+kind = "wall"
+from = [6.0, 4.0]
+to = [8.0, 4.0]
+[[world.obstacles]]
+kind = "wall"
+from = [8.0, 4.0]
+to = [8.0, 6.0]
+[[world.obstacles]]
+kind = "wall"
+from = [8.0, 6.0]
+to = [6.0, 6.0]
+[[world.obstacles]]
+kind = "wall"
+from = [6.0, 6.0]
+to = [6.0, 4.0]
+[robot]
+start = [2.0, 5.0]
+goal = [7.0, 5.0]
+[planner]
+name = "vplane_plus"
+[run]
+seed = 0
+time_limit_s = 600.0
+"""
+
+
+@pytest.mark.parametrize(
+    "sensor, most_s",
+    [
+        ("sensors.kind=sonar", 120.0),  # read at the control rate
+        ("sensors.kind=laser", 150.0),  # a scan every other tick
+        ("robot.profile=turtlebot3_burger", 300.0),  # a scan every fourth tick
+    ],
+)
+def test_vplane_plus_gives_up_on_a_walled_in_goal(sensor, most_s):
+    """No way leads to the goal: vplane_plus ends `stuck` once its map has held no way for
+    `no_way_patience_s`, however often its sensor scans (a scan handed to several ticks is
+    folded into the map once: folded again at later poses it erased the walls, and the robot
+    drove for the whole time limit)."""
+    summary = run_scenario(parse_scenario(WALLED_GOAL, "walled_goal.toml", [sensor])).summary
+    assert summary.outcome == "stuck", summary
+    assert "the map has held no way to the goal" in summary.message
+    assert summary.sim_time_s < most_s and summary.path_length_m < 60.0
+    assert summary.collisions == 0

@@ -129,6 +129,26 @@ size = [0.1, 1.8]
     assert any("gave up: the map has held no way" in e.text for d in decisions for e in d.events)
 
 
+def test_a_scan_is_folded_into_the_map_once():
+    """A sensor slower than the control rate hands one scan to several ticks: folded again at
+    the pose of a later tick it would show the cup displaced, so the map takes it once."""
+    scenario, footprints = world()
+    planner = make_planner("vplane_plus", {}, RADIUS)
+    goal = np.asarray(scenario.robot.goal, float)
+
+    def observation(time_s, x, ranges, scan_time_s):
+        position = np.array([x, 5.0])
+        return Observation(time_s, position, 0.0, goal, 0.15, BEARINGS, ranges, BEAM, scan_time_s=scan_time_s)
+
+    first_scan = scan(footprints, (3.5, 5.0), 0.0)
+    planner.step(observation(0.0, 3.5, first_scan, 0.0))
+    mapped = planner.map.grid.copy()
+    planner.step(observation(0.05, 3.8, first_scan, 0.0))  # the same scan, the robot 0.3 m on
+    np.testing.assert_array_equal(planner.map.grid, mapped)
+    planner.step(observation(0.1, 3.8, scan(footprints, (3.8, 5.0), 0.0), 0.1))  # a new scan
+    assert not np.array_equal(planner.map.grid, mapped)
+
+
 def test_a_plane_that_closes_the_only_way_is_retired():
     """The goal lies before the cup's mouth and the robot inside: a plane across the mouth
     closes the only way, so following the map retires it."""

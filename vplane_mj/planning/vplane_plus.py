@@ -170,11 +170,12 @@ class VPlanePlusPlanner(VPlanePlanner):
         self.sight: gridsearch.Window | None = None  # the window of the latest way, for sight lines
         self.stalls: list[np.ndarray] = []  # where following the way was held up (m)
         self.last_scan_pose: tuple[float, float, float] | None = None
+        self.last_scan_s: float | None = None  # when the sensor took the last scan seen (s)
 
     # -- the loop -------------------------------------------------------------------------
     def step(self, obs: Observation) -> Decision:
         p = self.params
-        if self._moved_since_last_scan(obs):
+        if self._new_scan(obs) and self._moved_since_last_scan(obs):
             self.map.update(obs.position, obs.yaw, obs.bearings, obs.static_ranges(), obs.beam_width)
             self.map.sweep(obs.position, self.robot.inner_radius_m)  # under the robot at any heading
         self.map.forget(obs.tracks, obs.time_s)
@@ -246,6 +247,16 @@ class VPlanePlusPlanner(VPlanePlanner):
         decision.objective = self.temp_goal
         decision.planes = [(plane.e1, plane.e2) for plane in self.planes]
         return decision
+
+    def _new_scan(self, obs: Observation) -> bool:
+        """Whether the tick brings a scan not seen before: a sensor slower than the control rate
+        hands one scan to several ticks, and folded again at a later pose it would show the
+        obstacles displaced (erasing walls the robot has driven away from)."""
+        taken = obs.time_s if obs.scan_time_s is None else obs.scan_time_s
+        if taken == self.last_scan_s:
+            return False
+        self.last_scan_s = taken
+        return True
 
     def _moved_since_last_scan(self, obs: Observation) -> bool:
         """Whether the robot has moved or turned enough since the last scan folded into the map:
