@@ -189,8 +189,7 @@ class Run:
         self.goal = np.asarray(scenario.robot.goal, float)
         self.tolerance = scenario.robot.goal_tolerance
         self.ranges = np.full(len(self.sensor.bearings), np.nan)
-        self.scan_time_s = 0.0  # when the sensor took `ranges` (s)
-        self.next_scan_s = 0.0
+        self.scan_time_s = self.next_scan_s = 0.0  # when the sensor took `ranges`, takes the next (s)
         self.tracker = Tracker() if scenario.sensors.kind == "laser" else None
         self.tracks: tuple[TrackedObstacle, ...] = ()
         self.moving_echoes: np.ndarray | None = None
