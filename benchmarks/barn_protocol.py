@@ -33,7 +33,7 @@ from vplane_mj.bench.report import markdown_table
 from vplane_mj.bench.sweep import parse_seeds, plan_jobs, run_sweep
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
-from vplane_mj.planning.registry import PLANNERS
+from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.worlds.barn_protocol import generate_protocol
 
 PLANNER_ORDER = ("vplane_plus", "dwa", "vplane", "vfh", "apf", "vobs", "bug2")

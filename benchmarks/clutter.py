@@ -30,7 +30,7 @@ from vplane_mj.bench.report import markdown_table
 from vplane_mj.bench.sweep import plan_jobs, run_sweep
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
-from vplane_mj.planning.registry import PLANNERS
+from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.worlds.families import generate, trap_suite
 
 PAPER = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")

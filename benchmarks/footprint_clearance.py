@@ -23,9 +23,9 @@ import time
 
 import numpy as np
 
-from vplane_mj.planning.dwa import DwaPlanner
 from vplane_mj.planning.kernels.footprint_clearance import footprint_clearance
-from vplane_mj.planning.types import Observation
+from vplane_mj.planning.planners.dwa import DwaPlanner
+from vplane_mj.planning.protocol.types import Observation
 from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario import parse_scenario
 from vplane_mj.worlds.barn_protocol import generate_protocol

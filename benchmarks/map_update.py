@@ -29,8 +29,8 @@ import numpy as np
 
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.synthetic import LAYOUTS
-from vplane_mj.planning.localmap import LocalMap
-from vplane_mj.planning.registry import make_planner
+from vplane_mj.planning.perception.localmap import LocalMap
+from vplane_mj.planning.protocol.registry import make_planner
 from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.worlds.families import BARN_CELL_M, BARN_COLUMNS, BARN_FIELD_Y_M, barn_cells
 

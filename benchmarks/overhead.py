@@ -41,7 +41,7 @@ import numpy as np
 
 from vplane_mj.logs.writer import McapLog
 from vplane_mj.planning import Decision, Observation, Planner, PlannerParams
-from vplane_mj.planning.registry import register_planner
+from vplane_mj.planning.protocol.registry import register_planner
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.laser import LaserScanner
 from vplane_mj.sim.loop import run_scenario

@@ -25,9 +25,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from vplane_mj.planning.groups import LocalMapParams
-from vplane_mj.planning.registry import PLANNERS, make_planner
-from vplane_mj.planning.types import Observation
+from vplane_mj.planning.planners.groups import LocalMapParams
+from vplane_mj.planning.protocol.registry import PLANNERS, make_planner
+from vplane_mj.planning.protocol.types import Observation
 from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import load_scenario, parse_scenario
 from vplane_mj.sim.loop import run_scenario

@@ -28,7 +28,7 @@ import tomli_w
 
 from vplane_mj.bench.sweep import plan_jobs, run_sweep
 from vplane_mj.geometry.cache import CACHE_ENV
-from vplane_mj.planning.registry import PLANNERS
+from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim.loop import run_scenario
 from vplane_mj.sim.world import build_model

@@ -55,7 +55,7 @@ from vplane_mj.bench.job import Job
 from vplane_mj.bench.sweep import family_of, run_sweep
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir, write_atomically, write_json
-from vplane_mj.planning.registry import PLANNERS
+from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.scenario import SensorSpec, parse_scenario
 from vplane_mj.terminal import Interrupted, signals_raise_interrupted
 from vplane_mj.worlds.families import generate

@@ -21,10 +21,10 @@ import numpy as np
 
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.synthetic import BEAM, BEARINGS, scan
-from vplane_mj.planning import histogram
-from vplane_mj.planning.registry import make_planner
-from vplane_mj.planning.types import Observation
-from vplane_mj.planning.vplane_geometry import plane_force
+from vplane_mj.planning.perception import histogram
+from vplane_mj.planning.planners.vplane_geometry import plane_force
+from vplane_mj.planning.protocol.registry import make_planner
+from vplane_mj.planning.protocol.types import Observation
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.loop import run_scenario
 from vplane_mj.viz.render import render_top_view, write_png

@@ -25,7 +25,7 @@ import numpy as np
 
 import vplane_mj  # before dm_control: it picks OSMesa for rendering unless MUJOCO_GL is set
 from vplane_mj.envs import PlannerPolicy, VPlaneNavDmEnv
-from vplane_mj.planning.registry import load_planner
+from vplane_mj.planning.protocol.registry import load_planner
 
 # isort: split
 from dm_control.suite.wrappers import pixels

@@ -20,8 +20,8 @@ from hypothesis import settings
 
 from vplane_mj.cli import main
 from vplane_mj.geometry.cache import CACHE_ENV
-from vplane_mj.planning import registry
-from vplane_mj.planning.registry import make_planner
+from vplane_mj.planning.protocol import registry
+from vplane_mj.planning.protocol.registry import make_planner
 from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import build_scenario, load_scenario, parse_scenario, wall
 

@@ -32,8 +32,8 @@ from vplane_mj.bench.sweep import (
 )
 from vplane_mj.cli import main
 from vplane_mj.errors import VPlaneError
-from vplane_mj.planning.plugins import FILE_MODULE_PREFIX
-from vplane_mj.planning.registry import load_planner
+from vplane_mj.planning.protocol.plugins import FILE_MODULE_PREFIX
+from vplane_mj.planning.protocol.registry import load_planner
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.summary import without_timing
 
@@ -167,7 +167,7 @@ import time
 import uuid
 from pathlib import Path
 
-from vplane_mj.planning.apf import ApfPlanner
+from vplane_mj.planning.planners.apf import ApfPlanner
 
 GATE = Path(__file__).parent
 HOLD_AT_S = 0.5

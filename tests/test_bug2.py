@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from vplane_mj.geometry import shapes, synthetic
-from vplane_mj.planning import bug2
-from vplane_mj.planning.types import Observation
+from vplane_mj.planning.planners import bug2
+from vplane_mj.planning.protocol.types import Observation
 from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.robots.profiles import ControllerGains
 from vplane_mj.scenario import load_scenario

@@ -8,7 +8,7 @@ import pytest
 
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.reference import shortest_path
-from vplane_mj.planning.events import EventKind
+from vplane_mj.planning.protocol.events import EventKind
 from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim.loop import run_scenario

@@ -8,9 +8,9 @@ import pytest
 
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.synthetic import BEAM, BEARINGS, scan
-from vplane_mj.planning import dwa
-from vplane_mj.planning.body import DriveLimits, HeadingGains, RobotBody
-from vplane_mj.planning.types import Observation
+from vplane_mj.planning.planners import dwa
+from vplane_mj.planning.protocol.body import DriveLimits, HeadingGains, RobotBody
+from vplane_mj.planning.protocol.types import Observation
 from vplane_mj.robots.facts import robot_body, robot_radius_m
 from vplane_mj.robots.profiles import PROFILES, ControllerGains
 from vplane_mj.scenario import parse_scenario

@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj.planning.evasion import Evasion
-from vplane_mj.planning.groups import MotionParams
 from vplane_mj.planning.kernels import evasion as kernels
+from vplane_mj.planning.motion.evasion import Evasion
 from vplane_mj.planning.perception.tracker import Track
-from vplane_mj.planning.types import Observation
+from vplane_mj.planning.planners.groups import MotionParams
+from vplane_mj.planning.protocol.types import Observation
 from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim.loop import Run

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from vplane_mj.planning import fields
+from vplane_mj.planning.motion import fields
 
 GOAL = np.array([3.0, -1.0])
 OBSTACLES = np.array([[0.5, 0.2], [0.6, -0.4], [-0.3, 0.5]])

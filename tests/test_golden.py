@@ -30,7 +30,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from vplane_mj.planning.registry import BUILT_IN
+from vplane_mj.planning.protocol.registry import BUILT_IN
 from vplane_mj.scenario import load_scenario, parse_scenario
 from vplane_mj.sim.loop import run_scenario
 from vplane_mj.worlds.families import generate, trap_suite

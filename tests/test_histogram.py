@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj.planning.histogram import (
+from vplane_mj.planning.perception.histogram import (
     Valley,
     find_valleys,
     nearest_wide_valley,

@@ -32,8 +32,9 @@ from vplane_mj.cli import main
 from vplane_mj.geometry.reference import shortest_path
 from vplane_mj.logs.reader import read_log
 from vplane_mj.logs.writer import METADATA_NAME
-from vplane_mj.planning import register_planner, registry
-from vplane_mj.planning.params import Param
+from vplane_mj.planning import register_planner
+from vplane_mj.planning.protocol import registry
+from vplane_mj.planning.protocol.params import Param
 from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import Field, keys, load_scenario, parse_scenario
 from vplane_mj.sim.loop import run_scenario

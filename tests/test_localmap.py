@@ -10,10 +10,10 @@ import pytest
 
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.synthetic import BEAM, BEARINGS, LAYOUTS, scan
-from vplane_mj.planning import beams
 from vplane_mj.planning.kernels import map_update
 from vplane_mj.planning.kernels.map_update import nearest_by_search, nearest_in_ring
-from vplane_mj.planning.localmap import LocalMap, angular_extremes
+from vplane_mj.planning.perception import beams
+from vplane_mj.planning.perception.localmap import LocalMap, angular_extremes
 
 WALL = shapes.Footprints(shapes.Wall((2.0, -1.0), (2.0, 1.0), 0.1).footprint())
 
@@ -665,7 +665,7 @@ def test_the_compiled_distance_transform_equals_scipys_bit_for_bit(seed):
 
 
 def test_mask_cells_are_numpys_nonzero():
-    from vplane_mj.planning.localmap import mask_cells
+    from vplane_mj.planning.perception.localmap import mask_cells
 
     rng = np.random.default_rng(0)
     for shape in ((1, 1), (3, 5), (64, 64), (7, 1)):

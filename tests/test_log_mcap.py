@@ -33,8 +33,8 @@ from vplane_mj.logs.writer import (
     McapLog,
     time_ns,
 )
-from vplane_mj.planning.events import Event, EventKind
-from vplane_mj.planning.types import Decision
+from vplane_mj.planning.protocol.events import Event, EventKind
+from vplane_mj.planning.protocol.types import Decision
 from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import load_scenario, parse_scenario
 from vplane_mj.sim.loop import Tick, run_scenario

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from vplane_mj.planning.minima import LocalMinimumDetector
+from vplane_mj.planning.perception.minima import LocalMinimumDetector
 
 DT = 0.05
 

@@ -1,4 +1,4 @@
-"""The governor that drives a planner's force on the robot's body (vplane_mj/planning/motion.py),
+"""The governor that drives a planner's force on the robot's body (vplane_mj/planning/motion/governor.py),
 the dense scan's reduction (scan.py) and the gap sizing by the robot's width, on synthetic
 observations; the drive model against the Jackal in MuJoCo; and real runs of the Jackal on BARN
 protocol worlds and of the Pioneer and the TurtleBot3 in the paper's four scenarios."""
@@ -9,11 +9,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vplane_mj.planning import motion, scan
-from vplane_mj.planning.body import DriveLimits, HeadingGains, RobotBody
-from vplane_mj.planning.registry import make_planner
-from vplane_mj.planning.types import Observation
-from vplane_mj.planning.vectors import evenly_spaced, wrap_angle
+from vplane_mj.planning.motion import governor as motion
+from vplane_mj.planning.perception import scan
+from vplane_mj.planning.protocol.body import DriveLimits, HeadingGains, RobotBody
+from vplane_mj.planning.protocol.registry import make_planner
+from vplane_mj.planning.protocol.types import Observation
+from vplane_mj.planning.protocol.vectors import evenly_spaced, wrap_angle
 from vplane_mj.robots.facts import robot_body
 
 JACKAL = robot_body("jackal")

@@ -14,7 +14,7 @@ from vplane_mj.logs.replay import disagreements, obstacle_distances, summarize, 
 from vplane_mj.logs.scene import TRACK_ARROW_S
 from vplane_mj.logs.timeline import timeline_from_log
 from vplane_mj.logs.writer import MOVING_PERIOD_S, MOVING_TOPIC, TRACKS_TOPIC, McapLog, time_ns
-from vplane_mj.planning.types import Decision
+from vplane_mj.planning.protocol.types import Decision
 from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim.loop import Tick, run_scenario
 from vplane_mj.sim.sensors import scan_bearings

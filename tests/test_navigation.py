@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from vplane_mj.geometry import shapes
-from vplane_mj.planning.events import EventKind
+from vplane_mj.planning.protocol.events import EventKind
 from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim.loop import run_scenario
 from vplane_mj.worlds.families import cup_case, rotated, trap_suite

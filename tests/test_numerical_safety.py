@@ -7,10 +7,16 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from vplane_mj.planning import fields, registry
-from vplane_mj.planning.params import PlannerParams
-from vplane_mj.planning.types import Decision, Observation
-from vplane_mj.planning.vplane_geometry import escape_direction, make_plane, plane_force, virtual_objective
+from vplane_mj.planning.motion import fields
+from vplane_mj.planning.planners.vplane_geometry import (
+    escape_direction,
+    make_plane,
+    plane_force,
+    virtual_objective,
+)
+from vplane_mj.planning.protocol import registry
+from vplane_mj.planning.protocol.params import PlannerParams
+from vplane_mj.planning.protocol.types import Decision, Observation
 from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.sim import control
 from vplane_mj.sim import loop as sim

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from vplane_mj.cli import main
-from vplane_mj.planning.params import PlannerParams
-from vplane_mj.planning.types import Decision
+from vplane_mj.planning.protocol.params import PlannerParams
+from vplane_mj.planning.protocol.types import Decision
 from vplane_mj.sim import loop as sim
 from vplane_mj.sim.world import build_model
 

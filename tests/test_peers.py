@@ -2,7 +2,7 @@
 
 import pytest
 
-from vplane_mj.planning.registry import PLANNERS
+from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.sim.loop import run_scenario
 
 pytestmark = pytest.mark.slow  # a long suite: `python -m pytest -m slow` runs it

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from vplane_mj.errors import ScenarioError
-from vplane_mj.planning.base import Planner
-from vplane_mj.planning.params import ParamError
-from vplane_mj.planning.registry import PLANNERS, make_planner
-from vplane_mj.planning.vectors import evenly_spaced, unit, wrap_angle
+from vplane_mj.planning.protocol.base import Planner
+from vplane_mj.planning.protocol.params import ParamError
+from vplane_mj.planning.protocol.registry import PLANNERS, make_planner
+from vplane_mj.planning.protocol.vectors import evenly_spaced, unit, wrap_angle
 from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.scenario import load_scenario
 

@@ -11,10 +11,10 @@ import pytest
 
 from vplane_mj import VPlaneError
 from vplane_mj.envs import PlannerPolicy, VPlaneNavDmEnv
-from vplane_mj.planning.bug2 import Bug2Planner
-from vplane_mj.planning.plugins import PlannerError
-from vplane_mj.planning.registry import PLANNERS
-from vplane_mj.planning.vplane import VPlanePlanner
+from vplane_mj.planning.planners.bug2 import Bug2Planner
+from vplane_mj.planning.planners.vplane import VPlanePlanner
+from vplane_mj.planning.protocol.plugins import PlannerError
+from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.loop import run_scenario
 

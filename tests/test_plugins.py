@@ -31,7 +31,7 @@ from vplane_mj.planning import (
     param,
     register_planner,
 )
-from vplane_mj.planning.plugins import canonical_spec
+from vplane_mj.planning.protocol.plugins import canonical_spec
 from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.sim.loop import run_scenario
 from vplane_mj.sweeps import sweep
@@ -346,7 +346,7 @@ def test_an_installed_entry_point_is_listed_without_import_and_usable_by_name(tm
     probe = textwrap.dedent(
         """
         import sys
-        from vplane_mj.planning.registry import PLANNERS
+        from vplane_mj.planning.protocol.registry import PLANNERS
         names = list(PLANNERS)
         print(names[-1], "wander" in PLANNERS, "wander_pkg" in sys.modules)
         print(PLANNERS["wander"].Params().pull, "wander_pkg" in sys.modules)

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from vplane_mj import scenario as scenario_module
 from vplane_mj.errors import ScenarioError
 from vplane_mj.geometry.shapes import Box, Cup, Cylinder, HShape, Wall
-from vplane_mj.planning import registry
+from vplane_mj.planning.protocol import registry
 from vplane_mj.scenario import (
     RunSpec,
     Scenario,

@@ -10,7 +10,7 @@ from PIL import Image
 from vplane_mj.cli import main
 from vplane_mj.logs.reader import read_log
 from vplane_mj.logs.timeline import timeline_from_log
-from vplane_mj.planning.events import EventKind
+from vplane_mj.planning.protocol.events import EventKind
 
 TIME_LIMIT_S = 6.0  # vplane detects the trap at 5.45 s: the escape starts on screen
 

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from vplane_mj.planning.vplane_geometry import (
+from vplane_mj.planning.planners.vplane_geometry import (
     escape_direction,
     make_plane,
     plane_force,

@@ -9,9 +9,9 @@ from hypothesis import strategies as st
 
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.synthetic import BEAM, BEARINGS, scan
-from vplane_mj.planning.events import EventKind
-from vplane_mj.planning.registry import make_planner
-from vplane_mj.planning.types import Observation
+from vplane_mj.planning.protocol.events import EventKind
+from vplane_mj.planning.protocol.registry import make_planner
+from vplane_mj.planning.protocol.types import Observation
 
 RADIUS = 0.11
 

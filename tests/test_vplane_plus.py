@@ -8,11 +8,11 @@ import pytest
 
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.synthetic import BEAM, BEARINGS, scan
-from vplane_mj.planning import gridsearch
-from vplane_mj.planning.events import EventKind
-from vplane_mj.planning.registry import make_planner
-from vplane_mj.planning.types import Observation
-from vplane_mj.planning.vplane_geometry import make_plane
+from vplane_mj.planning.motion import gridsearch
+from vplane_mj.planning.planners.vplane_geometry import make_plane
+from vplane_mj.planning.protocol.events import EventKind
+from vplane_mj.planning.protocol.registry import make_planner
+from vplane_mj.planning.protocol.types import Observation
 from vplane_mj.scenario import parse_scenario
 
 RADIUS = 0.11
@@ -359,8 +359,8 @@ def test_the_next_waypoint_is_the_farthest_in_sight_of_the_run_within_reach_past
     """The compiled choice against its definition: the nearest point (the first of equally near
     ones), the run of points after it within reach, the farthest of them the robot sees in a
     straight line (the nearest when none); every one seen without a window."""
-    from vplane_mj.planning import vplane_plus
     from vplane_mj.planning.kernels import way as way_kernels
+    from vplane_mj.planning.planners import vplane_plus
 
     rng = np.random.default_rng(11)
     for trial in range(2000):

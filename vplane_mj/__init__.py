@@ -38,7 +38,7 @@ _EXPORTS = {
     "vplane_mj.errors": ("VPlaneError",),
     "vplane_mj.files": ("OutputBusy",),
     "vplane_mj.sim.summary": ("Outcome", "RunSummary"),
-    "vplane_mj.planning.events": ("EventKind",),
+    "vplane_mj.planning.protocol.events": ("EventKind",),
     "vplane_mj.runner": ("RunEvent", "RunRecord", "Trajectory", "run"),
     "vplane_mj.sweeps": ("SweepErrorWarning", "SweepResult", "sweep"),
 }
@@ -72,7 +72,7 @@ __all__ = [
 if TYPE_CHECKING:
     from vplane_mj.errors import VPlaneError
     from vplane_mj.files import OutputBusy
-    from vplane_mj.planning.events import EventKind
+    from vplane_mj.planning.protocol.events import EventKind
     from vplane_mj.runner import RunEvent, RunRecord, Trajectory, run
     from vplane_mj.scenario import (
         Scenario,

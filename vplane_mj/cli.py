@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING
 import vplane_mj
 from vplane_mj.errors import VPlaneError, readable, without_surrogates
 from vplane_mj.files import DEFAULT_OUT, prepare_out_dir, write_atomically
-from vplane_mj.planning.plugins import PlannerError
-from vplane_mj.planning.registry import DEFAULT_PLANNER, PLANNERS
+from vplane_mj.planning.protocol.plugins import PlannerError
+from vplane_mj.planning.protocol.registry import DEFAULT_PLANNER, PLANNERS
 from vplane_mj.terminal import Interrupted, signals_raise_interrupted
 from vplane_mj.worlds.dynabarn_layout import DIFFICULTIES
 from vplane_mj.worlds.families import FAMILIES

@@ -24,7 +24,7 @@ from vplane_mj.files import (
     write_atomically,
     write_json,
 )
-from vplane_mj.planning.events import Event, EventKind
+from vplane_mj.planning.protocol.events import Event, EventKind
 from vplane_mj.scenario import Scenario, load_scenario
 from vplane_mj.sim.loop import RunResult, Tick, run_scenario
 from vplane_mj.sim.summary import RunSummary

@@ -24,10 +24,10 @@ from vplane_mj.bench.sweep import (
 )
 from vplane_mj.errors import VPlaneError, readable
 from vplane_mj.files import DEFAULT_OUT, exclusive, output_directory
-from vplane_mj.planning import registry
-from vplane_mj.planning.base import Planner
-from vplane_mj.planning.plugins import PlannerError, is_import_spec
-from vplane_mj.planning.registry import for_worker, load_planner, register_planner, unknown_planner
+from vplane_mj.planning.protocol import registry
+from vplane_mj.planning.protocol.base import Planner
+from vplane_mj.planning.protocol.plugins import PlannerError, is_import_spec
+from vplane_mj.planning.protocol.registry import for_worker, load_planner, register_planner, unknown_planner
 from vplane_mj.scenario import Scenario, parse_scenario
 from vplane_mj.sim.summary import Outcome, RunSummary
 

@@ -20,7 +20,7 @@ from typing import Any, TypeVar
 
 from vplane_mj.bench.job import Job
 from vplane_mj.files import write_atomically
-from vplane_mj.planning.registry import command_line_spec
+from vplane_mj.planning.protocol.registry import command_line_spec
 from vplane_mj.robots.profiles import PROFILES
 from vplane_mj.sim.failure import FailureKind, RunFailure, failure_of
 from vplane_mj.sim.summary import Outcome, RunSummary

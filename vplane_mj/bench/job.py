@@ -5,7 +5,7 @@ from __future__ import annotations
 import hashlib
 from dataclasses import dataclass
 
-from vplane_mj.planning.registry import WorkerPlanner
+from vplane_mj.planning.protocol.registry import WorkerPlanner
 
 
 @dataclass(frozen=True)

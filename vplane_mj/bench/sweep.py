@@ -27,7 +27,7 @@ from vplane_mj.bench.failures import FAILED_DIR, RERUN_KEY, call_or_failure, fin
 from vplane_mj.bench.job import Job
 from vplane_mj.bench.pool import run_in_pool
 from vplane_mj.errors import VPlaneError
-from vplane_mj.planning.registry import for_worker
+from vplane_mj.planning.protocol.registry import for_worker
 from vplane_mj.scenario import load_scenario
 from vplane_mj.scenario.overrides import Override
 from vplane_mj.sim.failure import FailureKind, RunFailure, failure_of
@@ -104,7 +104,7 @@ def run_job(job: Job) -> dict:
     """Run one job (in a worker process): its summary, the job's key and, under PATH_KEY,
     the travelled path simplified to PATH_TOLERANCE_M (for the report's picture of it)."""
     from vplane_mj.geometry.polyline import PathSimplifier
-    from vplane_mj.planning.registry import register_in_worker
+    from vplane_mj.planning.protocol.registry import register_in_worker
     from vplane_mj.scenario import parse_scenario
     from vplane_mj.sim.loop import run_scenario
 

@@ -20,10 +20,10 @@ import dm_env
 import numpy as np
 
 from vplane_mj.errors import VPlaneError
-from vplane_mj.planning.base import Planner
-from vplane_mj.planning.plugins import PlannerError, planner_problem
-from vplane_mj.planning.registry import PLANNERS, unknown_planner
-from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.planning.protocol.base import Planner
+from vplane_mj.planning.protocol.plugins import PlannerError, planner_problem
+from vplane_mj.planning.protocol.registry import PLANNERS, unknown_planner
+from vplane_mj.planning.protocol.types import Decision, Observation
 from vplane_mj.robots.facts import robot_body
 from vplane_mj.sim.control import heading_command, within_limits
 from vplane_mj.sim.loop import Run

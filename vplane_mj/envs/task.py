@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from vplane_mj.errors import VPlaneError
-from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.planning.protocol.types import Decision, Observation
 from vplane_mj.robots.facts import SONAR_MOUNT_RADIUS_M
 from vplane_mj.robots.profiles import PROFILES, ControllerGains
 from vplane_mj.scenario import MAX_ARENA_M, Scenario, load_scenario, parse_scenario

@@ -17,7 +17,7 @@ from mcap.stream_reader import StreamReader
 from mcap_protobuf.decoder import DecoderFactory
 
 from vplane_mj.logs.writer import EVENTS_DATA_TOPIC, MOVING_TOPIC, SUMMARY_METADATA_NAME
-from vplane_mj.planning.events import EVENT_POINTS, EventKind
+from vplane_mj.planning.protocol.events import EVENT_POINTS, EventKind
 
 
 @dataclass(frozen=True)

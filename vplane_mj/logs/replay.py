@@ -19,7 +19,7 @@ from vplane_mj.geometry import shapes
 from vplane_mj.geometry.motion import Moving
 from vplane_mj.logs.reader import LogContents, iter_messages, read_log
 from vplane_mj.logs.writer import METADATA_NAME
-from vplane_mj.planning.events import EventKind
+from vplane_mj.planning.protocol.events import EventKind
 from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario import Scenario, parse_scenario
 from vplane_mj.sim.loop import Track

@@ -21,7 +21,7 @@ from foxglove import messages as fm
 
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.motion import Moving
-from vplane_mj.planning.body import RobotBody
+from vplane_mj.planning.protocol.body import RobotBody
 from vplane_mj.scenario import Scenario
 from vplane_mj.sim.world import OBSTACLE_HEIGHT_M
 

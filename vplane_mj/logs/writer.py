@@ -53,7 +53,7 @@ bearing's degree (the nearer of two that share one), NaN elsewhere.
 of numbers), as viewers require: a value that is missing (`force_virtual` without a
 virtual force, `odometry_error_m` without odometry, an event's points) or not finite is
 omitted from the message instead of being null. `/run/events` has the kind
-(`vplane_mj.planning.events.EventKind`), the text and the event's named points (`point`,
+(`vplane_mj.planning.protocol.events.EventKind`), the text and the event's named points (`point`,
 `e1`, `e2`, `objective`, `waypoint`, each [x, y] in m), from which `vplane-mj summary`
 recomputes a run's outcome and counts.
 
@@ -104,8 +104,8 @@ from vplane_mj.logs.scene import (
     WORLD_FRAME,
     TrackMark,
 )
-from vplane_mj.planning.events import EVENT_POINTS, Event, EventKind
-from vplane_mj.planning.types import Decision
+from vplane_mj.planning.protocol.events import EVENT_POINTS, Event, EventKind
+from vplane_mj.planning.protocol.types import Decision
 from vplane_mj.robots.facts import robot_body
 from vplane_mj.robots.profiles import PROFILES
 from vplane_mj.scenario import Scenario
@@ -170,7 +170,10 @@ EVENTS_JSON_SCHEMA: dict[str, Any] = {
     "title": "vplane_mj.Event",
     "type": "object",
     "properties": {
-        "kind": {"type": "string", "description": "the event's kind (vplane_mj.planning.events.EventKind)"},
+        "kind": {
+            "type": "string",
+            "description": "the event's kind (vplane_mj.planning.EventKind)",
+        },
         "text": {"type": "string", "description": "what happened, for people"},
         **{
             name: {"type": "array", "items": {"type": "number"}, "description": "[x, y] (m), if any"}

@@ -16,24 +16,24 @@ The names for writing a planner of one's own (docs/own-planner.md):
 - `register_planner`, `load_planner`: registration in code.
 """
 
-from vplane_mj.planning.base import Planner
-from vplane_mj.planning.body import DriveLimits, HeadingGains, RobotBody
-from vplane_mj.planning.events import Event, EventKind, point
-from vplane_mj.planning.groups import (
+from vplane_mj.planning.perception.localmap import LocalMap
+from vplane_mj.planning.perception.minima import LocalMinimumDetector, report_trap
+from vplane_mj.planning.perception.tracker import Track
+from vplane_mj.planning.planners.groups import (
     DetectorParams,
     FieldParams,
     LocalMapParams,
     MinimumParams,
     SonarMapParams,
 )
-from vplane_mj.planning.localmap import LocalMap
-from vplane_mj.planning.minima import LocalMinimumDetector, report_trap
-from vplane_mj.planning.params import Param, ParamError, PlannerParams, param, with_default
-from vplane_mj.planning.perception.tracker import Track
-from vplane_mj.planning.plugins import PlannerError
-from vplane_mj.planning.registry import load_planner, register_planner
-from vplane_mj.planning.types import Decision, Observation
-from vplane_mj.planning.vectors import unit, wrap_angle
+from vplane_mj.planning.protocol.base import Planner
+from vplane_mj.planning.protocol.body import DriveLimits, HeadingGains, RobotBody
+from vplane_mj.planning.protocol.events import Event, EventKind, point
+from vplane_mj.planning.protocol.params import Param, ParamError, PlannerParams, param, with_default
+from vplane_mj.planning.protocol.plugins import PlannerError
+from vplane_mj.planning.protocol.registry import load_planner, register_planner
+from vplane_mj.planning.protocol.types import Decision, Observation
+from vplane_mj.planning.protocol.vectors import unit, wrap_angle
 
 __all__ = [
     "Decision",

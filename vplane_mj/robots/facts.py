@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from vplane_mj.files import model_path
-from vplane_mj.planning.body import HeadingGains, RobotBody
+from vplane_mj.planning.protocol.body import HeadingGains, RobotBody
 from vplane_mj.robots.mjcf_reader import MjcfReader, PosedGeom
 from vplane_mj.robots.profiles import PROFILES
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 
 from vplane_mj.errors import VPlaneError
-from vplane_mj.planning.body import DriveLimits
+from vplane_mj.planning.protocol.body import DriveLimits
 
 DRIVES = ("differential", "skid_steer")
 Point = tuple[float, float]

@@ -15,7 +15,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from vplane_mj.geometry.shapes import Obstacle, scene_footprints
-from vplane_mj.planning.body import RobotBody
+from vplane_mj.planning.protocol.body import RobotBody
 from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario.fields import Invalid
 from vplane_mj.scenario.spec import RobotSpec, WorldSpec

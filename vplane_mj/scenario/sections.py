@@ -18,9 +18,9 @@ from typing import Any
 from vplane_mj.errors import did_you_mean
 from vplane_mj.geometry.motion import Moving
 from vplane_mj.geometry.shapes import Box, Cylinder, Obstacle
-from vplane_mj.planning import registry
-from vplane_mj.planning.params import ParamError
-from vplane_mj.planning.plugins import is_import_spec
+from vplane_mj.planning.protocol import registry
+from vplane_mj.planning.protocol.params import ParamError
+from vplane_mj.planning.protocol.plugins import is_import_spec
 from vplane_mj.robots.facts import robot_facts
 from vplane_mj.robots.profiles import PROFILES
 from vplane_mj.scenario.fields import (

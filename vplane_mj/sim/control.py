@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import math
 
-from vplane_mj.planning.body import DriveLimits
-from vplane_mj.planning.vectors import wrap_angle
+from vplane_mj.planning.protocol.body import DriveLimits
+from vplane_mj.planning.protocol.vectors import wrap_angle
 from vplane_mj.robots.profiles import ControllerGains
 
 

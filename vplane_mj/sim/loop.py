@@ -24,11 +24,11 @@ import mujoco
 import numpy as np
 
 from vplane_mj.errors import VPlaneError
-from vplane_mj.planning.events import Event, EventKind, point
 from vplane_mj.planning.perception.tracker import Track as TrackedObstacle
 from vplane_mj.planning.perception.tracker import Tracker
-from vplane_mj.planning.registry import make_planner
-from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.planning.protocol.events import Event, EventKind, point
+from vplane_mj.planning.protocol.registry import make_planner
+from vplane_mj.planning.protocol.types import Decision, Observation
 from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario import Scenario
 from vplane_mj.sim.control import heading_command, within_limits

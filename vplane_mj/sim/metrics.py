@@ -11,8 +11,8 @@ import numpy as np
 
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.reference import shortest_path_length
-from vplane_mj.planning.body import RobotBody
-from vplane_mj.planning.vectors import wrap_angle
+from vplane_mj.planning.protocol.body import RobotBody
+from vplane_mj.planning.protocol.vectors import wrap_angle
 from vplane_mj.scenario import Scenario
 
 CLEARANCE_BATCH = 200

@@ -23,9 +23,9 @@ from matplotlib.patches import Circle, Polygon
 from vplane_mj.geometry import shapes
 from vplane_mj.logs.reader import LogContents, iter_messages
 from vplane_mj.logs.writer import METADATA_NAME
-from vplane_mj.planning import fields
-from vplane_mj.planning.events import EventKind
-from vplane_mj.planning.groups import FieldParams
+from vplane_mj.planning.motion import fields
+from vplane_mj.planning.planners.groups import FieldParams
+from vplane_mj.planning.protocol.events import EventKind
 from vplane_mj.scenario import Scenario
 from vplane_mj.sim.loop import Track
 from vplane_mj.viz.render import MODE_RGBA, OTHER_MODE_RGBA

@@ -1,4 +1,4 @@
-"""Khatib's FIRAS attraction and repulsion, compiled (`vplane_mj.planning.fields`)."""
+"""Khatib's FIRAS attraction and repulsion, compiled (`vplane_mj.planning.motion.fields`)."""
 
 from __future__ import annotations
 

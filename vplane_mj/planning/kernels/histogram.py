@@ -1,4 +1,4 @@
-"""The VFH polar histogram, compiled (`vplane_mj.planning.histogram` describes it)."""
+"""The VFH polar histogram, compiled (`vplane_mj.planning.perception.histogram` describes it)."""
 
 from __future__ import annotations
 

@@ -16,7 +16,7 @@ nearest direction), or nearer than the band and marked (an echo clears it), or n
 yet seen (with `seen`); the bounds are wider than the rule by a margin, so rounding never drops
 a cell. The wedge's own bounds (the widest of its cones') are tested first: a cell no cone of
 the wedge can change is passed over before its direction is sought. Each cell taken is then
-judged by the map's rule (`vplane_mj.planning.localmap`), in the walk of the wedge that holds
+judged by the map's rule (`vplane_mj.planning.perception.localmap`), in the walk of the wedge that holds
 its own beam's cone alone (the wedges overlap at their margins; its own holds every cell the
 beam can change), so once: its beam is the nearest direction, and it must lie within half a
 beam width of that direction's axis; a cell within ARC_HALF_WIDTH cell of the range, along its

@@ -87,7 +87,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from vplane_mj.planning.params import PlannerParams, param
+from vplane_mj.planning.protocol.params import PlannerParams, param
 
 
 @dataclass(frozen=True)

@@ -40,16 +40,17 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from vplane_mj.planning import fields, gridsearch, scan
-from vplane_mj.planning.body import RobotBody
-from vplane_mj.planning.events import Event, EventKind, point
-from vplane_mj.planning.localmap import LocalMap, angular_extremes, mask_cells
-from vplane_mj.planning.motion import Steering
-from vplane_mj.planning.params import param, with_default
-from vplane_mj.planning.types import Decision, Observation
-from vplane_mj.planning.vectors import unit, wrap_angle
-from vplane_mj.planning.vplane import VPlaneParams, VPlanePlanner, escape_started, plane_created
-from vplane_mj.planning.vplane_geometry import VirtualPlane, make_plane, virtual_objective
+from vplane_mj.planning.motion import fields, gridsearch
+from vplane_mj.planning.motion.governor import Steering
+from vplane_mj.planning.perception import scan
+from vplane_mj.planning.perception.localmap import LocalMap, angular_extremes, mask_cells
+from vplane_mj.planning.planners.vplane import VPlaneParams, VPlanePlanner, escape_started, plane_created
+from vplane_mj.planning.planners.vplane_geometry import VirtualPlane, make_plane, virtual_objective
+from vplane_mj.planning.protocol.body import RobotBody
+from vplane_mj.planning.protocol.events import Event, EventKind, point
+from vplane_mj.planning.protocol.params import param, with_default
+from vplane_mj.planning.protocol.types import Decision, Observation
+from vplane_mj.planning.protocol.vectors import unit, wrap_angle
 
 CLOSE_ECHO_MARGIN_M = 0.1
 """An echo this close beyond the robot's disc (m) repels in full, even against the way."""

@@ -18,9 +18,9 @@ from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from typing import ClassVar, Self
 
-from vplane_mj.planning.body import RobotBody
-from vplane_mj.planning.params import PlannerInfo, PlannerParams
-from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.planning.protocol.body import RobotBody
+from vplane_mj.planning.protocol.params import PlannerInfo, PlannerParams
+from vplane_mj.planning.protocol.types import Decision, Observation
 
 
 class Planner(ABC):

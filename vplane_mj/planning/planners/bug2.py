@@ -17,13 +17,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning.base import Planner
-from vplane_mj.planning.body import RobotBody
-from vplane_mj.planning.events import Event, EventKind, point
-from vplane_mj.planning.groups import MotionParams
-from vplane_mj.planning.params import param
-from vplane_mj.planning.types import Decision, Observation
-from vplane_mj.planning.vectors import unit, wrap_angle
+from vplane_mj.planning.planners.groups import MotionParams
+from vplane_mj.planning.protocol.base import Planner
+from vplane_mj.planning.protocol.body import RobotBody
+from vplane_mj.planning.protocol.events import Event, EventKind, point
+from vplane_mj.planning.protocol.params import param
+from vplane_mj.planning.protocol.types import Decision, Observation
+from vplane_mj.planning.protocol.vectors import unit, wrap_angle
 
 AHEAD_HALF_ANGLE = math.radians(30.0)
 """Echoes within this angle of the goal direction count as ahead (hit and leave tests)."""

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vplane_mj.planning.types import Observation
+from vplane_mj.planning.protocol.types import Observation
 
 RING_SECTORS = 16
 """Sectors of the full circle a dense scan is reduced to (the default sonar ring's 22.5 deg)."""

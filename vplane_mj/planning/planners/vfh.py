@@ -20,15 +20,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning import histogram
-from vplane_mj.planning.base import Planner
-from vplane_mj.planning.body import RobotBody
-from vplane_mj.planning.groups import MinimumParams, MotionParams, SonarMapParams
-from vplane_mj.planning.minima import report_trap
-from vplane_mj.planning.motion import Steering
-from vplane_mj.planning.params import param
-from vplane_mj.planning.types import Decision, Observation
-from vplane_mj.planning.vectors import wrap_angle
+from vplane_mj.planning.motion.governor import Steering
+from vplane_mj.planning.perception import histogram
+from vplane_mj.planning.perception.minima import report_trap
+from vplane_mj.planning.planners.groups import MinimumParams, MotionParams, SonarMapParams
+from vplane_mj.planning.protocol.base import Planner
+from vplane_mj.planning.protocol.body import RobotBody
+from vplane_mj.planning.protocol.params import param
+from vplane_mj.planning.protocol.types import Decision, Observation
+from vplane_mj.planning.protocol.vectors import wrap_angle
 
 GOAL_WEIGHT, HEADING_WEIGHT, PREVIOUS_WEIGHT = 5.0, 2.0, 2.0
 """VFH+ cost weights (Ulrich and Borenstein, 1998)."""

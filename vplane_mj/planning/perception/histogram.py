@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning.localmap import LocalMap
+from vplane_mj.planning.perception.localmap import LocalMap
 
 
 @dataclass(frozen=True)

@@ -20,8 +20,8 @@ from pathlib import Path
 from types import ModuleType
 
 from vplane_mj.errors import VPlaneError
-from vplane_mj.planning.base import Planner
-from vplane_mj.planning.params import PARAM, PlannerParams
+from vplane_mj.planning.protocol.base import Planner
+from vplane_mj.planning.protocol.params import PARAM, PlannerParams
 
 NAME_PATTERN = re.compile(r"[a-z0-9_]+")
 MAX_NAME_LENGTH = 64

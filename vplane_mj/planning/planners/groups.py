@@ -15,14 +15,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning import fields, scan
-from vplane_mj.planning.body import RobotBody
-from vplane_mj.planning.evasion import Evasion
-from vplane_mj.planning.localmap import LocalMap
-from vplane_mj.planning.minima import LocalMinimumDetector
-from vplane_mj.planning.motion import Governor
-from vplane_mj.planning.params import PlannerParams, param
-from vplane_mj.planning.types import Observation
+from vplane_mj.planning.motion import fields
+from vplane_mj.planning.motion.evasion import Evasion
+from vplane_mj.planning.motion.governor import Governor
+from vplane_mj.planning.perception import scan
+from vplane_mj.planning.perception.localmap import LocalMap
+from vplane_mj.planning.perception.minima import LocalMinimumDetector
+from vplane_mj.planning.protocol.body import RobotBody
+from vplane_mj.planning.protocol.params import PlannerParams, param
+from vplane_mj.planning.protocol.types import Observation
 
 
 @dataclass(frozen=True)

@@ -41,10 +41,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from vplane_mj.planning.body import DriveLimits, RobotBody
-from vplane_mj.planning.evasion import Evasion
-from vplane_mj.planning.types import Observation
-from vplane_mj.planning.vectors import evenly_spaced, wrap_angle
+from vplane_mj.planning.motion.evasion import Evasion
+from vplane_mj.planning.protocol.body import DriveLimits, RobotBody
+from vplane_mj.planning.protocol.types import Observation
+from vplane_mj.planning.protocol.vectors import evenly_spaced, wrap_angle
 
 SHAPED_STOP_M = 0.1
 """A round robot whose braking distance from its top speed is at most this (m) is not governed."""

@@ -13,13 +13,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning import fields
-from vplane_mj.planning.base import Planner
-from vplane_mj.planning.body import RobotBody
-from vplane_mj.planning.events import Event, EventKind, point
-from vplane_mj.planning.groups import DetectorParams, FieldParams, MotionParams
-from vplane_mj.planning.params import param
-from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.planning.motion import fields
+from vplane_mj.planning.planners.groups import DetectorParams, FieldParams, MotionParams
+from vplane_mj.planning.protocol.base import Planner
+from vplane_mj.planning.protocol.body import RobotBody
+from vplane_mj.planning.protocol.events import Event, EventKind, point
+from vplane_mj.planning.protocol.params import param
+from vplane_mj.planning.protocol.types import Decision, Observation
 
 
 @dataclass(frozen=True)

@@ -47,7 +47,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning.beams import BeamFan
+from vplane_mj.planning.perception.beams import BeamFan
 from vplane_mj.planning.perception.tracker import Track, moving_tracks
 
 FORGET_MARGIN_M = 0.2

@@ -9,11 +9,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from vplane_mj.planning.base import Planner
-from vplane_mj.planning.body import RobotBody
-from vplane_mj.planning.groups import FieldParams, MinimumParams, MotionParams
-from vplane_mj.planning.minima import report_trap
-from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.planning.perception.minima import report_trap
+from vplane_mj.planning.planners.groups import FieldParams, MinimumParams, MotionParams
+from vplane_mj.planning.protocol.base import Planner
+from vplane_mj.planning.protocol.body import RobotBody
+from vplane_mj.planning.protocol.types import Decision, Observation
 
 
 @dataclass(frozen=True)

@@ -29,17 +29,23 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning import fields, histogram
-from vplane_mj.planning.base import Planner
-from vplane_mj.planning.body import RobotBody
-from vplane_mj.planning.events import Event, EventKind, point
-from vplane_mj.planning.groups import DetectorParams, FieldParams, MotionParams, SonarMapParams
-from vplane_mj.planning.localmap import angular_extremes
-from vplane_mj.planning.motion import Steering
-from vplane_mj.planning.params import param
-from vplane_mj.planning.types import Decision, Observation
-from vplane_mj.planning.vectors import unit
-from vplane_mj.planning.vplane_geometry import VirtualPlane, make_plane, plane_force, virtual_objective
+from vplane_mj.planning.motion import fields
+from vplane_mj.planning.motion.governor import Steering
+from vplane_mj.planning.perception import histogram
+from vplane_mj.planning.perception.localmap import angular_extremes
+from vplane_mj.planning.planners.groups import DetectorParams, FieldParams, MotionParams, SonarMapParams
+from vplane_mj.planning.planners.vplane_geometry import (
+    VirtualPlane,
+    make_plane,
+    plane_force,
+    virtual_objective,
+)
+from vplane_mj.planning.protocol.base import Planner
+from vplane_mj.planning.protocol.body import RobotBody
+from vplane_mj.planning.protocol.events import Event, EventKind, point
+from vplane_mj.planning.protocol.params import param
+from vplane_mj.planning.protocol.types import Decision, Observation
+from vplane_mj.planning.protocol.vectors import unit
 
 CONCAVITY_CHECK_PERIOD_S = 0.2
 """How often (s) the map is examined for a concave obstacle ahead (cheap checks run every tick)."""

@@ -17,10 +17,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from vplane_mj.errors import did_you_mean
-from vplane_mj.planning.base import Planner
-from vplane_mj.planning.body import RobotBody
-from vplane_mj.planning.params import PlannerInfo
-from vplane_mj.planning.plugins import PlannerError, canonical_spec, import_planner, planner_problem
+from vplane_mj.planning.protocol.base import Planner
+from vplane_mj.planning.protocol.body import RobotBody
+from vplane_mj.planning.protocol.params import PlannerInfo
+from vplane_mj.planning.protocol.plugins import PlannerError, canonical_spec, import_planner, planner_problem
 
 if TYPE_CHECKING:
     from importlib.metadata import EntryPoint
@@ -69,7 +69,7 @@ class _Planners(Mapping[str, type[Planner]]):
         if cls is None:
             if name in BUILT_IN:
                 module_name, class_name = BUILT_IN[name]
-                module = importlib.import_module(f"vplane_mj.planning.{module_name}")
+                module = importlib.import_module(f"vplane_mj.planning.planners.{module_name}")
                 cls = getattr(module, class_name)
             elif isinstance(name, str) and name in self.installed():
                 cls = _load_entry_point(self.installed()[name])

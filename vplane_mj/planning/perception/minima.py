@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning.events import Event, EventKind
-from vplane_mj.planning.types import Decision, Observation
+from vplane_mj.planning.protocol.events import Event, EventKind
+from vplane_mj.planning.protocol.types import Decision, Observation
 
 
 @dataclass(frozen=True)

@@ -82,16 +82,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning import gridsearch, scan
-from vplane_mj.planning.base import Planner
-from vplane_mj.planning.body import DriveLimits, HeadingGains, RobotBody
-from vplane_mj.planning.evasion import STEP_S
-from vplane_mj.planning.events import Event, EventKind
-from vplane_mj.planning.groups import EvasionParams, LocalMapParams, MinimumParams
-from vplane_mj.planning.minima import report_trap
-from vplane_mj.planning.params import param
-from vplane_mj.planning.types import Decision, Observation
-from vplane_mj.planning.vectors import evenly_spaced, wrap_angle
+from vplane_mj.planning.motion import gridsearch
+from vplane_mj.planning.motion.evasion import STEP_S
+from vplane_mj.planning.perception import scan
+from vplane_mj.planning.perception.minima import report_trap
+from vplane_mj.planning.planners.groups import EvasionParams, LocalMapParams, MinimumParams
+from vplane_mj.planning.protocol.base import Planner
+from vplane_mj.planning.protocol.body import DriveLimits, HeadingGains, RobotBody
+from vplane_mj.planning.protocol.events import Event, EventKind
+from vplane_mj.planning.protocol.params import param
+from vplane_mj.planning.protocol.types import Decision, Observation
+from vplane_mj.planning.protocol.vectors import evenly_spaced, wrap_angle
 
 MIN_LOOKAHEAD_M = 1.0
 """The shortest look-ahead (m) when `lookahead_m` is 0 (the default robot's, at 0.5 m/s)."""

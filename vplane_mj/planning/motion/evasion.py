@@ -29,8 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning.body import RobotBody
 from vplane_mj.planning.perception.tracker import Track, moving_tracks
+from vplane_mj.planning.protocol.body import RobotBody
 
 STEP_S = 0.1
 """Time step (s) of the check along a candidate's motion."""

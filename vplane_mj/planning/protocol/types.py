@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from vplane_mj.planning.events import Event
-from vplane_mj.planning.perception.tracker import Track
+from vplane_mj.planning.protocol.events import Event
+
+if TYPE_CHECKING:
+    from vplane_mj.planning.perception.tracker import Track
 
 
 @dataclass(frozen=True)

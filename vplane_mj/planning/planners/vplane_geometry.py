@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vplane_mj.planning.fields import MIN_DISTANCE_M
-from vplane_mj.planning.vectors import unit
+from vplane_mj.planning.motion.fields import MIN_DISTANCE_M
+from vplane_mj.planning.protocol.vectors import unit
 
 
 @dataclass(frozen=True)
