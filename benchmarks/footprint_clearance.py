@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from vplane_mj.planning.kernels.footprint_clearance import footprint_clearance
+from vplane_mj.kernels.motion.footprint_clearance import footprint_clearance
 from vplane_mj.planning.planners.dwa import DwaPlanner
 from vplane_mj.planning.protocol.types import Observation
 from vplane_mj.robots.facts import robot_body

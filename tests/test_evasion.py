@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj.planning.kernels import evasion as kernels
+from vplane_mj.kernels.motion import evasion as kernels
 from vplane_mj.planning.motion.evasion import Evasion
 from vplane_mj.planning.perception.tracker import Track
 from vplane_mj.planning.planners.groups import MotionParams

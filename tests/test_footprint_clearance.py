@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from vplane_mj.planning.kernels.footprint_clearance import footprint_clearance
+from vplane_mj.kernels.motion.footprint_clearance import footprint_clearance
 from vplane_mj.robots.facts import robot_body
 
 

@@ -10,8 +10,8 @@ import pytest
 
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.synthetic import BEAM, BEARINGS, LAYOUTS, scan
-from vplane_mj.planning.kernels import map_update
-from vplane_mj.planning.kernels.map_update import nearest_by_search, nearest_in_ring
+from vplane_mj.kernels.maps import map_update
+from vplane_mj.kernels.maps.map_update import nearest_by_search, nearest_in_ring
 from vplane_mj.planning.perception import beams
 from vplane_mj.planning.perception.localmap import LocalMap, angular_extremes
 
@@ -653,7 +653,7 @@ def test_an_arc_no_wider_than_a_cell_marks_beyond_the_hit_range():
 def test_the_compiled_distance_transform_equals_scipys_bit_for_bit(seed):
     from scipy import ndimage
 
-    from vplane_mj.planning.kernels.edt import distance_transform
+    from vplane_mj.kernels.maps.edt import distance_transform
 
     rng = np.random.default_rng(seed)
     for density in (0.002, 0.05, 0.5, 0.95):

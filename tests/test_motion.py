@@ -66,7 +66,7 @@ def test_the_free_turn_is_the_last_angle_before_any_point_comes_closer_than_it_m
 
 def _poses_by_numpy(drive: motion.DriveModel, command: tuple[float, float], hold_s: float) -> np.ndarray:
     """`DriveModel.poses` with numpy's `arange` and `interp` (the compiled one takes numba's)."""
-    from vplane_mj.planning.kernels import drive_model
+    from vplane_mj.kernels.motion import drive_model
 
     limits = drive.limits
     alpha, lag, brake = limits.max_turn_accel_radps2, limits.turn_lag_s, drive.braking(command)
@@ -247,7 +247,7 @@ def test_the_intrusion_is_the_largest_over_every_point_and_pose_of_the_distances
 def test_the_kernels_squares_decide_as_hypot_does_bit_for_bit():
     from numba import njit
 
-    from vplane_mj.planning.kernels import outline
+    from vplane_mj.kernels.motion import outline
 
     hypot = njit(lambda dx, dy: math.hypot(dx, dy))  # the compiled kernels' (the C library's)
     rng = np.random.default_rng(2)
@@ -426,7 +426,7 @@ def test_the_governor_remembers_what_its_laser_no_longer_sees_once_a_square():
 def test_the_memory_kernel_recalls_as_numpy_does(count, view):
     """Unseen points: within reach and out of view (numpy's arctan2, mod and hypot), given in
     the robot's frame; kept: the first of each memory square (numpy's unique), in order."""
-    from vplane_mj.planning.kernels import memory
+    from vplane_mj.kernels.motion import memory
 
     rng = np.random.default_rng(count)
     points = rng.uniform(-0.3, 0.3, (count, 2)) + rng.choice([0.0, -1e4, 5e3], (count, 1))
@@ -454,7 +454,7 @@ def test_points_on_the_edges_of_the_view_are_judged_by_the_angles_rule(yaw, low,
     """Points on, and a hair's breadth off, each edge of the view (and opposite them): in view
     exactly when their bearing past `low`, modulo a turn, is at most `span` (the C library's
     arctangent and Python's modulo, as the kernel takes them there)."""
-    from vplane_mj.planning.kernels import memory
+    from vplane_mj.kernels.motion import memory
 
     rng = np.random.default_rng(int(100 * span))
     hairs = np.array([0.0, 1e-15, -1e-15, 1e-12, -1e-12, 1e-9, -1e-9, 1e-7, -1e-7])

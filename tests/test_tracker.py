@@ -10,7 +10,7 @@ import pytest
 from scipy.optimize import least_squares, linear_sum_assignment
 
 from vplane_mj.geometry.shapes import Disc, Rect
-from vplane_mj.planning.kernels import tracking
+from vplane_mj.kernels import tracking
 from vplane_mj.planning.perception.tracker import Track, Tracker, TrackerParams, tracks_of
 from vplane_mj.sim.laser import RayCaster, laser_bearings
 

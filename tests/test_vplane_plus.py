@@ -221,7 +221,7 @@ def test_the_squared_distances_within_the_band_are_a_distance_transforms():
     gives it; beyond, some larger value below the bound."""
     from scipy import ndimage
 
-    from vplane_mj.planning.kernels.step_costs import near_squares, near_squares_bound
+    from vplane_mj.kernels.maps.step_costs import near_squares, near_squares_bound
 
     rng = np.random.default_rng(6)
     for _ in range(200):
@@ -311,7 +311,7 @@ def test_a_search_stopped_at_the_start_gives_the_same_costs_below_it_and_the_sam
 
 
 def test_the_way_ahead_is_blocked_where_numpys_distances_say():
-    from vplane_mj.planning.kernels import way as way_kernels
+    from vplane_mj.kernels.motion import way as way_kernels
 
     rng = np.random.default_rng(11)
     found = 0
@@ -336,7 +336,7 @@ def test_the_search_refuses_step_costs_that_are_not_positive():
 def test_line_of_sight_checks_linspaces_points_every_half_cell():
     """The compiled check against its definition: np.linspace's points, each on a free cell or
     outside the window; segments along a row, a column, and of no length among them."""
-    from vplane_mj.planning.kernels import way as way_kernels
+    from vplane_mj.kernels.motion import way as way_kernels
 
     rng = np.random.default_rng(3)
     for trial in range(3000):
@@ -359,7 +359,7 @@ def test_the_next_waypoint_is_the_farthest_in_sight_of_the_run_within_reach_past
     """The compiled choice against its definition: the nearest point (the first of equally near
     ones), the run of points after it within reach, the farthest of them the robot sees in a
     straight line (the nearest when none); every one seen without a window."""
-    from vplane_mj.planning.kernels import way as way_kernels
+    from vplane_mj.kernels.motion import way as way_kernels
     from vplane_mj.planning.planners import vplane_plus
 
     rng = np.random.default_rng(11)

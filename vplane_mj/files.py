@@ -30,6 +30,18 @@ _PACKAGE_DIR = Path(__file__).resolve().parent
 
 DEFAULT_OUT = Path("logs")
 """Where runs and sweeps write their files unless told otherwise."""
+CACHE_ENV = "VPLANE_MJ_CACHE"
+"""The environment variable that names the project's cache directory (`cache_dir`)."""
+
+
+def cache_dir() -> Path:
+    """The project's cache directory: the one VPLANE_MJ_CACHE names, else
+    `$XDG_CACHE_HOME/vplane-mj`, else `~/.cache/vplane-mj`."""
+    chosen = os.environ.get(CACHE_ENV)
+    if chosen:
+        return Path(chosen)
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "vplane-mj"
 
 
 def prepare_out_dir(path: Path) -> Path:

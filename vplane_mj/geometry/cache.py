@@ -22,16 +22,8 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
-CACHE_ENV = "VPLANE_MJ_CACHE"
-
-
-def cache_dir() -> Path:
-    """The cache's root directory (see the module docstring)."""
-    chosen = os.environ.get(CACHE_ENV)
-    if chosen:
-        return Path(chosen)
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "vplane-mj"
+from vplane_mj.files import CACHE_ENV as CACHE_ENV
+from vplane_mj.files import cache_dir
 
 
 def cached(namespace: str, key: dict[str, Any], compute: Callable[[], Any]) -> Any:

@@ -176,7 +176,7 @@ class MotionTable:
     def positions(self, run_time_s: float, out: np.ndarray | None = None) -> np.ndarray:
         """Every motion's position (count, 2; m) at run time `run_time_s` (s), written into
         `out` when given (any (count, >= 2) float array, a view into MuJoCo's mocap_pos say)."""
-        from vplane_mj.geometry import kernels  # numba: loaded by the first call
+        from vplane_mj.kernels import geometry as kernels  # numba: loaded by the first call
 
         if out is None:
             out = np.empty((self.count, 2))

@@ -86,7 +86,7 @@ class PathSimplifier:
     def _beyond_tolerance(self, held: int, point: tuple[float, float]) -> bool:
         """Whether a held-back position is farther than the tolerance from the edge from the
         last vertex to `point` (`kernels.beyond_tolerance`)."""
-        from vplane_mj.geometry import kernels  # numba: loaded by the first call
+        from vplane_mj.kernels import geometry as kernels  # numba: loaded by the first call
 
         ax, ay = self._vertices[-1]
         dx, dy = point[0] - ax, point[1] - ay

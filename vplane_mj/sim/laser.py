@@ -16,8 +16,8 @@ beam starting inside or on the boundary of a piece reads 0 m (the first point of
 the piece is its start). MuJoCo's ray caster differs there alone: from inside a geom it
 reads the distance to where the ray leaves it.
 
-Importing this module imports numba; its kernel compiles on first use and is cached on disk
-(`cache=True`), so later processes load it. `import vplane_mj` does not import numba.
+Importing this module imports numba (its kernels: `vplane_mj.kernels.laser`). `import vplane_mj`
+does not import numba.
 """
 
 from __future__ import annotations
@@ -26,16 +26,13 @@ import math
 from collections.abc import Callable, Sequence
 
 import numpy as np
-from numba import njit
 
 from vplane_mj.geometry.shapes import Disc, Footprints, Piece, Rect
+from vplane_mj.kernels.laser import cast_fan
 
 MOUNT_HEIGHT_M = 0.2
 """The laser's height above the floor (m) assumed when comparing with MuJoCo's 3D ray caster:
 any height strictly between the floor and the obstacles' tops (0.5 m) sees the same ranges."""
-SPAN_PAD_RAD = 1e-7
-"""Margin (rad) added on each side of a piece's angular extent before choosing the beams to
-test: a beam outside the padded extent misses the piece by far more than rounding."""
 TWO_PI = 2.0 * math.pi
 
 
@@ -85,7 +82,7 @@ class RayCaster:
         if moving is not None:
             discs = np.concatenate((discs, moving[0])) if len(discs) else moving[0]
             rects = np.concatenate((rects, moving[1])) if len(rects) else moving[1]
-        _cast_fan(discs, rects, ox, oy, float(first_angle), float(step), fan, float(range_max), ranges)
+        cast_fan(discs, rects, ox, oy, float(first_angle), float(step), fan, float(range_max), ranges)
         return ranges
 
     def _fan_offsets(self, step: float, beams: int) -> np.ndarray:
@@ -97,121 +94,6 @@ class RayCaster:
             self._fan = np.stack([np.cos(offsets), np.sin(offsets)])
             self._fan_key = (step, beams)
         return self._fan
-
-
-@njit(cache=True)
-def _beam_spans(lo: float, width: float, first: float, step: float, beams: int) -> tuple[int, int, int]:
-    """The beams whose angle lies in [lo, lo + width] (rad, width < 2 pi), as (a, m, w): the m
-    beams a .. a + m - 1, then the w beams 0 .. w - 1 where the interval wraps past the fan's
-    start a full turn later."""
-    start = (lo - first) % TWO_PI
-    # Clamped before rounding to integers, so a tiny step cannot overflow them.
-    a = math.ceil(min(start / step, beams))
-    m = max(0, math.floor(min((start + width) / step, beams - 1)) - a + 1)
-    w = 0
-    if start + width >= TWO_PI:
-        w = math.floor(min((start + width - TWO_PI) / step, beams - 1)) + 1
-    return a, m, w
-
-
-@njit(cache=True)
-def _disc_hit(dx: float, dy: float, outside: float, ux: float, uy: float) -> float:
-    """Distance along the unit direction (ux, uy) to a disc whose centre is at (dx, dy) from
-    the origin, which lies outside it (`outside` = |d|^2 - r^2 > 0); inf on a miss."""
-    along = dx * ux + dy * uy
-    if along <= 0.0:
-        return math.inf
-    discriminant = along * along - outside
-    if discriminant < 0.0:
-        return math.inf
-    return outside / (along + math.sqrt(discriminant))  # the nearer root, without cancellation
-
-
-@njit(cache=True)
-def _slab(p: float, v: float, half: float, lo: float, hi: float) -> tuple[float, float]:
-    """Narrow the ray's parameter interval [lo, hi] to the slab |p + t v| <= half."""
-    if v == 0.0:
-        if abs(p) > half:
-            return math.inf, -math.inf
-        return lo, hi
-    t1 = (-half - p) / v
-    t2 = (half - p) / v
-    return max(lo, min(t1, t2)), min(hi, max(t1, t2))
-
-
-@njit(cache=True)
-def _rect_hit(px: float, py: float, hx: float, hy: float, vx: float, vy: float) -> float:
-    """Distance along the unit direction (vx, vy) from (px, py) to the rectangle |x| <= hx,
-    |y| <= hy, everything in the rectangle's frame; inf on a miss."""
-    lo, hi = _slab(px, vx, hx, -math.inf, math.inf)
-    lo, hi = _slab(py, vy, hy, lo, hi)
-    if lo > hi or hi < 0.0:
-        return math.inf
-    return max(lo, 0.0)
-
-
-@njit(cache=True)
-def _cast_fan(
-    discs: np.ndarray,
-    rects: np.ndarray,
-    ox: float,
-    oy: float,
-    first: float,
-    step: float,
-    fan: np.ndarray,
-    range_max: float,
-    ranges: np.ndarray,
-) -> None:
-    """Fill `ranges` (beams,) with each beam's distance (m) to the nearest piece, inf beyond
-    `range_max`; all 0 when the origin lies inside or on a piece (see `RayCaster.cast`)."""
-    beams = ranges.shape[0]
-    cos_first, sin_first = math.cos(first), math.sin(first)
-    ux = cos_first * fan[0] - sin_first * fan[1]
-    uy = sin_first * fan[0] + cos_first * fan[1]
-    ranges[:] = math.inf
-    for i in range(discs.shape[0]):
-        dx, dy, radius = discs[i, 0] - ox, discs[i, 1] - oy, discs[i, 2]
-        distance = math.sqrt(dx * dx + dy * dy)
-        if distance - radius > range_max:
-            continue
-        if distance <= radius:
-            ranges[:] = 0.0
-            return
-        outside = dx * dx + dy * dy - radius * radius
-        half = math.asin(radius / distance) + SPAN_PAD_RAD
-        a, m, w = _beam_spans(math.atan2(dy, dx) - half, 2.0 * half, first, step, beams)
-        for j in range(m + w):
-            k = a + j if j < m else j - m
-            t = _disc_hit(dx, dy, outside, ux[k], uy[k])
-            if t <= range_max and t < ranges[k]:
-                ranges[k] = t
-    for i in range(rects.shape[0]):
-        cx, cy, hx, hy, cos_yaw, sin_yaw = rects[i]
-        # The origin in the rectangle's frame, and its distance to the rectangle.
-        px = cos_yaw * (ox - cx) + sin_yaw * (oy - cy)
-        py = -sin_yaw * (ox - cx) + cos_yaw * (oy - cy)
-        qx, qy = abs(px) - hx, abs(py) - hy
-        if qx <= 0.0 and qy <= 0.0:
-            ranges[:] = 0.0
-            return
-        if math.hypot(max(qx, 0.0), max(qy, 0.0)) > range_max:
-            continue
-        # Angular extent: the corners' angles about the direction to the centre (< pi apart).
-        lo, hi = math.inf, -math.inf
-        for sx in (-1.0, 1.0):
-            for sy in (-1.0, 1.0):
-                ex, ey = sx * hx - px, sy * hy - py
-                angle = math.atan2(-px * ey + py * ex, -px * ex - py * ey)
-                lo, hi = min(lo, angle), max(hi, angle)
-        centre = math.atan2(cy - oy, cx - ox)
-        a, m, w = _beam_spans(centre + lo - SPAN_PAD_RAD, hi - lo + 2.0 * SPAN_PAD_RAD, first, step, beams)
-        for j in range(m + w):
-            k = a + j if j < m else j - m
-            vx = cos_yaw * ux[k] + sin_yaw * uy[k]
-            vy = -sin_yaw * ux[k] + cos_yaw * uy[k]
-            t = _rect_hit(px, py, hx, hy, vx, vy)
-            if t <= range_max and t < ranges[k]:
-                ranges[k] = t
 
 
 def laser_bearings(fov_deg: float, beams: int) -> tuple[np.ndarray, float]:

@@ -119,7 +119,7 @@ class Evasion:
         the least room (m) over the horizon, the progress (m) toward the point `aim` (m, world)
         until then, the first command (m/s, rad/s), and the least room within NEAR_S
         (`kernels.evasion.candidate_risks`)."""
-        from vplane_mj.planning.kernels import evasion  # numba: loaded by the first call
+        from vplane_mj.kernels.motion import evasion  # numba: loaded by the first call
 
         limits = self.body.limits
         return evasion.candidate_risks(

@@ -22,7 +22,7 @@ def attractive_potential(position: np.ndarray, goal: np.ndarray, gain: float, ra
 
 def attractive_force(position: np.ndarray, goal: np.ndarray, gain: float, radius: float) -> np.ndarray:
     """Eq. 3: -grad of eq. 2: -2w d inside r, -2wr d/|d| beyond; zero at the goal."""
-    from vplane_mj.planning.kernels import fields  # numba: loaded by the first call
+    from vplane_mj.kernels.motion import fields  # numba: loaded by the first call
 
     return fields.attractive_force(
         float(position[0]), float(position[1]), float(goal[0]), float(goal[1]), float(gain), float(radius)
@@ -46,7 +46,7 @@ def repulsive_force(position: np.ndarray, points: np.ndarray, gain: float, influ
     `repulsive_potential`; it points away from every point within the influence distance.
     At a clamped distance the direction (x - x_obs)/f is still a unit vector or zero.
     """
-    from vplane_mj.planning.kernels import fields  # numba: loaded by the first call
+    from vplane_mj.kernels.motion import fields  # numba: loaded by the first call
 
     return fields.repulsive_force(
         np.asarray(position, float),

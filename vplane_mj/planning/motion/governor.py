@@ -99,7 +99,7 @@ def free_turn(body: RobotBody, local: np.ndarray, side: float, limit_rad: float,
     (robot frame, m) that it is not already that close to; `limit_rad` for a round robot."""
     if body.disc or limit_rad <= 0.0:
         return max(0.0, limit_rad)
-    from vplane_mj.planning.kernels import outline  # numba: loaded by the first call
+    from vplane_mj.kernels.motion import outline  # numba: loaded by the first call
 
     steps = max(1, math.ceil(limit_rad / TURN_STEP_RAD))
     angles = math.copysign(1.0, side) * evenly_spaced(0.0, limit_rad, steps + 1)
@@ -208,7 +208,7 @@ class DriveModel:
         omega^2 / 2 alpha); its slide across its heading fades at `braking`. Poses are kept
         where the robot has moved about SWEEP_STEP_M (m of travel plus rad of turn) since the
         last kept one; the first and last are always kept."""
-        from vplane_mj.planning.kernels import drive_model  # numba: loaded by the first call
+        from vplane_mj.kernels.motion import drive_model  # numba: loaded by the first call
 
         limits = self.limits
         brake = self.braking(command)
@@ -239,7 +239,7 @@ def intrusion(
     its turn), or for a point already closer, its distance now (a point already close does
     not freeze the robot, but it may come no closer). 0 when the motion keeps every point at
     its distance. With `enough` (m), any value above it once one is found (`kernels.outline`)."""
-    from vplane_mj.planning.kernels import outline  # numba: loaded by the first call
+    from vplane_mj.kernels.motion import outline  # numba: loaded by the first call
 
     footprint, normals = _outline(body)
     return outline.intrusion(
@@ -280,7 +280,7 @@ class SpeedPolicy:
         within the robot's circumscribed radius along the way do not count: the robot steers
         for points beyond its own outline; nor do points beyond `horizon_m` (m) along it
         (`kernels.way`)."""
-        from vplane_mj.planning.kernels import way as way_kernels  # numba: loaded by the first call
+        from vplane_mj.kernels.motion import way as way_kernels  # numba: loaded by the first call
 
         limits = self.body.limits
         rel = way - position
@@ -434,7 +434,7 @@ class Governor:
         wider each way; none for a sensor that looks all round), as behind a 270-degree laser;
         in the robot's frame (x forward, y left; m). Remembers `points` and those, one per
         MEMORY_CELL_M square, for the next ticks."""
-        from vplane_mj.planning.kernels import memory  # numba: loaded by the first call
+        from vplane_mj.kernels.motion import memory  # numba: loaded by the first call
 
         points = np.ascontiguousarray(points, float).reshape(-1, 2)
         x, y = float(obs.position[0]), float(obs.position[1])

@@ -40,7 +40,7 @@ def step_costs(
     than that to a `doubtful` one (a way through it is tried only when no other is known, and
     the sonar settles the doubt on the way); 1 + w ((lethal + inflation - d) / inflation)^2
     within `inflation_m` beyond the lethal distance of either kind; 1 farther."""
-    from vplane_mj.planning.kernels import step_costs as kernels  # numba: loaded by the first call
+    from vplane_mj.kernels.maps import step_costs as kernels  # numba: loaded by the first call
 
     sure, doubtful = np.ascontiguousarray(sure, bool), np.ascontiguousarray(doubtful, bool)
     rule = (float(cell_m), float(lethal_m), float(inflation_m), float(inflation_weight), float(doubt_cost))
@@ -171,7 +171,7 @@ def cost_to_go(
     cell's cost: the cells cheaper than it have theirs (all that a descent from it reads),
     the others an upper bound or inf.
     """
-    from vplane_mj.planning.kernels import grid_dijkstra  # numba: loaded by the first call
+    from vplane_mj.kernels.maps import grid_dijkstra  # numba: loaded by the first call
 
     targets = np.asarray(targets, dtype=np.int64).ravel()
     keep = np.isfinite(np.ravel(cost)[targets])
@@ -204,7 +204,7 @@ def way_exists(window: Window, start: np.ndarray, end: np.ndarray, radius_m: flo
     """Whether `way_to` finds a way (the window made passable around the end as it does): the
     start's cell joined to a target by the same moves, found by a flood fill instead of the
     search for the cheapest."""
-    from vplane_mj.planning.kernels import grid_dijkstra  # numba: loaded by the first call
+    from vplane_mj.kernels.maps import grid_dijkstra  # numba: loaded by the first call
 
     ends = _ends(window, start, end, radius_m)
     if ends is None:
@@ -242,7 +242,7 @@ def descend(costs: np.ndarray, start: tuple[int, int], max_cells: int) -> np.nda
     """The cells (K, 2: i, j) from `start` down the cost to the target (steepest descent over 8
     neighbours), at most `max_cells` steps; just `start` when it has no finite cost
     (`kernels.grid_dijkstra`)."""
-    from vplane_mj.planning.kernels import grid_dijkstra  # numba: loaded by the first call
+    from vplane_mj.kernels.maps import grid_dijkstra  # numba: loaded by the first call
 
     costs = np.ascontiguousarray(costs, float)
     return grid_dijkstra.descend(costs, int(start[0]), int(start[1]), int(max_cells))

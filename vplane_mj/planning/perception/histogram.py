@@ -35,7 +35,7 @@ def polar_histogram(
     enlarge_m: float,
 ) -> np.ndarray:
     """Obstacle density per sector (n_sectors,) around `origin` from map cells (N, 2)."""
-    from vplane_mj.planning.kernels import histogram  # numba: loaded by the first call
+    from vplane_mj.kernels.maps import histogram  # numba: loaded by the first call
 
     return histogram.polar_histogram(
         np.asarray(origin, float),
@@ -57,7 +57,7 @@ def map_histogram(
 ) -> tuple[np.ndarray, int]:
     """`polar_histogram` of the map cells at or above `min_certainty` in the square around `origin`
     that holds the window (`LocalMap.cells`), and how many such cells the square holds."""
-    from vplane_mj.planning.kernels import histogram  # numba: loaded by the first call
+    from vplane_mj.kernels.maps import histogram  # numba: loaded by the first call
 
     if local_map.origin is None:
         return np.zeros(n_sectors), 0

@@ -71,7 +71,7 @@ class LocalMap:
         track_seen: bool = False,
         silent_free_m: float = 0.0,
     ):
-        from vplane_mj.planning.kernels import grid, map_update  # numba: loaded by the first map a run makes
+        from vplane_mj.kernels.maps import grid, map_update  # numba: loaded by the first map a run makes
 
         self._fold_scan = map_update.fold_scan
         self._cells_near, self._nearest_cell = grid.cells_near, grid.nearest_cell
@@ -267,7 +267,7 @@ class LocalMap:
         if free.all():  # farther than any cell of the map could be
             values = np.full(free.shape, 2.0 * self.n * self.cell_m)
         else:
-            from vplane_mj.planning.kernels.edt import distance_transform  # numba: loaded by the first call
+            from vplane_mj.kernels.maps.edt import distance_transform  # numba: loaded by the first call
 
             values = distance_transform(free) * self.cell_m
         return ClearanceField(values, origin + np.array(lo), self.cell_m)
@@ -313,7 +313,7 @@ class ClearanceField:
     def at(self, points: np.ndarray) -> np.ndarray:
         """The distance at world points (N, 2), bilinear between the cell centres; points beyond
         the outermost centres take the border's values (`kernels.arcs`)."""
-        from vplane_mj.planning.kernels import arcs  # numba: loaded by the first call
+        from vplane_mj.kernels.motion import arcs  # numba: loaded by the first call
 
         points = np.ascontiguousarray(points, float).reshape(-1, 2)
         first_i, first_j = float(self.first_cell[0]), float(self.first_cell[1])

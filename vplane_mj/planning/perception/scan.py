@@ -42,7 +42,7 @@ def repulsion_points(obs: Observation) -> np.ndarray:
 def _nearest_per_sector(obs: Observation) -> np.ndarray:
     """The nearest echo of each sector k (bearings within half a sector of k 2 pi / RING_SECTORS,
     robot frame), in world coordinates; sectors without an echo give none (`kernels.points`)."""
-    from vplane_mj.planning.kernels import points  # numba: loaded by the first call
+    from vplane_mj.kernels.maps import points  # numba: loaded by the first call
 
     return points.nearest_per_sector(
         np.asarray(obs.position, float),

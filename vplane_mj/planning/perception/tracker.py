@@ -366,7 +366,7 @@ class Tracker:
     """
 
     def __init__(self, params: TrackerParams | None = None):
-        from vplane_mj.planning.kernels import tracking  # numba: loaded by the first tracker made
+        from vplane_mj.kernels import tracking  # numba: loaded by the first tracker made
 
         self._k = tracking
         self.params = p = params if params is not None else TrackerParams()

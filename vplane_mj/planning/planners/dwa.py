@@ -208,7 +208,7 @@ def arc_poses(
     """Points (..., 2) and headings (...) after travelling `travel` (m) along a circle while
     turning by `turn` (rad), from `position` at `yaw` (a straight line when turn = 0;
     `kernels.arcs`)."""
-    from vplane_mj.planning.kernels import arcs  # numba: loaded by the first call
+    from vplane_mj.kernels.motion import arcs  # numba: loaded by the first call
 
     shape = np.broadcast_shapes(np.shape(travel), np.shape(turn))
     travels, turns = np.empty(shape), np.empty(shape)
@@ -272,7 +272,7 @@ class DwaPlanner(Planner):
             # between two: a corner passing a cell centre at d comes at most
             # sqrt(d^2 + (cell / 4)^2) - d closer between them (6 mm at d = 5 cm).
             self.step_m = p.map_cell_m / 2
-            from vplane_mj.planning.kernels.footprint_clearance import footprint_clearance  # imports numba
+            from vplane_mj.kernels.motion.footprint_clearance import footprint_clearance  # imports numba
 
             self.footprint_clearance = footprint_clearance
         self.smooth_speeds = smoothing_matrix(p.speed_samples, p.smoothing)
@@ -342,7 +342,7 @@ class DwaPlanner(Planner):
         dist = np.full((len(speeds), len(turns)), self.lookahead)
         if not threat:
             return dist
-        from vplane_mj.planning.kernels import evasion  # numba: loaded by the first call
+        from vplane_mj.kernels.motion import evasion  # numba: loaded by the first call
 
         commands = np.stack(np.broadcast_arrays(speeds[:, None], turns[None, :]), axis=-1).reshape(-1, 2)
         hits = evasion.arc_hits(
@@ -392,7 +392,7 @@ class DwaPlanner(Planner):
         moving = speeds > 0  # a turn on the spot sweeps nothing the disc does not already cover
         if not moving.any():
             return dist
-        from vplane_mj.planning.kernels import arcs  # numba: loaded by the first call
+        from vplane_mj.kernels.motion import arcs  # numba: loaded by the first call
 
         curvature = turns / speeds[moving, None]
         safe = self.radius + p.margin_m
@@ -558,7 +558,7 @@ class DwaPlanner(Planner):
     ) -> np.ndarray:
         """alpha heading + beta dist + gamma velocity (speeds, turns), each term in [0, 1]; the
         heading toward `aim` (m)."""
-        from vplane_mj.planning.kernels import arcs  # numba: loaded by the first call
+        from vplane_mj.kernels.motion import arcs  # numba: loaded by the first call
 
         p, limits = self.params, self.limits
         travel = speeds * self.period + speeds**2 / (2 * limits.max_accel_mps2)

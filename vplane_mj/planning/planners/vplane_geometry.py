@@ -145,7 +145,7 @@ def plane_force(
     hardest. A tangential part `slide_gain` times as large moves the robot along the plane
     toward the end with the shorter way to the goal, so a head-on approach cannot stall.
     """
-    from vplane_mj.planning.kernels import fields  # numba: loaded by the first call
+    from vplane_mj.kernels.motion import fields  # numba: loaded by the first call
 
     along, out = plane.frame_coordinates(robot)
     return fields.plane_force(

@@ -359,7 +359,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         """Whether a mapped obstacle cell now lies within the robot's half width of the way's next
         `BLOCK_LOOKAHEAD_M` (the sonar has seen something new on it): the robot drives along the
         way aligned with it."""
-        from vplane_mj.planning.kernels import way as way_kernels  # numba: loaded by the first call
+        from vplane_mj.kernels.motion import way as way_kernels  # numba: loaded by the first call
 
         if not len(way):
             return False
@@ -505,7 +505,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         """The paper's objective if the map has seen it free, clear of obstacles and reachable,
         else the nearest such cell outside the trap; with the map's way there. (None, NO_WAY) when
         there is none."""
-        from vplane_mj.planning.kernels.edt import distance_transform  # numba: loaded by the first call
+        from vplane_mj.kernels.maps.edt import distance_transform  # numba: loaded by the first call
 
         start = window.free_cell_near(robot, 2 * self.radius)
         if start is None:
@@ -719,7 +719,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         """The farthest point of the way (K, 2; m) within `waypoint_m` that the robot sees in a
         straight line on the map (the way's end when the way is empty), and the way without the
         points before the one nearest the robot: the robot has passed them."""
-        from vplane_mj.planning.kernels import way as way_kernels  # numba: loaded by the first call
+        from vplane_mj.kernels.motion import way as way_kernels  # numba: loaded by the first call
 
         if not len(way):
             return end, way

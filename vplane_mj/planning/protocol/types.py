@@ -77,7 +77,7 @@ class Observation:
         """The world-frame points of `ranges`' echoes, cached under `key`."""
         points = self.__dict__.get(key)
         if points is None:
-            from vplane_mj.planning.kernels import points as compiled  # numba: loaded by the first call
+            from vplane_mj.kernels.maps import points as compiled  # numba: loaded by the first call
 
             points = compiled.echo_points(
                 np.asarray(self.position, float),

@@ -5,10 +5,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from vplane_mj.kernels import njit
 
 
-@njit(cache=True)
+@njit
 def repulsive_force(
     position: np.ndarray, points: np.ndarray, gain: float, influence: float, min_distance: float
 ) -> np.ndarray:
@@ -25,7 +26,7 @@ def repulsive_force(
     return force
 
 
-@njit(cache=True)
+@njit
 def attractive_force(
     x: float, y: float, goal_x: float, goal_y: float, gain: float, radius: float
 ) -> np.ndarray:
@@ -42,7 +43,7 @@ def attractive_force(
     return force
 
 
-@njit(cache=True)
+@njit
 def plane_force(
     along: float,
     out: float,

@@ -15,12 +15,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from vplane_mj.kernels import njit
 
 _STEPS = np.array([[-1, -1], [-1, 0], [-1, 1], [0, -1], [0, 1], [1, -1], [1, 0], [1, 1]])
 
 
-@njit(cache=True)
+@njit
 def cost_to_go(
     cost: np.ndarray, targets: np.ndarray, target_costs: np.ndarray, cell_m: float, stop: int
 ) -> np.ndarray:
@@ -100,7 +101,7 @@ def cost_to_go(
     return dist.reshape(nx + 2, wide)[1:-1, 1:-1].copy()
 
 
-@njit(cache=True)
+@njit
 def _framed(cost):
     """The step costs (nx, ny) framed by a blocked cell each side, flat ((nx + 2) (ny + 2)), so
     that no move needs a bounds check; and the least and the largest finite step cost."""
@@ -116,7 +117,7 @@ def _framed(cost):
     return step, least, most
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _push(head, after, cells, keys, used, cell, key, width):
     """Queue `cell` at `key` in its bucket (entry `used`, put before the bucket's others); the
     entries used now."""
@@ -126,7 +127,7 @@ def _push(head, after, cells, keys, used, cell, key, width):
     return used + 1
 
 
-@njit(cache=True)
+@njit
 def descend(costs: np.ndarray, i: int, j: int, max_cells: int) -> np.ndarray:
     """The cells (K, 2) from (i, j) down `costs` to the target: from each cell to its cheapest
     neighbour (the first of the 8 in `_STEPS`' order among equals) while that one is cheaper,
@@ -152,7 +153,7 @@ def descend(costs: np.ndarray, i: int, j: int, max_cells: int) -> np.ndarray:
     return path[:count]
 
 
-@njit(cache=True)
+@njit
 def reaches(cost: np.ndarray, targets: np.ndarray, start: int) -> bool:
     """Whether the cell `start` (a flat index of a free cell of `cost`, nx x ny, inf blocked) is
     joined to one of the free `targets` (flat indices) by `cost_to_go`'s moves: its cost there

@@ -17,22 +17,23 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from vplane_mj.kernels import njit
 
 
-@njit(cache=True)
+@njit
 def _toward(value: float, target: float, step: float) -> float:
     """`value` moved toward `target` by at most `step`."""
     return value + min(max(target - value, -step), step)
 
 
-@njit(cache=True)
+@njit
 def _wrap(angle: float) -> float:
     """`angle` (rad) wrapped into [-pi, pi)."""
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
-@njit(cache=True)
+@njit
 def _outline_gap(outline: np.ndarray, px: float, py: float) -> float:
     """Signed distance (m) from the point (px, py) (robot frame) to the convex counter-clockwise
     `outline` (k, 2): negative inside."""
@@ -52,7 +53,7 @@ def _outline_gap(outline: np.ndarray, px: float, py: float) -> float:
     return best if outside else -best
 
 
-@njit(cache=True)
+@njit
 def candidate_risks(
     candidates: np.ndarray,
     pose: tuple[float, float, float],
@@ -131,7 +132,7 @@ def candidate_risks(
     return result
 
 
-@njit(cache=True)
+@njit
 def arc_hits(
     commands: np.ndarray,
     pose: tuple[float, float, float],

@@ -15,10 +15,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from vplane_mj.kernels import njit
 
 
-@njit(cache=True)
+@njit
 def step_costs(
     sure: np.ndarray, doubtful: np.ndarray, rule: tuple[float, float, float, float, float]
 ) -> np.ndarray:
@@ -52,7 +53,7 @@ def step_costs(
     return cost
 
 
-@njit(cache=True)
+@njit
 def _cost_of_square(square: int, rule: tuple[float, float, float, float, float]) -> float:
     """The step cost of a cell `square` squared cells from the nearest obstacle cell (of either
     kind): numpy's element-wise arithmetic on scipy's distance, bit for bit."""
@@ -62,7 +63,7 @@ def _cost_of_square(square: int, rule: tuple[float, float, float, float, float])
     return 1.0 + (inflation_weight * (closeness * closeness) + (doubt_cost if d_m < lethal_m else 0.0))
 
 
-@njit(cache=True)
+@njit
 def _row_costs(cost, near, near_sure, costs, lethal_square):
     """One row of step costs from its squared distances to the nearest obstacle cell (`near`)
     and sure one (`near_sure`): `costs` of the first, inf below `lethal_square` of the second."""
@@ -73,7 +74,7 @@ def _row_costs(cost, near, near_sure, costs, lethal_square):
             cost[j] = np.inf
 
 
-@njit(cache=True)
+@njit
 def near_squares(blocked: np.ndarray, band: int) -> np.ndarray:
     """Squared distance (cells^2; nx, ny int32) from each cell to the nearest `blocked` cell (nx,
     ny uint8, 1: blocked), exact where it is at most band^2, some larger value below
@@ -94,13 +95,13 @@ def near_squares(blocked: np.ndarray, band: int) -> np.ndarray:
     return near
 
 
-@njit(cache=True)
+@njit
 def near_squares_bound(band: int) -> int:
     """One more than the largest value of `near_squares` for `band`."""
     return (band + 1) ** 2 + band * band + 1
 
 
-@njit(cache=True)
+@njit
 def _either(out, a, b):
     """out = a | b (uint8 rows); whether `a` holds a 1."""
     found = 0
@@ -110,7 +111,7 @@ def _either(out, a, b):
     return found
 
 
-@njit(cache=True)
+@njit
 def _any(row):
     """Whether a uint8 row holds a 1."""
     found = 0
@@ -119,35 +120,35 @@ def _any(row):
     return found
 
 
-@njit(cache=True)
+@njit
 def _column_start(column, blocked, beyond):
     """The first row of the column distances: 0 on blocked cells, `beyond` elsewhere."""
     for j in range(column.size):
         column[j] = beyond * (blocked[j] ^ 1)
 
 
-@njit(cache=True)
+@njit
 def _column_down(column, above, blocked, beyond):
     """A row of the column distances from the row above (looking up the columns only)."""
     for j in range(column.size):
         column[j] = min(above[j] + 1, beyond) * (blocked[j] ^ 1)
 
 
-@njit(cache=True)
+@njit
 def _column_up(column, below):
     """A row of the column distances, the row below taken into account."""
     for j in range(column.size):
         column[j] = min(column[j], below[j] + 1)
 
 
-@njit(cache=True)
+@njit
 def _squared(out, values):
     """out = values^2."""
     for j in range(out.size):
         out[j] = values[j] * values[j]
 
 
-@njit(cache=True)
+@njit
 def _row_least(near, squares, band):
     """near[j] = the least squares[j + k] + k^2 over |k| <= `band`, one shift k at a time."""
     count = near.size

@@ -5,10 +5,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from vplane_mj.kernels import njit
 
 
-@njit(cache=True)
+@njit
 def echo_points(position: np.ndarray, yaw: float, bearings: np.ndarray, ranges: np.ndarray) -> np.ndarray:
     """World points (N, 2; m) of the finite `ranges` (m) along `bearings` (rad, robot frame) from
     `position` (m) at `yaw` (rad), in the beams' order: position + r (cos(yaw + b), sin(yaw + b))."""
@@ -28,7 +29,7 @@ def echo_points(position: np.ndarray, yaw: float, bearings: np.ndarray, ranges: 
     return points
 
 
-@njit(cache=True)
+@njit
 def nearest_per_sector(
     position: np.ndarray, yaw: float, bearings: np.ndarray, ranges: np.ndarray, sectors: int
 ) -> np.ndarray:

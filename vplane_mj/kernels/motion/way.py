@@ -7,14 +7,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-from vplane_mj.planning.kernels.outline import closer
+from vplane_mj.kernels import njit
+from vplane_mj.kernels.motion.outline import closer
 
 TURN = 2 * math.pi
 
 
-@njit(cache=True)
+@njit
 def bend_speed(
     x: float,
     y: float,
@@ -49,7 +49,7 @@ def bend_speed(
     return min(top, slowest)
 
 
-@njit(cache=True)
+@njit
 def blocked(x: float, y: float, way: np.ndarray, reach_m: float, cells: np.ndarray, gap_m: float) -> bool:
     """Whether one of `cells` (N, 2; m) lies closer than `gap_m` (m) to a point of `way` (K, 2;
     m) within `reach_m` of `x`, `y` (m)."""
@@ -62,7 +62,7 @@ def blocked(x: float, y: float, way: np.ndarray, reach_m: float, cells: np.ndarr
     return False
 
 
-@njit(cache=True)
+@njit
 def next_waypoint(x: float, y: float, way: np.ndarray, reach_m: float, sight: tuple) -> tuple[int, int]:
     """For the robot at `x`, `y` (m) on `way` (K >= 1, 2; m): the index of the way's point
     nearest it (the first of equally near ones), and of the farthest point of the run that
@@ -85,7 +85,7 @@ def next_waypoint(x: float, y: float, way: np.ndarray, reach_m: float, sight: tu
     return nearest, nearest
 
 
-@njit(cache=True)
+@njit
 def segment_free(sight: tuple, ax: float, ay: float, bx: float, by: float) -> bool:
     """Whether the points every half cell from a to b (m; `np.linspace`'s points, bit for bit,
     max(2, ceil(2 |b - a| / cell_m) + 1) of them) all lie on finite cells of a window's step

@@ -7,13 +7,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-from vplane_mj.planning.kernels.map_update import remainder_of_turn, side_of, sure_off_line
-from vplane_mj.planning.kernels.outline import closer
+from vplane_mj.kernels import njit
+from vplane_mj.kernels.maps.map_update import remainder_of_turn, side_of, sure_off_line
+from vplane_mj.kernels.motion.outline import closer
 
 
-@njit(cache=True)
+@njit
 def recall(
     points: np.ndarray,
     remembered: np.ndarray,
@@ -52,7 +52,7 @@ def recall(
     return local, known[_first_in_each_cell(known, cell_m)]
 
 
-@njit(cache=True)
+@njit
 def _in_view(rel_x, rel_y, yaw, low, span, edges):
     """Whether the point (`rel_x`, `rel_y`; m from the robot) is in view: its bearing past `low`
     (rad, robot frame; the robot heading `yaw`), modulo a turn, at most `span`. Decided by which
@@ -70,7 +70,7 @@ def _in_view(rel_x, rel_y, yaw, low, span, edges):
     return remainder_of_turn(math.atan2(rel_y, rel_x) - yaw - low) <= span
 
 
-@njit(cache=True)
+@njit
 def _first_in_each_cell(points: np.ndarray, cell_m: float) -> np.ndarray:
     """Indices (ascending) of the first of `points` (N, 2; m) in each square cell of `cell_m`:
     what `np.unique` of the cells' keys with `return_index` gives, sorted, by one pass with a

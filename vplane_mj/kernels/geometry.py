@@ -4,10 +4,11 @@ moving obstacles' positions (`motion.MotionTable`)."""
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from vplane_mj.kernels import njit
 
 
-@njit(cache=True)
+@njit
 def beyond_tolerance(
     rel_x: np.ndarray, rel_y: np.ndarray, held: int, dx: float, dy: float, tolerance2: float
 ) -> bool:
@@ -25,7 +26,7 @@ def beyond_tolerance(
     return False
 
 
-@njit(cache=True)
+@njit
 def motion_positions(
     run_time_s: float,
     starts: np.ndarray,

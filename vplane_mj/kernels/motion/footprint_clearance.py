@@ -10,7 +10,8 @@ kernel: per pose it visits only the cells within reach of the footprint's circum
 (the points binned by the cell that holds them), and skips those that cannot come closer
 than the best so far.
 
-Importing this module imports numba; the kernel compiles on first use and is cached on disk.
+Importing this module imports numba; the kernel compiles on first use and is cached on disk
+(`vplane_mj.kernels`).
 """
 
 from __future__ import annotations
@@ -18,7 +19,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from vplane_mj.kernels import njit
 
 RING_MARGIN_M = 1e-9
 """How much nearer (m) than its cells' bound a ring of cells is taken to be, so that rounding
@@ -83,7 +85,7 @@ def _bin_points(
     return starts, np.ascontiguousarray(points[inside][order])
 
 
-@njit(cache=True)
+@njit
 def _signed_distance(polygon: np.ndarray, px: float, py: float) -> float:
     """Signed distance (m) from the point (px, py) to the convex counter-clockwise polygon:
     negative inside."""
@@ -103,7 +105,7 @@ def _signed_distance(polygon: np.ndarray, px: float, py: float) -> float:
     return -distance if inside else distance
 
 
-@njit(cache=True)
+@njit
 def _may_be_nearer(radius: float, dx: float, dy: float, best: float) -> bool:
     """Whether an obstacle at (dx, dy) (m) from a pose may lie nearer than `best` to the
     footprint: one at r from the pose is at least r - radius (the circumscribed radius) from
@@ -113,7 +115,7 @@ def _may_be_nearer(radius: float, dx: float, dy: float, best: float) -> bool:
     return bound > 0.0 and dx * dx + dy * dy < bound * bound
 
 
-@njit(cache=True)
+@njit
 def _clearances(
     occupied: np.ndarray,
     starts: np.ndarray,

@@ -6,10 +6,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from vplane_mj.kernels import njit
 
 
-@njit(cache=True)
+@njit
 def ramp_at(start: float, phases: np.ndarray, time_s: float) -> float:
     """A ramped drive's speed (or turn rate) at `time_s` (s from now): from `start` it moves
     toward each phase's target at the phase's rate (per s) for its duration (s), in turn
@@ -26,7 +27,7 @@ def ramp_at(start: float, phases: np.ndarray, time_s: float) -> float:
     return value
 
 
-@njit(cache=True)
+@njit
 def command_poses(
     command: tuple[float, float],
     hold_s: float,
@@ -61,7 +62,7 @@ def command_poses(
     return predicted_poses(t, start[0], speeds, start[1], turns, lag_s, late_turns, start[2], brake, steps[1])
 
 
-@njit(cache=True)
+@njit
 def predicted_poses(
     t: np.ndarray,
     speed: float,

@@ -10,10 +10,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from vplane_mj.kernels import njit
 
 
-@njit(cache=True)
+@njit
 def distance_transform(free: np.ndarray) -> np.ndarray:
     """Distance (cells) from each cell of `free` (nx, ny bool) to the nearest cell that is not
     free (0 on those); inf everywhere when every cell is free."""
@@ -58,14 +59,14 @@ def distance_transform(free: np.ndarray) -> np.ndarray:
     return out
 
 
-@njit(cache=True)
+@njit
 def _height(x, apex, g_apex):
     """The squared distance (cells^2) from column x of a row to the nearest non-free cell of
     column `apex` (its distance `g_apex` along the column)."""
     return (x - apex) * (x - apex) + g_apex * g_apex
 
 
-@njit(cache=True)
+@njit
 def _separation(a, b, g_a, g_b):
     """The last column (a < b) at which the parabola of `a` (its column's distance `g_a`) is at
     most that of `b` (`g_b`)."""

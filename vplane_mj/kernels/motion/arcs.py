@@ -6,10 +6,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from vplane_mj.kernels import njit
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _arc_point(x0: float, y0: float, cos_yaw: float, sin_yaw: float, travel: float, turn: float) -> tuple:
     """The point (m) after travelling `travel` (m) along a circle while turning by `turn` (rad)
     from (x0, y0) heading (cos_yaw, sin_yaw): the chord 2 sin(turn / 2) / curvature (the travel
@@ -23,7 +24,7 @@ def _arc_point(x0: float, y0: float, cos_yaw: float, sin_yaw: float, travel: flo
     )
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _bilinear_at(values: np.ndarray, first_i: float, first_j: float, cell_m: float, x: float, y: float):
     """`values` at the world point (x, y) (m); see `bilinear`."""
     rows, cols = values.shape
@@ -38,7 +39,7 @@ def _bilinear_at(values: np.ndarray, first_i: float, first_j: float, cell_m: flo
     return below + (above - below) * fy
 
 
-@njit(cache=True)
+@njit
 def arc_points(x0: float, y0: float, yaw: float, travel: np.ndarray, turn: np.ndarray) -> np.ndarray:
     """Points (N, 2; m) after travelling `travel` (N,; m) along a circle while turning by `turn`
     (N,; rad) from (x0, y0) at `yaw` (rad) (`_arc_point`)."""
@@ -49,7 +50,7 @@ def arc_points(x0: float, y0: float, yaw: float, travel: np.ndarray, turn: np.nd
     return out
 
 
-@njit(cache=True)
+@njit
 def bilinear(
     values: np.ndarray, first_i: float, first_j: float, cell_m: float, points: np.ndarray
 ) -> np.ndarray:
@@ -62,7 +63,7 @@ def bilinear(
     return out
 
 
-@njit(cache=True)
+@njit
 def first_hits(
     x0: float,
     y0: float,
@@ -99,7 +100,7 @@ def first_hits(
     return first
 
 
-@njit(cache=True)
+@njit
 def objective(
     x0: float,
     y0: float,

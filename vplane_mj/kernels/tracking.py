@@ -22,7 +22,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from vplane_mj.kernels import njit
 
 END_CLEAR = 0
 """A cluster's end is a silhouette: beyond it nothing echoes, or only what lies well behind."""
@@ -53,13 +54,13 @@ took."""
 INFO_COLUMNS = 11
 
 
-@njit(cache=True)
+@njit
 def _echo(r: float) -> bool:
     """Whether a range (m) is an echo: finite and positive (NaN: none)."""
     return math.isfinite(r) and r > 0.0
 
 
-@njit(cache=True)
+@njit
 def joined(
     range_a: float,
     range_b: float,
@@ -81,7 +82,7 @@ def joined(
     return gap2 <= limit * limit
 
 
-@njit(cache=True)
+@njit
 def _breaks(
     bearings: np.ndarray,
     ranges: np.ndarray,
@@ -114,7 +115,7 @@ def _breaks(
     return breaks
 
 
-@njit(cache=True)
+@njit
 def _end_code(
     ranges: np.ndarray, end: int, other: int, missing: int, max_missing: int, depth_m: float
 ) -> int:
@@ -127,7 +128,7 @@ def _end_code(
     return END_CLEAR if ranges[other] > ranges[end] + depth_m else END_BLOCKED
 
 
-@njit(cache=True)
+@njit
 def _ends(
     ranges: np.ndarray,
     echoes: np.ndarray,
@@ -160,7 +161,7 @@ def _ends(
     return ends
 
 
-@njit(cache=True)
+@njit
 def segment(
     bearings: np.ndarray,
     ranges: np.ndarray,
@@ -210,7 +211,7 @@ def segment(
     return order, bounds, labels, _ends(ranges, echoes, start, bounds, cyclic, max_missing, clear_depth_m)
 
 
-@njit(cache=True)
+@njit
 def _larger_than(points: np.ndarray, lo: int, hi: int, size_m: float) -> bool:
     """Whether the cluster points[lo:hi] is larger than `size_m` (m): a point farther than that
     from either end (stops at the first)."""
@@ -223,7 +224,7 @@ def _larger_than(points: np.ndarray, lo: int, hi: int, size_m: float) -> bool:
     return False
 
 
-@njit(cache=True)
+@njit
 def kasa_fit(points: np.ndarray, lo: int, hi: int) -> tuple[float, float, float, float]:
     """Kasa's algebraic circle fit to points[lo:hi] (m), in coordinates centred on their mean:
     centre x, y, radius and the RMS distance of the points from the circle (m); NaN when the
@@ -258,7 +259,7 @@ def kasa_fit(points: np.ndarray, lo: int, hi: int) -> tuple[float, float, float,
     return mx + uc, my + vc, radius, math.sqrt(square / n)
 
 
-@njit(cache=True)
+@njit
 def refine(
     points: np.ndarray, lo: int, hi: int, fit: tuple[float, float, float, float], iterations: int
 ) -> tuple[float, float, float, float]:
@@ -296,7 +297,7 @@ def refine(
     return cx, cy, radius, math.sqrt(square / (hi - lo))
 
 
-@njit(cache=True)
+@njit
 def circle_fit(points: np.ndarray, lo: int, hi: int, iterations: int) -> tuple[float, float, float, float]:
     """The geometric circle fit to points[lo:hi] (m): `kasa_fit`'s circle refined by `iterations`
     Gauss-Newton steps (`refine`; Kasa's algebraic fit draws the circle of a short noisy arc too
@@ -306,7 +307,7 @@ def circle_fit(points: np.ndarray, lo: int, hi: int, iterations: int) -> tuple[f
     return refine(points, lo, hi, kasa_fit(points, lo, hi), iterations)
 
 
-@njit(cache=True)
+@njit
 def fit_sigma(rms: float, n: int, arc: float) -> float:
     """The 1-sigma (m) of the centre of a circle fitted to `n` echoes over an `arc` (rad) with
     `rms` (m) about it: sqrt(45 / n) sigma / (arc / 2)^2, sigma the echoes' noise (their RMS
@@ -316,7 +317,7 @@ def fit_sigma(rms: float, n: int, arc: float) -> float:
     return math.sqrt(45.0 / n) * noise / max(0.5 * arc, 1e-9) ** 2
 
 
-@njit(cache=True)
+@njit
 def _fit_sane(
     points: np.ndarray, lo: int, hi: int, fit: tuple, x: float, y: float, settings: np.ndarray
 ) -> bool:
@@ -338,7 +339,7 @@ def _fit_sane(
     return math.hypot(cx - x, cy - y) > math.hypot(mx - x, my - y)
 
 
-@njit(cache=True)
+@njit
 def _arc(points: np.ndarray, lo: int, hi: int, cx: float, cy: float) -> float:
     """The angle (rad) between the first and last of points[lo:hi] seen from (cx, cy)."""
     ax, ay = points[lo, 0] - cx, points[lo, 1] - cy
@@ -346,7 +347,7 @@ def _arc(points: np.ndarray, lo: int, hi: int, cx: float, cy: float) -> float:
     return abs(math.atan2(ax * by - ay * bx, ax * bx + ay * by))
 
 
-@njit(cache=True)
+@njit
 def _chord_centre(points: np.ndarray, lo: int, hi: int, x: float, y: float) -> tuple[float, float, float]:
     """The chord's midpoint of points[lo:hi] pushed away from the sensor at (x, y) by half the
     chord: the centre (m) of a disc whose near side the chord spans; and the chord (m)."""
@@ -358,7 +359,7 @@ def _chord_centre(points: np.ndarray, lo: int, hi: int, x: float, y: float) -> t
     return mx + 0.5 * chord * (mx - x) / away, my + 0.5 * chord * (my - y) / away, chord
 
 
-@njit(cache=True)
+@njit
 def world_points(
     order: np.ndarray,
     cos_b: np.ndarray,
@@ -387,7 +388,7 @@ FIT_SANE = 1
 """A cluster's circle fit is sane."""
 
 
-@njit(cache=True)
+@njit
 def _sane_fit(
     points: np.ndarray, lo: int, hi: int, x: float, y: float, settings: np.ndarray
 ) -> tuple[int, tuple[float, float, float, float]]:
@@ -402,7 +403,7 @@ def _sane_fit(
     return FIT_SANE if sane else FIT_FAILED, fit
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def concavity(points: np.ndarray, lo: int, hi: int, j: int, w: int, x: float, y: float) -> float:
     """How far (m) the echo points[j] lies behind its neighbours in points[lo:hi] as seen from
     the sensor at (x, y) (m): its distance beyond the line through the echoes `w` before and
@@ -417,7 +418,7 @@ def concavity(points: np.ndarray, lo: int, hi: int, j: int, w: int, x: float, y:
     return behind / math.sqrt(ex * ex + ey * ey) if behind > 0.0 else behind
 
 
-@njit(cache=True)
+@njit
 def _cuts(
     points: np.ndarray,
     lo: int,
@@ -471,7 +472,7 @@ def _cuts(
     return count
 
 
-@njit(cache=True)
+@njit
 def split(
     points: np.ndarray,
     distances: np.ndarray,
@@ -546,7 +547,7 @@ def split(
     return new_bounds[: total + 1], new_ends[:total], fits[:total], states[:total]
 
 
-@njit(cache=True)
+@njit
 def cluster_features(
     points: np.ndarray,
     bounds: np.ndarray,
@@ -610,7 +611,7 @@ def cluster_features(
     return usable, fitted, centres, radii, sigmas
 
 
-@njit(cache=True)
+@njit
 def predict(state: np.ndarray, cov: np.ndarray, count: int, dt: float, accel_psd: float) -> None:
     """Move the first `count` tracks' states (x, y, vx, vy; m, m/s) and covariances `dt` s ahead,
     constant velocity with white-noise acceleration of spectral density `accel_psd` (m^2/s^3):
@@ -633,7 +634,7 @@ def predict(state: np.ndarray, cov: np.ndarray, count: int, dt: float, accel_psd
             p[axis + 2, axis + 2] += q22
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _innovation_cov(
     cov: np.ndarray, sigma_r: float, sigma_t: float, ux: float, uy: float
 ) -> tuple[float, float, float]:
@@ -647,14 +648,14 @@ def _innovation_cov(
     )
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _unit_from(x: float, y: float, tx: float, ty: float) -> tuple[float, float]:
     """The unit vector from (x, y) toward (tx, ty); (1, 0) when they coincide."""
     d = math.sqrt((tx - x) ** 2 + (ty - y) ** 2)
     return ((tx - x) / d, (ty - y) / d) if d > 0.0 else (1.0, 0.0)
 
 
-@njit(cache=True)
+@njit
 def gate_costs(
     state: np.ndarray,
     cov: np.ndarray,
@@ -689,7 +690,7 @@ def gate_costs(
     return costs
 
 
-@njit(cache=True)
+@njit
 def _hungarian(costs: np.ndarray) -> np.ndarray:
     """The column of each row in the assignment of rows to distinct columns of least total cost,
     for no more rows than columns: Kuhn's Hungarian method in its O(n^2 m) form by
@@ -732,7 +733,7 @@ def _hungarian(costs: np.ndarray) -> np.ndarray:
     return columns
 
 
-@njit(cache=True)
+@njit
 def _solve(costs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The pairs (rows, columns) of the least-cost assignment (`_hungarian`, either way round)."""
     n, m = costs.shape
@@ -741,7 +742,7 @@ def _solve(costs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return _hungarian(costs.T.copy()), np.arange(m)
 
 
-@njit(cache=True)
+@njit
 def _components(gated: np.ndarray) -> np.ndarray:
     """The connected component (labelled by its least member) of each row and then each column
     (n + m,) of the bipartite graph whose edges are the `gated` (n, m) pairs."""
@@ -764,7 +765,7 @@ def _components(gated: np.ndarray) -> np.ndarray:
     return parent
 
 
-@njit(cache=True)
+@njit
 def _members(flags: np.ndarray, lo: int, hi: int, value: float) -> np.ndarray:
     """The indices k - lo of the entries of flags[lo:hi] equal to `value`."""
     out = np.empty(hi - lo, dtype=np.int64)
@@ -776,7 +777,7 @@ def _members(flags: np.ndarray, lo: int, hi: int, value: float) -> np.ndarray:
     return out[:count]
 
 
-@njit(cache=True)
+@njit
 def assign(costs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The pairs (rows, columns) of finite cost of the assignment of least total cost that pairs
     as many as it can (`_hungarian`, inf as a cost larger than any sum of finite ones), solved
@@ -811,7 +812,7 @@ def assign(costs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return rows[:pairs], columns[:pairs]
 
 
-@njit(cache=True)
+@njit
 def associate(
     state: np.ndarray,
     cov: np.ndarray,
@@ -836,7 +837,7 @@ def associate(
     return rows, clusters
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _search(bearings: np.ndarray, angle: float, right: bool) -> int:
     """The first index of `bearings` (N,; rad, increasing) at least `angle` (rad), or, `right`,
     beyond it (N: none), as `np.searchsorted` finds it (side "left" or "right"), from a guess as
@@ -859,7 +860,7 @@ def _search(bearings: np.ndarray, angle: float, right: bool) -> int:
     return k
 
 
-@njit(cache=True)
+@njit
 def _window(bearings: np.ndarray, cyclic: bool, lo: float, hi: float) -> tuple[int, int]:
     """The beams whose bearings (rad, increasing) lie in [lo, hi] (rad, robot frame, taken a
     whole number of turns on so that lo lies within a turn past the first bearing): the first,
@@ -878,7 +879,7 @@ def _window(bearings: np.ndarray, cyclic: bool, lo: float, hi: float) -> tuple[i
     return start, min(n, n - start + _search(bearings, hi - TWO_PI, True))  # on past the last
 
 
-@njit(cache=True)
+@njit
 def _stands(
     x: float,
     y: float,
@@ -908,7 +909,7 @@ def _stands(
     return 1 if count > 0 and beyond == count else 0
 
 
-@njit(cache=True)
+@njit
 def free_and_held(
     points: np.ndarray,
     lo: int,
@@ -932,7 +933,7 @@ def free_and_held(
     return free, held, looked
 
 
-@njit(cache=True)
+@njit
 def _verdict(free: int, held: int, looked: int, fraction: float, min_free: float) -> int:
     """What `looked` echoes tell of their object, `free` of them standing in an earlier scan's
     free space and `held` where it echoed: `MOTION_MOVED` when at least `min_free` and a
@@ -946,7 +947,7 @@ def _verdict(free: int, held: int, looked: int, fraction: float, min_free: float
     return MOTION_UNKNOWN
 
 
-@njit(cache=True)
+@njit
 def structure(
     points: np.ndarray, bounds: np.ndarray, usable: np.ndarray, min_points: int, most: int
 ) -> np.ndarray:
@@ -970,7 +971,7 @@ def structure(
     return out
 
 
-@njit(cache=True)
+@njit
 def structure_stays(
     now: np.ndarray,
     then: np.ndarray,
@@ -1003,7 +1004,7 @@ def structure_stays(
     return free <= pose_share * (free + held)
 
 
-@njit(cache=True)
+@njit
 def judge(
     points: np.ndarray,
     bounds: np.ndarray,
@@ -1032,7 +1033,7 @@ def judge(
     return verdicts
 
 
-@njit(cache=True)
+@njit
 def scan_clusters(
     bearings: np.ndarray,
     cos_b: np.ndarray,
@@ -1072,7 +1073,7 @@ def scan_clusters(
     return bounds, labels, ends, points, usable, fitted, centres, radii, sigmas
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _whole(ends: np.ndarray, fitted: np.ndarray, c: int) -> bool:
     """Whether cluster c shows enough of its object to place it: silhouettes at both ends, or an
     arc whose circle fit is sane (a part that meets a nearer echo, another object's outline or
@@ -1080,7 +1081,7 @@ def _whole(ends: np.ndarray, fitted: np.ndarray, c: int) -> bool:
     return fitted[c] or (ends[c, 0] == END_CLEAR and ends[c, 1] == END_CLEAR)
 
 
-@njit(cache=True)
+@njit
 def _kalman_update(
     x: np.ndarray, p: np.ndarray, zx: float, zy: float, sigma_r: float, sigma_t: float, ux: float, uy: float
 ) -> None:
@@ -1105,14 +1106,14 @@ def _kalman_update(
             p[a, b] = p[b, a] = 0.5 * (p[a, b] + p[b, a])
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _largest_sd(cov: np.ndarray, first: int) -> float:
     """The square root of the larger eigenvalue of cov[first:first + 2, first:first + 2]."""
     a, b, d = cov[first, first], cov[first, first + 1], cov[first + 1, first + 1]
     return math.sqrt(max(0.5 * (a + d) + math.sqrt(0.25 * (a - d) ** 2 + b * b), 0.0))
 
 
-@njit(cache=True)
+@njit
 def _classify(state: np.ndarray, cov: np.ndarray, info: np.ndarray, count: int, settings: np.ndarray) -> None:
     """Set MOVING for the first `count` tracks. A track starts moving when measured `min_hits`
     times, seen for `min_age_s`, its motion `MOTION_MOVED`, and its speed above `floor_mps` and
@@ -1138,7 +1139,7 @@ def _classify(state: np.ndarray, cov: np.ndarray, info: np.ndarray, count: int, 
         info[t, CONFIRMED] = 1.0 if moving else info[t, CONFIRMED]
 
 
-@njit(cache=True)
+@njit
 def left_free(
     x: float,
     y: float,
@@ -1178,7 +1179,7 @@ def left_free(
     return free, looked
 
 
-@njit(cache=True)
+@njit
 def _fold_one(
     state: np.ndarray,
     cov: np.ndarray,
@@ -1205,7 +1206,7 @@ def _fold_one(
     info[t, ECHOES] = bounds[c + 1] - bounds[c]
 
 
-@njit(cache=True)
+@njit
 def _verdicts(
     references: tuple[tuple[np.ndarray, np.ndarray, float, np.ndarray], ...],
     scan: tuple,
@@ -1251,7 +1252,7 @@ def _verdicts(
     return True, verdicts
 
 
-@njit(cache=True)
+@njit
 def fold(
     state: np.ndarray,
     cov: np.ndarray,
@@ -1323,7 +1324,7 @@ def fold(
     return verdicts
 
 
-@njit(cache=True)
+@njit
 def _judged(info: np.ndarray, t: int, verdict: int, time_s: float) -> None:
     """Set track t's MOTION and STATIC_SINCE by a `verdict` at `time_s` (an unknown one changes
     nothing)."""
@@ -1334,7 +1335,7 @@ def _judged(info: np.ndarray, t: int, verdict: int, time_s: float) -> None:
         info[t, STATIC_SINCE] = info[t, STATIC_SINCE] if info[t, STATIC_SINCE] >= 0.0 else time_s
 
 
-@njit(cache=True)
+@njit
 def _beam_labels(
     labels: np.ndarray,
     by_bearing: np.ndarray,
@@ -1363,7 +1364,7 @@ def _beam_labels(
     return ids, moving
 
 
-@njit(cache=True)
+@njit
 def _near_a_track(x: float, y: float, state: np.ndarray, info: np.ndarray, rows: np.ndarray) -> bool:
     """Whether (x, y) (m) lies within the radius of one of the tracks `rows`."""
     inside = math.inf  # the least distance from a track's disc
@@ -1372,7 +1373,7 @@ def _near_a_track(x: float, y: float, state: np.ndarray, info: np.ndarray, rows:
     return inside <= 0.0
 
 
-@njit(cache=True)
+@njit
 def _fresh(
     usable: np.ndarray,
     fitted: np.ndarray,
@@ -1401,7 +1402,7 @@ def _fresh(
     return fresh[:count]
 
 
-@njit(cache=True)
+@njit
 def look_for(
     x: float,
     y: float,
@@ -1442,7 +1443,7 @@ def look_for(
     return LOOK_THROUGH if through > before else LOOK_SOMETHING
 
 
-@njit(cache=True)
+@njit
 def _duplicate(t: int, state: np.ndarray, info: np.ndarray, seen: np.ndarray, max_dv: float) -> bool:
     """Whether track t is centred within the radius of a track of `seen` and its velocity within
     `max_dv` (m/s) of that track's: one object tracked twice."""
@@ -1453,7 +1454,7 @@ def _duplicate(t: int, state: np.ndarray, info: np.ndarray, seen: np.ndarray, ma
     return False
 
 
-@njit(cache=True)
+@njit
 def _gone(
     state: np.ndarray,
     info: np.ndarray,
@@ -1493,7 +1494,7 @@ def _gone(
     return drop
 
 
-@njit(cache=True)
+@njit
 def start_tracks(
     state: np.ndarray,
     cov: np.ndarray,
@@ -1533,7 +1534,7 @@ def start_tracks(
         info[t, ECHOES] = bounds[c + 1] - bounds[c]
 
 
-@njit(cache=True)
+@njit
 def _compact(state: np.ndarray, cov: np.ndarray, info: np.ndarray, count: int, drop: np.ndarray) -> int:
     """Remove the rows where `drop` holds from the first `count` of the track table, keeping the
     others' order; the number kept."""
@@ -1549,7 +1550,7 @@ def _compact(state: np.ndarray, cov: np.ndarray, info: np.ndarray, count: int, d
     return kept
 
 
-@njit(cache=True)
+@njit
 def track_scan(
     table: tuple[np.ndarray, np.ndarray, np.ndarray],
     count: int,
@@ -1600,7 +1601,7 @@ def track_scan(
     return count + fresh.shape[0], next_id + fresh.shape[0], ids, moving, fixed
 
 
-@njit(cache=True)
+@njit
 def confirmed(
     state: np.ndarray, cov: np.ndarray, info: np.ndarray, count: int
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -1621,7 +1622,7 @@ def confirmed(
     return states, values
 
 
-@njit(cache=True)
+@njit
 def same(a: np.ndarray, b: np.ndarray) -> bool:
     """Whether the arrays (N,) hold the same values."""
     if a.shape[0] != b.shape[0]:

@@ -36,7 +36,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from vplane_mj.kernels import njit
 
 ARC_HALF_WIDTH = 0.75
 """An echo's arc holds the cells within this many cells of its range (along the beam)."""
@@ -55,7 +56,7 @@ side of it (a bound between beams here, an edge of the view in `memory`): the an
 rounding (an arctangent, differences of angles) is some 1e-14 rad."""
 
 
-@njit(cache=True)
+@njit
 def fold_scan(
     x: float,
     y: float,
@@ -121,7 +122,7 @@ def fold_scan(
     )
 
 
-@njit(cache=True)
+@njit
 def _fold_cones(scan, cells, fan, rule, flat, seen_flat):
     """`fold_scan`'s walk through the scan's wedges (`_wedge`: the cones of neighbouring beams
     that reach about as far, walked as one) and its judgement of the cells it takes: one loop
@@ -195,7 +196,7 @@ def _fold_cones(scan, cells, fan, rule, flat, seen_flat):
         c = last + 1
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _by_sides(rel_x, rel_y, c, last, units):
     """The nearest direction of the cell at (`rel_x`, `rel_y`) (m from the robot) among the
     wedge's `c` to `last`, all `quick`, and its angle from that direction's axis where the
@@ -214,7 +215,7 @@ def _by_sides(rel_x, rel_y, c, last, units):
     return -1, 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def sure_off_line(x: float, y: float) -> float:
     """How far (in the units of `side_of`'s cross product) the point (x, y) (m from the robot)
     must lie off a line through the robot to lie surely on one side: SURE_RAD times a bound on
@@ -222,7 +223,7 @@ def sure_off_line(x: float, y: float) -> float:
     return SURE_RAD * (abs(x) + abs(y))
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def side_of(ux: float, uy: float, x: float, y: float, sure: float) -> int:
     """Which side of the line through the robot along the unit vector (ux, uy) the point (x, y)
     (m from the robot) lies on: 1 counter-clockwise of it, -1 clockwise, 0 within `sure`
@@ -231,7 +232,7 @@ def side_of(ux: float, uy: float, x: float, y: float, sure: float) -> int:
     return 1 if side > sure else -1 if side < -sure else 0
 
 
-@njit(cache=True)
+@njit
 def _turned(units, angle):
     """The unit vectors (K, 2) turned counter-clockwise by `angle` (rad)."""
     c, s = math.cos(angle), math.sin(angle)
@@ -242,7 +243,7 @@ def _turned(units, angle):
     return out
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _may_change(d2, band_lo2, band_hi2, clear2, show2, value, seen, track_seen):
     """Whether a cell `d2` (m^2) from the robot, of certainty `value`, may change under a cone
     (or a wedge) with these squared bounds (`_cone_bounds`): in the arc band, or nearer and
@@ -252,13 +253,13 @@ def _may_change(d2, band_lo2, band_hi2, clear2, show2, value, seen, track_seen):
     )
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _may_change_by(d2, reach, k, value, seen, track_seen):
     """`_may_change` under direction `k`'s cone, its bounds `reach[k]` (`_cone_bounds`)."""
     return _may_change(d2, reach[k, 0], reach[k, 1], reach[k, 2], reach[k, 3], value, seen, track_seen)
 
 
-@njit(cache=True)
+@njit
 def _cone_bounds(ranges, marks, arc_m, cell_m, silent_m, track_seen, extent2):
     """Each direction's squared bounds (m^2, `_cone_reach`): the arc band's low and high, how
     far it clears marked cells, how far it shows unseen ones, and how far its cone is walked (at
@@ -274,7 +275,7 @@ def _cone_bounds(ranges, marks, arc_m, cell_m, silent_m, track_seen, extent2):
     return reach
 
 
-@njit(cache=True)
+@njit
 def _wedge(c, reach, directions, half_before, half_after, cell_m):
     """The wedge walked from direction `c`: it and the next directions whose cones adjoin it,
     while it spans at most WEDGE_SPAN_RAD and their walked reaches differ by at most
@@ -299,7 +300,7 @@ def _wedge(c, reach, directions, half_before, half_after, cell_m):
     return last, lo2, hi2, clear2, show2, reach2
 
 
-@njit(cache=True)
+@njit
 def _judged(value, distance, offset, reading, marking, judging):
     """A cell's certainty after one scan, from `value`, and whether the scan shows it free: the
     cell `distance` (m) from the robot and `offset` (rad) from the axis of its nearest
@@ -319,7 +320,7 @@ def _judged(value, distance, offset, reading, marking, judging):
     return min(max(value + delta, 0), most), shown_free or silent_free
 
 
-@njit(cache=True)
+@njit
 def nearest_in_ring(angle: float, axis: float, spacing: float, count: int) -> tuple[int, float]:
     """The nearest direction (index) of an angle (rad from the first direction's world axis,
     `axis`) on an evenly spaced ring of `count` directions `spacing` apart, and the angle from
@@ -335,7 +336,7 @@ def nearest_in_ring(angle: float, axis: float, spacing: float, count: int) -> tu
     return beam, offset % TURN - math.pi
 
 
-@njit(cache=True)
+@njit
 def nearest_by_search(angle: float, bounds: np.ndarray, directions: np.ndarray) -> tuple[int, float]:
     """`nearest_in_ring` for any directions (rad, ascending): a search among the `bounds` half-way
     between neighbouring directions (each relative to the first direction)."""
@@ -344,7 +345,7 @@ def nearest_by_search(angle: float, bounds: np.ndarray, directions: np.ndarray) 
     return beam, remainder_of_turn(angle - (directions[beam] - directions[0]) + math.pi) - math.pi
 
 
-@njit(cache=True)
+@njit
 def remainder_of_turn(angle: float) -> float:
     """`angle % TURN` (rad) as Python's float modulo gives it, by one conditional turn when the
     angle lies within a turn of [0, TURN) (the modulo is then that turn added or taken away,
@@ -358,7 +359,7 @@ def remainder_of_turn(angle: float) -> float:
     return angle % TURN
 
 
-@njit(cache=True)
+@njit
 def _cone_reach(
     r: float, marks: bool, arc_m: float, cell_m: float, silent_m: float, track_seen: bool
 ) -> tuple[float, float, float, float]:
@@ -382,7 +383,7 @@ def _cone_reach(
     return band_lo2, band_hi2, clear, show
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _run(u, us, vs, edges, per_cell, first_v, n):
     """The first and last cell (indices along the line, within the grid) of the run of a piece's
     quadrilateral (see `_piece_lines`) on the grid line at `u` (m), cells `1 / per_cell` m
@@ -399,7 +400,7 @@ def _run(u, us, vs, edges, per_cell, first_v, n):
     )
 
 
-@njit(cache=True)
+@njit
 def _piece_lines(n, sight, reach2, x0, y0, cell_m, first_i, first_j):
     """How to walk one piece of a cone (see `fold_scan`): the corners (u, v) of the
     quadrilateral that holds it (the robot, the arc's start, the corner where the tangents at
@@ -430,7 +431,7 @@ def _piece_lines(n, sight, reach2, x0, y0, cell_m, first_i, first_j):
     return us, vs, edges, (line_first, line_last, first_u), first_v, step_u, step_v
 
 
-@njit(cache=True)
+@njit
 def _edge(ua, va, ub, vb, orient):
     """How the edge a -> b bounds the run of a line of constant u: (1, slope) from below,
     (-1, slope) from above, (0, s) parallel to the lines (a line at u is outside when
@@ -441,7 +442,7 @@ def _edge(ua, va, ub, vb, orient):
     return (1 if orient * du > 0.0 else -1), dv / du
 
 
-@njit(cache=True)
+@njit
 def _bound(lo, hi, u, kind, slope, ua, va):
     """The run [lo, hi] of the line at `u` cut by one edge (see `_edge`) through (ua, va)."""
     if kind > 0:

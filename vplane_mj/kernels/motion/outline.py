@@ -14,7 +14,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from vplane_mj.kernels import njit
 
 SURE = 1e-9
 SURE_M = 1e-9
@@ -22,7 +23,7 @@ SURE_M = 1e-9
 distances."""
 
 
-@njit(cache=True)
+@njit
 def _gap(footprint: np.ndarray, normals: np.ndarray, x: float, y: float) -> float:
     """Distance (m) from the point (x, y), in the footprint's frame, to the convex `footprint`
     (k, 2; counter-clockwise, each edge's outward unit normal in `normals`); 0 inside: the
@@ -47,7 +48,7 @@ def _gap(footprint: np.ndarray, normals: np.ndarray, x: float, y: float) -> floa
     return gap
 
 
-@njit(cache=True)
+@njit
 def _to_edge(ax: float, ay: float, bx: float, by: float, x: float, y: float) -> tuple[float, float]:
     """The vector (m) from the nearest point of the edge a -> b to the point (x, y)."""
     ex, ey = bx - ax, by - ay
@@ -56,7 +57,7 @@ def _to_edge(ax: float, ay: float, bx: float, by: float, x: float, y: float) -> 
     return px - t * ex, py - t * ey
 
 
-@njit(cache=True)
+@njit
 def _surely_beyond(dx: float, dy: float, bound: float) -> bool:
     """Whether hypot(dx, dy) (m) exceeds `bound` (m) by more than any rounding, judged by the
     square alone (False: maybe not)."""
@@ -64,7 +65,7 @@ def _surely_beyond(dx: float, dy: float, bound: float) -> bool:
     return bound > 0.0 and dx * dx + dy * dy > limit * limit
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def closer(dx: float, dy: float, bound: float) -> bool:
     """hypot(dx, dy) < `bound` (m), the C library's `hypot` (numpy's) taken only where the square
     does not decide: a squared distance carries a rounding error of a few parts in 1e16, and a
@@ -78,7 +79,7 @@ def closer(dx: float, dy: float, bound: float) -> bool:
     return math.hypot(dx, dy) < bound
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def _beyond_box(x: float, y: float, box: tuple[float, float, float, float], bound: float) -> bool:
     """Whether the point (x, y) lies more than `bound` (m) and SURE_M beyond the box (x low, x
     high, y low, y high; m) that holds the footprint, along x or y: then farther than `bound`
@@ -86,7 +87,7 @@ def _beyond_box(x: float, y: float, box: tuple[float, float, float, float], boun
     return max(box[0] - x, x - box[1], box[2] - y, y - box[3]) > bound + SURE_M
 
 
-@njit(cache=True)
+@njit
 def first_blocked_turn(
     footprint: np.ndarray,
     normals: np.ndarray,
@@ -119,7 +120,7 @@ def first_blocked_turn(
     return -1
 
 
-@njit(cache=True)
+@njit
 def intrusion(
     footprint: np.ndarray,
     normals: np.ndarray,

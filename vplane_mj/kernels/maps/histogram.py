@@ -5,14 +5,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-from vplane_mj.planning.kernels.grid import cells_near
+from vplane_mj.kernels import njit
+from vplane_mj.kernels.maps.grid import cells_near
 
 NO_SKIP = np.zeros((0, 0), dtype=np.bool_)
 
 
-@njit(cache=True)
+@njit
 def polar_histogram(
     origin: np.ndarray,
     cells: np.ndarray,
@@ -58,7 +58,7 @@ def polar_histogram(
     return h
 
 
-@njit(cache=True)
+@njit
 def grid_histogram(
     grid: np.ndarray,
     first_cell: np.ndarray,

@@ -6,10 +6,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from vplane_mj.kernels import njit
 
 
-@njit(cache=True)
+@njit
 def square(first_cell: np.ndarray, n: int, cell_m: float, x: float, y: float, within_m: float) -> tuple:
     """The rows and columns [lo, hi) of an n x n grid (cell (0, 0) the world cell `first_cell`,
     cells of `cell_m`) in the square around the point (x, y) (m) that holds the disc of radius
@@ -28,14 +29,14 @@ def square(first_cell: np.ndarray, n: int, cell_m: float, x: float, y: float, wi
     )
 
 
-@njit(cache=True)
+@njit
 def _counted(certainty: int, min_certainty: int, skipped: bool) -> bool:
     """Whether a cell of `certainty` is one of `cells_near` (and `nearest_cell`): at or above
     `min_certainty`, and not skipped (`_row_count` counts them by this test without a branch)."""
     return certainty >= min_certainty and not skipped
 
 
-@njit(cache=True)
+@njit
 def cells_near(
     grid: np.ndarray,
     first_cell: np.ndarray,
@@ -74,7 +75,7 @@ def cells_near(
     return centres, certainty
 
 
-@njit(cache=True)
+@njit
 def _row_count(row: np.ndarray, skipped: np.ndarray, lo: int, hi: int, min_certainty: int) -> int:
     """How many cells [lo, hi) of a grid `row` are at or above `min_certainty` and not `skipped`
     (1 in that row of the mask): `_counted`'s test without a branch, which the compiler runs on
@@ -86,7 +87,7 @@ def _row_count(row: np.ndarray, skipped: np.ndarray, lo: int, hi: int, min_certa
     return count
 
 
-@njit(cache=True)
+@njit
 def mark_disc(
     swept: np.ndarray,
     seen: np.ndarray,
@@ -108,7 +109,7 @@ def mark_disc(
                 seen[i, j] = True
 
 
-@njit(cache=True)
+@njit
 def clear_discs(grid: np.ndarray, first_cell: np.ndarray, cell_m: float, discs: np.ndarray) -> None:
     """Set to 0 the certainty of the cells of `grid` whose centres lie within a disc of `discs`
     (N, 3: x, y, radius; m); cell (i, j) as in `cells_near`."""
@@ -124,7 +125,7 @@ def clear_discs(grid: np.ndarray, first_cell: np.ndarray, cell_m: float, discs: 
                         grid[i, j] = 0
 
 
-@njit(cache=True)
+@njit
 def dilate(mask: np.ndarray, disk: np.ndarray) -> np.ndarray:
     """Binary dilation of `mask` by the centred structuring element `disk` (cells beyond the edge
     are off)."""
@@ -146,7 +147,7 @@ def dilate(mask: np.ndarray, disk: np.ndarray) -> np.ndarray:
     return out
 
 
-@njit(cache=True)
+@njit
 def label_regions(mask: np.ndarray) -> np.ndarray:
     """Labels (1, 2, ...) of the 4-connected regions of `mask`, 0 elsewhere, numbered in row-major
     order of their first cell (as scipy.ndimage.label numbers them)."""
@@ -173,7 +174,7 @@ def label_regions(mask: np.ndarray) -> np.ndarray:
     return labels
 
 
-@njit(cache=True)
+@njit
 def nearest_cell(
     grid: np.ndarray,
     first_cell: np.ndarray,
