@@ -25,8 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from vplane_mj.bench.report import markdown_table, write_table
 from vplane_mj.bench.sweep import parse_seeds
+from vplane_mj.bench.tables import markdown_table, write_table
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir
 from vplane_mj.scenario import load_scenario

@@ -14,7 +14,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from vplane_mj.bench.report import markdown_table, write_table
+from vplane_mj.bench.tables import markdown_table, write_table
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir
 from vplane_mj.logs.reader import iter_messages

@@ -27,6 +27,8 @@ import numpy as np
 
 from vplane_mj.bench.job import Job
 from vplane_mj.bench.sweep import PATH_KEY, family_of
+from vplane_mj.bench.tables import markdown_table as markdown_table  # kept here for its callers
+from vplane_mj.bench.tables import write_table as write_table
 from vplane_mj.files import write_atomically, write_csv, write_json
 from vplane_mj.geometry import shapes
 from vplane_mj.scenario import parse_scenario
@@ -383,25 +385,6 @@ svg.defs { position: absolute; width: 0; height: 0; }
 .run svg.path { width: 360px; height: 360px; border: 1px solid #ccc; background: white; flex: none; }
 .run pre { margin: 0; font-size: 12px; max-height: 360px; overflow: auto; }
 """
-
-
-def markdown_table(rows: list[dict], columns: tuple[str, ...], cell: Callable[[str, object], str]) -> str:
-    """`rows` as a Markdown table of `columns`, each value written by `cell(column, value)` (a
-    missing value is None)."""
-    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-    lines += ["| " + " | ".join(cell(key, row.get(key)) for key in columns) + " |" for row in rows]
-    return "\n".join(lines)
-
-
-def write_table(
-    out_dir: Path, stem: str, table: list[dict], columns: tuple[str, ...], text: str
-) -> list[Path]:
-    """A benchmark's table as `stem`.csv (`columns`) and, as the Markdown `text`, `stem`.md in
-    `out_dir`, each written whole; their paths."""
-    return [
-        write_csv(out_dir / f"{stem}.csv", table, columns),
-        write_atomically(out_dir / f"{stem}.md", lambda tmp: tmp.write_text(text + "\n", encoding="utf-8")),
-    ]
 
 
 def write_outputs(rows: list[dict], table: list[dict], out_dir: Path, jobs: list[Job]) -> list[Path]:
