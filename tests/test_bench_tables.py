@@ -5,7 +5,14 @@ import json
 from datetime import datetime
 
 from vplane_mj.bench import report
-from vplane_mj.bench.tables import Measurement, benchmark_command, markdown_table, measured_now, write_table
+from vplane_mj.bench.tables import (
+    Measurement,
+    benchmark_command,
+    formatted,
+    markdown_table,
+    measured_now,
+    write_table,
+)
 
 TABLE = [{"planner": "vplane", "success_rate": 0.5, "runs": 2}, {"planner": "apf", "runs": 2}]
 COLUMNS = ("planner", "runs", "success_rate")
@@ -50,3 +57,13 @@ def test_write_table_is_called_as_before_and_measures_now(tmp_path, monkeypatch)
     assert sidecar["command"] == "python benchmarks/log_growth.py --minutes 1"
     line = f"Measured {sidecar['date'][:10]} with `{sidecar['command']}` on {sidecar['machine']}.\n"
     assert (tmp_path / "log_growth.md").read_text(encoding="utf-8").endswith(line)
+
+
+def test_formatted_cells_take_their_column_s_format():
+    cell = formatted({"wall s": ".3f", "ratio": ".2f"})
+    assert [cell("wall s", 0.12345), cell("ratio", 2.0), cell("name", "a"), cell("ratio", None)] == [
+        "0.123",
+        "2.00",
+        "a",
+        "-",
+    ]

@@ -73,6 +73,16 @@ def markdown_table(rows: list[dict], columns: Sequence[str], cell: Callable[[str
     return "\n".join(lines)
 
 
+def formatted(formats: dict[str, str]) -> Callable[[str, object], str]:
+    """A cell writer for `markdown_table`: a value in its column's format spec (`formats`, e.g.
+    ".3f"), None as "-", any other value as `format` writes it."""
+
+    def cell(key: str, value: object) -> str:
+        return "-" if value is None else format(value, formats.get(key, ""))
+
+    return cell
+
+
 def write_table(
     out_dir: Path,
     stem: str,
