@@ -13,8 +13,9 @@ with a collision, timeouts, stuck runs, the mean BARN score (success x OT / clip
 8 OT), at most 0.5) and the planner's mean CPU time per tick, beside BARN's published figures:
 the DWA baseline of the benchmark paper (Perille et al., 2020: score 0.159, 85% success, 5.6%
 collisions) and the best entries of the BARN challenges (mean scores 0.40 to 0.48). Writes the
-table to `OUT/barn_protocol.csv` and a figure of success and mean score per planner, with the
-published figures as lines, to `OUT/barn_protocol.png`.
+table to `OUT/barn_protocol.csv`, `.md` and `.json` (with the command and the date) and a figure
+of success and mean score per planner, with the published figures as lines, to
+`OUT/barn_protocol.png`.
 
     python benchmarks/barn_protocol.py [--count 50] [--seeds 0-2] [--noise 0.01] [--jobs 2]
     python benchmarks/barn_protocol.py --count 2 --seeds 0 --planners vplane_plus,dwa --out /tmp/barn
@@ -30,9 +31,9 @@ from pathlib import Path
 import numpy as np
 
 from vplane_mj.bench.sweep import parse_seeds, plan_jobs, run_sweep
-from vplane_mj.bench.tables import markdown_table
+from vplane_mj.bench.tables import markdown_table, write_table
 from vplane_mj.errors import VPlaneError
-from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
+from vplane_mj.files import prepare_out_dir, write_atomically
 from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.worlds.barn_protocol import generate_protocol
 
@@ -161,10 +162,11 @@ def main(argv: list[str] | None = None) -> int:
     jobs = plan_jobs(scenarios, planners, seeds, overrides)
     rows = run_sweep(jobs, out, args.jobs)
     table = planner_table(rows)
-    write_csv(out / "barn_protocol.csv", table, COLUMNS)
+    text = markdown([*table, *PUBLISHED])
+    written = write_table(out, "barn_protocol", table, COLUMNS, text)
     plot(table, out / "barn_protocol.png")
-    print(markdown([*table, *PUBLISHED]))
-    print(f"wrote {out / 'barn_protocol.csv'}\nwrote {out / 'barn_protocol.png'}")
+    print(text)
+    print("\n".join(f"wrote {path}" for path in [*written, out / "barn_protocol.png"]))
     return 0
 
 
