@@ -9,9 +9,10 @@ scenario files are written to `OUT/cases/`; the runs go through `vplane_mj.bench
 so `OUT/bench.jsonl` journals them and the same command run again only does what is missing.
 
 Writes `OUT/clutter.csv` (per family and planner: runs, success rate, runs with a collision,
-timeouts, stuck, mean BARN score, median path ratio of the successes) and `OUT/clutter.png`
-(success, mean score and median path ratio per planner and family, as annotated heatmaps),
-and prints the table as Markdown.
+timeouts, stuck, mean BARN score, median path ratio of the successes), `OUT/clutter.json` (the
+same with the command and the date), `OUT/clutter.md` (success, then mean score and median path
+ratio, per planner and family) and `OUT/clutter.png` (the three as annotated heatmaps), and
+prints the Markdown.
 
     python benchmarks/clutter.py [--jobs 2] [--barn 100] [--count 10] [--out logs/clutter]
     python benchmarks/clutter.py --barn 4 --count 2 --planners vplane,vplane_plus --out /tmp/clutter
@@ -22,14 +23,15 @@ from __future__ import annotations
 import argparse
 import statistics
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
 from vplane_mj.bench.sweep import plan_jobs, run_sweep
-from vplane_mj.bench.tables import markdown_table
+from vplane_mj.bench.tables import markdown_table, write_table
 from vplane_mj.errors import VPlaneError
-from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
+from vplane_mj.files import prepare_out_dir, write_atomically
 from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.worlds.families import generate, trap_suite
 
@@ -100,14 +102,39 @@ def family_table(rows: list[dict], family_of: dict[str, str]) -> list[dict]:
 
 
 def markdown(table: list[dict]) -> str:
-    def cell(key: str, value) -> str:
-        if value is None:
-            return "-"
-        if key.endswith("_rate"):
-            return f"{100 * value:.0f}%"
-        return f"{value:.2f}" if isinstance(value, float) else str(value)
+    """Success, then mean BARN score and median path ratio, per planner (rows) and family
+    (columns), each table under its caption."""
+    runs = {row["family"]: row["runs"] for row in table}
+    return "\n\n".join(
+        [
+            "Success (reached, no collision), with the share of runs that touched an obstacle when any did:",
+            pivot(table, lambda family: f"{family} ({runs[family]})", success_cell),
+            "Mean BARN score / median path ratio of the successes:",
+            pivot(table, str, score_cell),
+        ]
+    )
 
-    return markdown_table(table, COLUMNS, cell)
+
+def pivot(table: list[dict], header: Callable[[str], str], cell: Callable[[dict], str]) -> str:
+    """A Markdown table of `cell(row)` per planner (rows) and family (columns, titled `header`)."""
+    families = {row["family"]: header(row["family"]) for row in table}
+    lines: dict[str, dict] = {}
+    for row in table:
+        line = lines.setdefault(row["planner"], {"planner": f"`{row['planner']}`"})
+        line[families[row["family"]]] = cell(row)
+    return markdown_table(list(lines.values()), ["planner", *families.values()], lambda _, v: v or "-")
+
+
+def success_cell(row: dict) -> str:
+    """The success rate, with the share of runs that touched an obstacle when any did."""
+    success = f"{100 * row['success_rate']:.0f}%"
+    return f"{success} ({100 * row['collision_rate']:.0f}% coll.)" if row["collision_rate"] else success
+
+
+def score_cell(row: dict) -> str:
+    """Mean BARN score / median path ratio, "-" for none."""
+    keys = ("mean_score", "median_path_ratio")
+    return " / ".join("-" if row[key] is None else f"{row[key]:.2f}" for key in keys)
 
 
 def plot(table: list[dict], path: Path) -> None:
@@ -181,10 +208,11 @@ def main(argv: list[str] | None = None) -> int:
             family_of[job.scenario] = "barn" + NOISY_SUFFIX
     rows = run_sweep(jobs + noisy, out, args.jobs)
     table = family_table(rows, family_of)
-    write_csv(out / "clutter.csv", table, COLUMNS)
+    text = markdown(table)
+    written = write_table(out, "clutter", table, COLUMNS, text)
     plot(table, out / "clutter.png")
-    print(markdown(table))
-    print(f"wrote {out / 'clutter.csv'}\nwrote {out / 'clutter.png'}")
+    print(text)
+    print("\n".join(f"wrote {path}" for path in [*written, out / "clutter.png"]))
     return 0
 
 
