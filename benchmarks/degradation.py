@@ -12,9 +12,10 @@ dropout 0.1), so every journal row says which level it belongs to. A run succeed
 the goal without a collision.
 
 Writes `OUT/degradation.csv` (per planner and level: runs, successes, reached, runs with a
-collision, timeouts, stuck, errors, success rate) and `OUT/degradation.png` (success % against
-noise_std and against dropout, one line per planner, the reference point starred), and prints
-the success table.
+collision, timeouts, stuck, errors, success rate), `OUT/degradation.json` (the same with the
+command and the date), `OUT/degradation.md` (success % per planner and level, the reference
+level last) and `OUT/degradation.png` (success % against noise_std and against dropout, one line
+per planner, the reference point starred), and prints the success table.
 
     python benchmarks/degradation.py [--jobs 2] [--seeds 0] [--time-limit 120] [--out logs/degradation]
     python benchmarks/degradation.py --cases 3 --noise 0,0.05 --dropout '' --out /tmp/degradation
@@ -27,8 +28,9 @@ import sys
 from pathlib import Path
 
 from vplane_mj.bench.sweep import parse_seeds, plan_jobs, run_sweep
+from vplane_mj.bench.tables import markdown_table, write_table
 from vplane_mj.errors import VPlaneError
-from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
+from vplane_mj.files import prepare_out_dir, write_atomically
 from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.worlds.families import trap_suite
 
@@ -92,15 +94,19 @@ def tally(jobs_levels: list[tuple], rows: list[dict]) -> list[dict]:
     return table
 
 
-def format_table(table: list[dict], levels: list[tuple]) -> str:
-    """Success % per planner (rows) and level (columns, "noise_std/dropout")."""
-    headers = ["planner", *(f"{n:g}/{d:g}" for n, d in levels)]
+def markdown(table: list[dict], levels: list[tuple]) -> str:
+    """Success % per planner (rows) and level (columns, "noise_std / dropout") as Markdown."""
+    corner = "noise_std (m) / dropout"
+    labels = {f"{noise:g} / {dropout:g}": (noise, dropout) for noise, dropout in levels}
     rate = {(r["planner"], r["noise_std"], r["dropout"]): r["success_rate"] for r in table}
-    lines = [headers]
-    for planner in dict.fromkeys(r["planner"] for r in table):
-        lines.append([planner, *(f"{100 * rate[planner, n, d]:.0f}%" for n, d in levels)])
-    widths = [max(len(line[k]) for line in lines) for k in range(len(headers))]
-    return "\n".join("  ".join(cell.rjust(w) for cell, w in zip(line, widths, strict=True)) for line in lines)
+    rows = [
+        {
+            corner: f"`{planner}`",
+            **{label: f"{100 * rate[planner, *level]:.0f}%" for label, level in labels.items()},
+        }
+        for planner in dict.fromkeys(r["planner"] for r in table)
+    ]
+    return markdown_table(rows, [corner, *labels], lambda _, value: value)
 
 
 def plot(table: list[dict], reference: list[float], path: Path) -> Path:
@@ -179,14 +185,15 @@ def sweep(args: argparse.Namespace) -> int:
 
     rows = run_sweep(jobs, args.out, args.jobs)
     table = tally(jobs_levels, rows)
-    csv_path = write_csv(args.out / "degradation.csv", table, COLUMNS)
+    text = markdown(table, levels)
+    written = write_table(args.out, "degradation", table, COLUMNS, text)
     png_path = plot(table, args.reference, args.out / "degradation.png")
     runs_per_cell = len(paths) * len(seeds)
     print(f"success per planner and sensor level (noise_std m / dropout), {runs_per_cell} runs each")
-    print(format_table(table, levels))
+    print(text)
     wall = sum(row["wall_time_s"] for row in rows)
     print(f"simulation wall time: {wall:.0f} s over {len(rows)} runs ({wall / len(rows):.2f} s per run)")
-    print(f"wrote {csv_path}\nwrote {png_path}")
+    print("\n".join(f"wrote {path}" for path in [*written, png_path]))
     return 0
 
 
