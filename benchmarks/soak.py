@@ -32,7 +32,9 @@ generators).
 
 Prints and writes `OUT/soak.json` (runs, crashes, runs without a summary, outcomes per
 planner, success rate per planner and family, the `error` outcomes with their messages,
-wall times) and `OUT/soak.png` (outcomes per planner). Exit status 1 if any run crashed or
+wall times), the planners' table (runs, outcomes, success per family and with the true pose
+and with odometry) as `OUT/soak_planners.md`, `.csv` and `.json` (with the command and the
+date), and `OUT/soak.png` (outcomes per planner). Exit status 1 if any run crashed or
 ended without a summary, else 0.
 
     python benchmarks/soak.py [--count 1000] [--seed 0] [--jobs 2] [--time-limit 60] [--out logs/soak]
@@ -53,6 +55,7 @@ import numpy as np
 from vplane_mj.bench.failures import FAILURE_KEY, FailureKind
 from vplane_mj.bench.job import Job
 from vplane_mj.bench.sweep import family_of, run_sweep
+from vplane_mj.bench.tables import markdown_table, write_table
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir, write_atomically, write_json
 from vplane_mj.planning.protocol.registry import PLANNERS
@@ -62,6 +65,8 @@ from vplane_mj.worlds.families import generate
 
 JOURNAL = "soak.jsonl"
 PLAN = "plan.json"
+TABLE = "soak_planners"
+"""The planners' table: `soak_planners.md`, `.csv` and `.json` (`soak.json` has every figure)."""
 OUTCOMES = ("reached", "timeout", "stuck", "error")
 ODOMETRY_FAULT = 'sensors.pose="odometry"'
 
@@ -190,20 +195,38 @@ def report(runs: list[tuple[Job, list[str]]], rows: dict[str, dict], wall_s: flo
     }
 
 
-def print_report(figures: dict) -> None:
+def planner_table(figures: dict) -> list[dict]:
+    """One row per planner: its runs, their outcomes, and its success per family and per pose
+    (`success_traps`, ..., `success_true_pose`, `success_odometry`)."""
+    failed = figures["crashes"] + figures["without_summary"]
+    table = []
+    for planner, counts in figures["outcomes_per_planner"].items():
+        rates = {
+            **figures["success_rate_per_planner_and_family"][planner],
+            **figures["success_rate_per_planner_and_pose"][planner],
+        }
+        runs = sum(counts.values()) + sum(entry["planner"] == planner for entry in failed)
+        success = {f"success_{name.replace(' ', '_')}": rate for name, rate in rates.items()}
+        table.append({"planner": planner, "runs": runs, **counts, **success})
+    return table
+
+
+def markdown(table: list[dict]) -> str:
+    """The planners' table as Markdown, the success rates in %."""
+
+    def cell(key: str, value) -> str:
+        if key.startswith("success_"):
+            return "-" if value is None else f"{100 * value:.0f}%"
+        return f"`{value}`" if key == "planner" else str(value)
+
+    return markdown_table(table, list(table[0]), cell)
+
+
+def print_report(figures: dict, text: str) -> None:
+    """The soak's counts, the planners' table (`text`), what failed and the times."""
     crashes, missing = figures["crashes"], figures["without_summary"]
     print(f"runs: {figures['runs']}, crashes: {len(crashes)}, without a summary: {len(missing)}\n")
-    success = figures["success_rate_per_planner_and_family"]
-    by_pose = figures["success_rate_per_planner_and_pose"]
-    families, poses = list(next(iter(success.values()))), list(next(iter(by_pose.values())))
-    table = [["planner", *OUTCOMES, *(f"success {name}" for name in families + poses)]]
-    for planner, counts in figures["outcomes_per_planner"].items():
-        rates = [*success[planner].values(), *by_pose[planner].values()]
-        cells = ["-" if rate is None else f"{100 * rate:.0f}%" for rate in rates]
-        table.append([planner, *(str(counts[outcome]) for outcome in OUTCOMES), *cells])
-    widths = [max(len(line[k]) for line in table) for k in range(len(table[0]))]
-    for line in table:
-        print("  ".join(cell.rjust(width) for cell, width in zip(line, widths, strict=True)))
+    print(text)
     for title, entries, field in (
         ("crashes", crashes, "exception"),
         ("without a summary", missing, "reason"),
@@ -270,9 +293,15 @@ def main(argv: list[str] | None = None) -> int:
         return exc.exit_status
 
     figures = report(runs, {row["key"]: row for row in rows}, time.monotonic() - started)
-    print_report(figures)
-    print(f"\nwrote {write_json(args.out / 'soak.json', figures)}")
-    print(f"wrote {plot(figures, args.out / 'soak.png')}")
+    table = planner_table(figures)
+    text = markdown(table)
+    print_report(figures, text)
+    written = [
+        *write_table(args.out, TABLE, table, list(table[0]), text),
+        write_json(args.out / "soak.json", figures),
+        plot(figures, args.out / "soak.png"),
+    ]
+    print("\n" + "\n".join(f"wrote {path}" for path in written))
     return 1 if figures["crashes"] or figures["without_summary"] else 0
 
 
