@@ -7,8 +7,8 @@ log, no render; on protocol worlds `dwa` follows its map's way, as in `barn_prot
 through `vplane_mj.bench.sweep.run_sweep` with `--jobs` workers. Reported per
 planner: runs, success, the sweep's wall time, the CPU time of its workers (their own
 accounting, so other processes on a shared machine do not inflate it), and runs per
-core-minute: runs over that CPU time in minutes. Writes `OUT/sweep_rate.csv` and a bar chart,
-`OUT/sweep_rate.png`.
+core-minute: runs over that CPU time in minutes. Writes the table to `OUT/sweep_rate.csv`, `.md`
+and `.json` (with the command and the date) and a bar chart to `OUT/sweep_rate.png`.
 
     python benchmarks/sweep_rate.py [--worlds 300] [--planners vplane,vplane_plus,dwa] [--protocol] [--jobs 2]
 """
@@ -25,7 +25,8 @@ from pathlib import Path
 from barn_protocol import write_scenarios
 
 from vplane_mj.bench.sweep import plan_jobs, run_sweep
-from vplane_mj.files import prepare_out_dir, write_atomically, write_csv
+from vplane_mj.bench.tables import markdown_table, write_table
+from vplane_mj.files import prepare_out_dir, write_atomically
 from vplane_mj.worlds.barn_protocol import generate_protocol
 from vplane_mj.worlds.families import generate
 
@@ -90,22 +91,31 @@ def main(argv: list[str] | None = None) -> int:
         sets["protocol, Jackal"] = write_scenarios(
             out / "protocol", generate_protocol(args.worlds, args.seed)
         )
-    table = []
-    print("| worlds | planner | runs | success | wall s | CPU s | runs per core-minute |")
-    print("|---|---|---:|---:|---:|---:|---:|")
-    for label, scenarios in sets.items():
-        for planner in (name.strip() for name in args.planners.split(",")):
-            row = sweep_row(label, scenarios, planner, args.jobs)
-            table.append(row)
-            print(
-                f"| {label} | `{planner}` | {row['runs']} | {row['success_rate']:.1%} | {row['wall_s']:.0f} "
-                f"| {row['cpu_s']:.0f} | {row['runs_per_core_minute']:.0f} |"
-            )
-            sys.stdout.flush()
-    write_csv(out / "sweep_rate.csv", table, COLUMNS)
+    planners = [name.strip() for name in args.planners.split(",")]
+    table = [
+        sweep_row(label, scenarios, planner, args.jobs)
+        for label, scenarios in sets.items()
+        for planner in planners
+    ]
+    text = markdown(table)
+    written = write_table(out, "sweep_rate", table, COLUMNS, text)
     plot(table, out / "sweep_rate.png")
-    print(f"wrote {out / 'sweep_rate.csv'}\nwrote {out / 'sweep_rate.png'}")
+    print(text)
+    print("\n".join(f"wrote {path}" for path in [*written, out / "sweep_rate.png"]))
     return 0
+
+
+def markdown(table: list[dict]) -> str:
+    """The table as Markdown: success in %, times and rates in whole numbers."""
+
+    def cell(key: str, value) -> str:
+        if key == "planner":
+            return f"`{value}`"
+        if key == "success_rate":
+            return f"{value:.1%}"
+        return f"{value:.0f}" if isinstance(value, float) else str(value)
+
+    return markdown_table(table, COLUMNS, cell)
 
 
 if __name__ == "__main__":
