@@ -13,7 +13,10 @@ Last, the commands that simulate nothing, `vplane-mj check` of the first scenari
 `vplane-mj list`, against the floor every command pays: Python starting and importing
 numpy. Their processes alternate with the floor's, so a busy machine slows all alike.
 
-    python benchmarks/startup.py [SCENARIO ...] [--repeat 5]
+Each table is printed and written to `OUT/startup.md`, `startup_job.md` and
+`startup_commands.md`, with their `.csv` and `.json` (the command and the date).
+
+    python benchmarks/startup.py [SCENARIO ...] [--repeat 5] [--out logs/startup]
 """
 
 from __future__ import annotations
@@ -27,7 +30,18 @@ import tempfile
 import time
 from pathlib import Path
 
+from vplane_mj.bench.tables import formatted, markdown_table, write_table
+from vplane_mj.errors import VPlaneError
+from vplane_mj.files import prepare_out_dir
+
 DEFAULT_SCENARIOS = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")
+FORMATS = {
+    "process wall s": ".3f",
+    "loop wall s": ".3f",
+    "process / loop": ".2f",
+    "/ python with numpy": ".2f",
+}
+"""The tables' cells: seconds to the millisecond, ratios to the hundredth."""
 
 
 def one_run(scenario: str, out: Path) -> tuple[float, float]:
@@ -59,7 +73,20 @@ def process_wall(arguments: list[str]) -> float:
     return time.perf_counter() - start
 
 
-def job_table(scenario: str, repeat: int, out: Path) -> None:
+def scenario_table(scenarios: list[str], repeat: int, out: Path) -> list[dict]:
+    """Per scenario, medians over `repeat` runs: the process's wall time, the loop's and their ratio."""
+    table = []
+    for scenario in scenarios:
+        one_run(scenario, out)  # fills the reference-path cache
+        walls, loops = zip(*(one_run(scenario, out) for _ in range(repeat)), strict=True)
+        wall, loop = statistics.median(walls), statistics.median(loops)
+        table.append(
+            {"scenario": scenario, "process wall s": wall, "loop wall s": loop, "process / loop": wall / loop}
+        )
+    return table
+
+
+def job_table(scenario: str, repeat: int, out: Path) -> list[dict]:
     """`vplane-mj run` with its log and render, without the render, without either; medians
     over `repeat` alternations."""
     variants = {
@@ -71,12 +98,11 @@ def job_table(scenario: str, repeat: int, out: Path) -> None:
     for _ in range(repeat):
         for name, flags in variants.items():
             walls[name].append(process_wall(["-m", "vplane_mj", "run", scenario, *flags, "--out", str(out)]))
-    print(f"\n| `vplane-mj run {scenario}` | process wall s |\n|---|---:|")
-    for name in variants:
-        print(f"| {name} | {statistics.median(walls[name]):.3f} |")
+    title = f"`vplane-mj run {scenario}`"
+    return [{title: name, "process wall s": statistics.median(walls[name])} for name in variants]
 
 
-def command_table(scenario: str, repeat: int) -> None:
+def command_table(scenario: str, repeat: int) -> list[dict]:
     """check and list processes against Python with numpy, medians over `repeat` alternations."""
     commands = {
         "python -c 'import numpy'": ["-c", "import numpy"],
@@ -87,29 +113,39 @@ def command_table(scenario: str, repeat: int) -> None:
     for _ in range(repeat):
         for name, arguments in commands.items():
             walls[name].append(process_wall(arguments))
-    floor = statistics.median(walls["python -c 'import numpy'"])
-    print("\n| command | process wall s | / python with numpy |\n|---|---:|---:|")
-    for name in commands:
-        wall = statistics.median(walls[name])
-        print(f"| `{name}` | {wall:.3f} | {wall / floor:.2f} |")
+    median = {name: statistics.median(times) for name, times in walls.items()}
+    floor = median["python -c 'import numpy'"]
+    return [
+        {"command": f"`{name}`", "process wall s": wall, "/ python with numpy": wall / floor}
+        for name, wall in median.items()
+    ]
+
+
+def publish(out: Path, stem: str, table: list[dict]) -> list[Path]:
+    """`table` printed and written as `stem` into `out`."""
+    columns = list(table[0])
+    text = markdown_table(table, columns, formatted(FORMATS))
+    print(f"\n{text}")
+    return write_table(out, stem, table, columns, text)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scenarios", nargs="*", default=list(DEFAULT_SCENARIOS))
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--out", type=Path, default=Path("logs/startup"))
     args = parser.parse_args(argv)
-    print("| scenario | process wall s | loop wall s | process / loop |\n|---|---:|---:|---:|")
+    try:
+        out = prepare_out_dir(args.out)
+    except VPlaneError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     with tempfile.TemporaryDirectory() as tmp:
-        out = Path(tmp)
-        for scenario in args.scenarios:
-            one_run(scenario, out)  # fills the reference-path cache
-            walls, loops = zip(*(one_run(scenario, out) for _ in range(args.repeat)), strict=True)
-            wall, loop = statistics.median(walls), statistics.median(loops)
-            print(f"| {scenario} | {wall:.3f} | {loop:.3f} | {wall / loop:.2f} |")
-            sys.stdout.flush()
-        job_table(args.scenarios[0], args.repeat, out)
-    command_table(args.scenarios[0], args.repeat)
+        runs = Path(tmp)
+        written = publish(out, "startup", scenario_table(args.scenarios, args.repeat, runs))
+        written += publish(out, "startup_job", job_table(args.scenarios[0], args.repeat, runs))
+    written += publish(out, "startup_commands", command_table(args.scenarios[0], args.repeat))
+    print("\n" + "\n".join(f"wrote {path}" for path in written))
     return 0
 
 
