@@ -12,7 +12,10 @@ candidate cells), the unit in which the planners' ticks are spent. The default s
 are a generated BARN-like world (the one of tests/test_dwa.py), paper_c_escape and
 single_box.
 
-    python benchmarks/planner_cost.py [SCENARIO ...] [--driver dwa] [--repeat 5]
+The table is written to `OUT/planner_cost.csv` (a row per scenario and planner), `.md` and
+`.json` (with the command and the date).
+
+    python benchmarks/planner_cost.py [SCENARIO ...] [--driver dwa] [--repeat 5] [--out logs/planner_cost]
 """
 
 from __future__ import annotations
@@ -22,9 +25,12 @@ import math
 import statistics
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 
+from vplane_mj.bench.tables import markdown_table, write_table
+from vplane_mj.files import prepare_out_dir
 from vplane_mj.planning.planners.groups import LocalMapParams
 from vplane_mj.planning.protocol.registry import PLANNERS, make_planner
 from vplane_mj.planning.protocol.types import Observation
@@ -36,6 +42,8 @@ from vplane_mj.worlds.families import random_barn
 
 BARN_SEED = 8
 """The generated BARN-like world of the default set (47 boxes; tests/test_dwa.py drives it)."""
+COLUMNS = ("scenario", "ticks", "planner", "ms_per_tick", "over_vfh")
+"""The CSV's: a row per scenario and planner (`map`, the sonar map's update alone, among them)."""
 
 
 class _Recorder:
@@ -109,24 +117,48 @@ def numpy_call_us(size: int, calls: int = 200_000) -> float:
     return 1e6 * (time.process_time() - start) / calls
 
 
+def cost_rows(name: str, ticks: int, cost: dict[str, float]) -> list[dict]:
+    """A scenario's rows: each planner's (and the map's) ms per tick and its ratio to vfh's."""
+    return [
+        {
+            "scenario": name,
+            "ticks": ticks,
+            "planner": planner,
+            "ms_per_tick": ms,
+            "over_vfh": ms / cost["vfh"],
+        }
+        for planner, ms in cost.items()
+    ]
+
+
+def markdown(table: list[dict]) -> str:
+    """One line per scenario: its ticks and each planner's ms per tick (its ratio to vfh's)."""
+    lines: dict[str, dict] = {}
+    for row in table:
+        line = lines.setdefault(row["scenario"], {"scenario": row["scenario"], "ticks": str(row["ticks"])})
+        line[f"`{row['planner']}` ms (x vfh)"] = f"{row['ms_per_tick']:.3f} ({row['over_vfh']:.2f})"
+    return markdown_table(list(lines.values()), list(next(iter(lines.values()))), lambda _, value: value)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scenarios", nargs="*")
     parser.add_argument("--driver", default="dwa", choices=sorted(PLANNERS))
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--out", type=Path, default=Path("logs/planner_cost"))
     args = parser.parse_args()
-    planners = sorted(PLANNERS)
-    columns = [*planners, "map"]
-    print("| scenario | ticks | " + " | ".join(f"`{p}` ms (x vfh)" for p in columns) + " |")
-    print("|---|---:|" + "---:|" * len(columns))
+    out = prepare_out_dir(args.out)
+    table = []
     for scenario in scenarios(args.scenarios, args.driver):
         recorder = _Recorder(scenario)
         run_scenario(scenario, observers=(recorder,))
-        cost = per_tick_ms(planners, recorder.observations, args.repeat)
-        cells = " | ".join(f"{cost[p]:.3f} ({cost[p] / cost['vfh']:.2f})" for p in columns)
-        print(f"| {scenario.name} | {len(recorder.observations)} | {cells} |", flush=True)
+        cost = per_tick_ms(sorted(PLANNERS), recorder.observations, args.repeat)
+        table += cost_rows(scenario.name, len(recorder.observations), cost)
+    text = markdown(table)
+    print(text)
     small, large = numpy_call_us(16), numpy_call_us(400)
     print(f"\nOne numpy operation: {small:.2f} us on 16 floats, {large:.2f} us on 400 floats (CPU time).")
+    print("\n".join(f"wrote {path}" for path in write_table(out, "planner_cost", table, COLUMNS, text)))
 
 
 if __name__ == "__main__":
