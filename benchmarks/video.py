@@ -6,7 +6,9 @@ from that log take T_mp4 and T_gif. Reported: the frames, the encoding's wall ti
 simulated second and its ratio to T_run (the medians of `--repeat` measurements), and the
 file sizes.
 
-    python benchmarks/video.py [SCENARIO ...] [--planner vplane] [--repeat 3]
+The table is written to `OUT/video.csv`, `.md` and `.json` (with the command and the date).
+
+    python benchmarks/video.py [SCENARIO ...] [--planner vplane] [--repeat 3] [--out logs/video]
 """
 
 from __future__ import annotations
@@ -18,6 +20,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from vplane_mj.bench.tables import formatted, markdown_table, write_table
+from vplane_mj.files import prepare_out_dir
 from vplane_mj.logs.reader import read_log
 from vplane_mj.logs.writer import McapLog
 from vplane_mj.scenario import load_scenario
@@ -27,6 +31,18 @@ from vplane_mj.viz.video import FORMATS, frame_count, write_video
 
 DEFAULT_SCENARIOS = ("paper_c_escape", "paper_h_escape")
 MP4_SPEED, GIF_SPEED = 1.0, 2.0
+CELLS = {
+    "scenario": "",
+    "simulated s": ".1f",
+    "MP4 frames": "d",
+    "MP4: wall s per simulated s": ".2f",
+    "MP4 / run": ".1f",
+    "MP4 kB": ".0f",
+    "GIF frames (2x)": "d",
+    "GIF / run": ".1f",
+    "GIF kB": ".0f",
+}
+"""The table's columns and how each is written."""
 
 
 def logged_run(scenario, path: Path) -> float:
@@ -69,26 +85,34 @@ def measure(name: str, planner: str, repeat: int, work: Path) -> dict:
     }
 
 
+def table_row(r: dict) -> dict:
+    """A measurement as the table's row: per simulated second and over the run's time."""
+    return {
+        "scenario": r["scenario"],
+        "simulated s": r["simulated_s"],
+        "MP4 frames": r["mp4_frames"],
+        "MP4: wall s per simulated s": r["mp4_s"] / r["simulated_s"],
+        "MP4 / run": r["mp4_s"] / r["run_s"],
+        "MP4 kB": r["mp4_kb"],
+        "GIF frames (2x)": r["gif_frames"],
+        "GIF / run": r["gif_s"] / r["run_s"],
+        "GIF kB": r["gif_kb"],
+    }
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scenarios", nargs="*", default=list(DEFAULT_SCENARIOS))
     parser.add_argument("--planner", default="vplane")
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--out", type=Path, default=Path("logs/video"))
     args = parser.parse_args(argv)
-    print(
-        "| scenario | simulated s | MP4 frames | MP4: wall s per simulated s | MP4 / run | MP4 kB "
-        "| GIF frames (2x) | GIF / run | GIF kB |"
-    )
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    out = prepare_out_dir(args.out)
     with tempfile.TemporaryDirectory() as work:
-        for name in args.scenarios:
-            r = measure(name, args.planner, args.repeat, Path(work))
-            print(
-                f"| {r['scenario']} | {r['simulated_s']:.1f} | {r['mp4_frames']} | "
-                f"{r['mp4_s'] / r['simulated_s']:.2f} | {r['mp4_s'] / r['run_s']:.1f} | {r['mp4_kb']:.0f} | "
-                f"{r['gif_frames']} | {r['gif_s'] / r['run_s']:.1f} | {r['gif_kb']:.0f} |",
-                flush=True,
-            )
+        table = [table_row(measure(name, args.planner, args.repeat, Path(work))) for name in args.scenarios]
+    text = markdown_table(table, list(CELLS), formatted(CELLS))
+    print(text)
+    print("\n".join(f"wrote {path}" for path in write_table(out, "video", table, list(CELLS), text)))
     return 0
 
 
