@@ -17,7 +17,9 @@ Last, the kernel's first call in a new process, in two processes run one after t
 with an empty numba cache: the first compiles the kernel and writes the cache, the second
 loads it. Importing `vplane_mj.sim.laser` (numba with it) is timed apart.
 
-    python benchmarks/laser_cast.py [--origins 200] [--repeat 20] [--seed 0]
+The table is written to `OUT/laser_cast.csv`, `.md` and `.json` (with the command and the date).
+
+    python benchmarks/laser_cast.py [--origins 200] [--repeat 20] [--seed 0] [--out logs/laser_cast]
 """
 
 from __future__ import annotations
@@ -31,10 +33,13 @@ import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
 
 import mujoco
 import numpy as np
 
+from vplane_mj.bench.tables import formatted, markdown_table, write_table
+from vplane_mj.files import prepare_out_dir
 from vplane_mj.geometry import shapes
 from vplane_mj.scenario import Scenario, box, build_scenario, cup, cylinder
 from vplane_mj.sim.laser import MOUNT_HEIGHT_M, RayCaster
@@ -51,6 +56,16 @@ LASERS = {
 ORIGIN_CLEARANCE_M = 0.1
 OBSTACLES_ONLY = np.array([1, 1, 1, 1, 1, 0], dtype=np.uint8)
 """Geom groups `mj_multiRay` sees: all but 5, where the robot's and the floor's geoms are moved."""
+CELLS = {
+    "world": "",
+    "pieces": "d",
+    "scan": "",
+    "`laser` us": ".1f",
+    "`mj_multiRay` us": ".1f",
+    "ratio": ".1f",
+    "max diff mm": ".1e",
+}
+"""The table's columns and how each is written: CPU us per scan, medians over the origins."""
 FIRST_CALL = """
 import json, time
 started = time.perf_counter()
@@ -192,25 +207,26 @@ def main() -> None:
     parser.add_argument("--origins", type=int, default=200)
     parser.add_argument("--repeat", type=int, default=20)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", type=Path, default=Path("logs/laser_cast"))
     args = parser.parse_args()
-    print("| world | pieces | scan | `laser` us | `mj_multiRay` us | ratio | max diff mm |")
-    print("|---|---:|---|---:|---:|---:|---:|")
+    out = prepare_out_dir(args.out)
+    table = []
     for label, scenario in (barn_world(args.seed), paper_world()):
         scene = scene_of(scenario)
         origins = free_origins(scene, scenario.world.size, args.origins, args.seed)
         for name, (step, beams, range_max) in LASERS.items():
             ours, theirs, worst = compare(scenario, origins, step, beams, range_max, args.repeat)
-            print(
-                f"| {label} | {len(scene)} | {name} | {ours:.1f} | {theirs:.1f} | "
-                f"{theirs / ours:.1f} | {worst:.1e} |",
-                flush=True,
-            )
+            cells = (label, len(scene), name, ours, theirs, theirs / ours, worst)
+            table.append(dict(zip(CELLS, cells, strict=True)))
+    text = markdown_table(table, list(CELLS), formatted(CELLS))
+    print(text)
     compiled, loaded = first_calls()
     print(
         f"\nFirst cast in a new process: {compiled['first_cast_s']:.3f} s with an empty numba cache "
         f"(compile), {loaded['first_cast_s']:.3f} s with the cache (load); importing vplane_mj.sim.laser: "
         f"{compiled['import_s']:.3f} s and {loaded['import_s']:.3f} s."
     )
+    print("\n".join(f"wrote {path}" for path in write_table(out, "laser_cast", table, list(CELLS), text)))
 
 
 if __name__ == "__main__":
