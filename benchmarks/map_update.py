@@ -13,7 +13,9 @@ time; reported is the median over `--repeat` rounds of the mean per update (ms),
 all maps and layouts in turn. Before the table, the CPU time of the process's first update
 that walks its cones (importing numba and loading, or compiling, its kernel).
 
-    python benchmarks/map_update.py [--repeat 5] [--poses 300] [--seed 0]
+The table is written to `OUT/map_update.csv`, `.md` and `.json` (with the command and the date).
+
+    python benchmarks/map_update.py [--repeat 5] [--poses 300] [--seed 0] [--out logs/map_update]
 """
 
 from __future__ import annotations
@@ -24,9 +26,12 @@ import math
 import statistics
 import time
 from collections import deque
+from pathlib import Path
 
 import numpy as np
 
+from vplane_mj.bench.tables import formatted, markdown_table, write_table
+from vplane_mj.files import prepare_out_dir
 from vplane_mj.geometry import shapes
 from vplane_mj.geometry.synthetic import LAYOUTS
 from vplane_mj.planning.perception.localmap import LocalMap
@@ -145,21 +150,26 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--poses", type=int, default=300, help="poses of the drive at most")
     parser.add_argument("--seed", type=int, default=0, help="first seed of the BARN field")
+    parser.add_argument("--out", type=Path, default=Path("logs/map_update"))
     args = parser.parse_args()
+    out = prepare_out_dir(args.out)
     footprints, poses = scene(args.seed, max(1, args.poses))
     print(f"The first update that walks its cones: {first_walk_s(footprints, poses[0]):.2f} s CPU.\n")
     scans = {name: [layout.scan(footprints, *pose) for pose in poses] for name, layout in LAYOUTS.items()}
     cost = per_update_ms(scans, poses, max(1, args.repeat))
-    print("| layout | beams | " + " | ".join(f"`{m}` ms" for m in MAPS) + " |")
-    print("|---|---:|" + "---:|" * len(MAPS))
-    for name, layout in LAYOUTS.items():
-        cells = " | ".join(f"{cost[(name, m)]:.3f}" for m in MAPS)
-        print(f"| {name} | {len(layout.bearings)} | {cells} |", flush=True)
+    columns = {"layout": "", "beams": "d", **{f"`{m}` ms": ".3f" for m in MAPS}}
+    table = [
+        {"layout": name, "beams": len(layout.bearings), **{f"`{m}` ms": cost[(name, m)] for m in MAPS}}
+        for name, layout in LAYOUTS.items()
+    ]
+    text = markdown_table(table, list(columns), formatted(columns))
+    print(text)
     echoes = np.concatenate(scans["jackal_laser"])
     print(
         f"\n{len(poses)} poses; the Jackal's farthest echo {np.nanmax(echoes):.1f} m, "
         f"{np.mean(np.isnan(echoes)):.0%} of its beams without one."
     )
+    print("\n".join(f"wrote {path}" for path in write_table(out, "map_update", table, list(columns), text)))
 
 
 if __name__ == "__main__":
