@@ -9,7 +9,10 @@
    border and the sonar sites added, the robot attached, the XML compiled; without the bump
    sensor, camera sizing, goal marker and motor faults, which favours mjcf).
 
-    python benchmarks/dm_control_env.py [SCENARIO] [--steps 200] [--repeat 20]
+The tables are written to `OUT/dm_control_env.md` (steps), `dm_control_env_reset.md` and
+`dm_control_env_build.md`, with their `.csv` and `.json` (the command and the date).
+
+    python benchmarks/dm_control_env.py [SCENARIO] [--steps 200] [--repeat 20] [--out logs/dm_control_env]
 """
 
 from __future__ import annotations
@@ -20,14 +23,16 @@ import statistics
 import sys
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import mujoco
 import numpy as np
 
 import vplane_mj  # before dm_control: OSMesa unless MUJOCO_GL is set
+from vplane_mj.bench.tables import formatted, markdown_table, write_table
 from vplane_mj.envs import VPlaneNavDmEnv
 from vplane_mj.envs.task import NavigationTask
-from vplane_mj.files import model_path
+from vplane_mj.files import model_path, prepare_out_dir
 from vplane_mj.geometry import shapes
 from vplane_mj.robots.facts import BASE_BODY
 from vplane_mj.robots.profiles import PROFILES
@@ -53,9 +58,9 @@ def median_ms(action: Callable[[], object], repeat: int) -> float:
     return 1e3 * statistics.median(times)
 
 
-def step_table(scenario: str, steps: int) -> None:
-    """A step's median wall time, plain and with each camera's pixels at each size."""
-    print("| environment | step ms |\n|---|---:|")
+def step_table(scenario: str, steps: int) -> list[dict]:
+    """A step's median wall time (ms), plain and with each camera's pixels at each size."""
+    table = []
     with VPlaneNavDmEnv(scenario, action="velocity") as env:
         views = [("no pixels", env)]
         for camera in ("top", "robot/chase"):
@@ -67,18 +72,20 @@ def step_table(scenario: str, steps: int) -> None:
         arc = np.array([0.3, 0.4])
         for name, view in views:
             view.reset()
-            print(f"| {name} | {median_ms(lambda view=view: view.step(arc), steps):.2f} |")
-            sys.stdout.flush()
+            table.append({"environment": name, "step ms": median_ms(lambda view=view: view.step(arc), steps)})
+    return table
 
 
-def reset_table(scenario: str, repeat: int) -> None:
-    """A reset with dm_control's Physics against the task's begin without one."""
+def reset_table(scenario: str, repeat: int) -> list[dict]:
+    """A reset with dm_control's Physics against the task's begin without one (ms)."""
     with VPlaneNavDmEnv(scenario) as env:
         with_physics = median_ms(env.reset, repeat)
     task = NavigationTask(scenario)
     without = median_ms(lambda: task.begin(task.episode_scenario(0)), repeat)
-    print(f"\n| reset | ms |\n|---|---:|\n| dm_env, with a Physics | {with_physics:.1f} |")
-    print(f"| the task's begin, without | {without:.1f} |")
+    return [
+        {"reset": "dm_env, with a Physics", "ms": with_physics},
+        {"reset": "the task's begin, without", "ms": without},
+    ]
 
 
 def mjcf_model(scenario: Scenario) -> mujoco.MjModel:
@@ -118,13 +125,21 @@ def mjcf_model(scenario: Scenario) -> mujoco.MjModel:
     return mujoco.MjModel.from_xml_string(arena.to_xml_string(), arena.get_assets())
 
 
-def build_table(scenario: str, repeat: int) -> None:
-    """Building and compiling the world with MjSpec and with dm_control.mjcf."""
+def build_table(scenario: str, repeat: int) -> list[dict]:
+    """Building and compiling the world with MjSpec and with dm_control.mjcf (ms)."""
     world = load_scenario(scenario)
     spec_ms = median_ms(lambda: build_model(world, rangefinders=False), repeat)
     mjcf_ms = median_ms(lambda: mjcf_model(world), repeat)
-    print(f"\n| building the {scenario} world | ms |\n|---|---:|")
-    print(f"| MjSpec | {spec_ms:.1f} |\n| dm_control.mjcf | {mjcf_ms:.1f} |")
+    title = f"building the {scenario} world"
+    return [{title: "MjSpec", "ms": spec_ms}, {title: "dm_control.mjcf", "ms": mjcf_ms}]
+
+
+def publish(out: Path, stem: str, table: list[dict], digits: int) -> list[Path]:
+    """`table` printed and written as `stem` into `out`, its times with `digits` decimals."""
+    columns = list(table[0])
+    text = markdown_table(table, columns, formatted({columns[1]: f".{digits}f"}))
+    print(f"\n{text}")
+    return write_table(out, stem, table, columns, text)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -132,14 +147,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("scenario", nargs="?", default="paper_c_escape")
     parser.add_argument("--steps", type=int, default=200, help="steps timed per variant")
     parser.add_argument("--repeat", type=int, default=20, help="resets and builds timed")
+    parser.add_argument("--out", type=Path, default=Path("logs/dm_control_env"))
     args = parser.parse_args(argv)
     try:
-        step_table(args.scenario, args.steps)
-        reset_table(args.scenario, args.repeat)
-        build_table(args.scenario, args.repeat)
+        out = prepare_out_dir(args.out)
+        written = publish(out, "dm_control_env", step_table(args.scenario, args.steps), 2)
+        written += publish(out, "dm_control_env_reset", reset_table(args.scenario, args.repeat), 1)
+        written += publish(out, "dm_control_env_build", build_table(args.scenario, args.repeat), 1)
     except vplane_mj.VPlaneError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    print("\n" + "\n".join(f"wrote {path}" for path in written))
     return 0
 
 
