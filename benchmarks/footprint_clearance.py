@@ -12,7 +12,10 @@ a distance matrix in chunks of poses, then the signed distance to the polygon of
 pairs). The time is the process's CPU time; reported per tick (ms, median over the points)
 for both, their ratio, and the largest difference between their results, as a table row.
 
-    python benchmarks/footprint_clearance.py [--points 20] [--repeat 5] [--seed 7]
+The table is written to `OUT/footprint_clearance.csv`, `.md` and `.json` (with the command and
+the date).
+
+    python benchmarks/footprint_clearance.py [--points 20] [--repeat 5] [--seed 7] [--out DIR]
 """
 
 from __future__ import annotations
@@ -20,11 +23,14 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
+from pathlib import Path
 
 import numpy as np
 
-from vplane_mj.kernels.motion.footprint_clearance import footprint_clearance
+from vplane_mj.bench.tables import formatted, markdown_table, write_table
+from vplane_mj.files import prepare_out_dir
 from vplane_mj.planning.planners.dwa import DwaPlanner
+from vplane_mj.kernels.motion.footprint_clearance import footprint_clearance
 from vplane_mj.planning.protocol.types import Observation
 from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario import parse_scenario
@@ -32,6 +38,14 @@ from vplane_mj.worlds.barn_protocol import generate_protocol
 
 CHUNK = 2048
 """Poses per distance matrix in the numpy version (a chunk's matrix: CHUNK x occupied cells)."""
+CELLS = {
+    "poses a tick": ".0f",
+    "numba kernel (ms)": ".2f",
+    "numpy (ms)": ".2f",
+    "ratio": ".0f",
+    "largest difference (m)": ".1e",
+}
+"""The table's columns (medians over the points) and how each is written."""
 
 
 def numpy_clearance(occupied, first_cell, cell_m, footprint, poses, cap_m, points=None):
@@ -112,7 +126,9 @@ def main() -> None:
     parser.add_argument("--points", type=int, default=20)
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--seed", type=int, default=7)
+    parser.add_argument("--out", type=Path, default=Path("logs/footprint_clearance"))
     args = parser.parse_args()
+    out = prepare_out_dir(args.out)
     ticks = recorded_checks(args.seed, args.points)
     kernel, plain, worst, poses = [], [], 0.0, []
     for calls in ticks:
@@ -121,11 +137,17 @@ def main() -> None:
         for call in calls:
             worst = max(worst, float(np.max(np.abs(footprint_clearance(*call) - numpy_clearance(*call)))))
         poses.append(sum(len(call[4]) for call in calls))
-    print(f"The Jackal at {len(ticks)} points of barn_protocol_{args.seed}_000 (CPU ms per dwa tick):\n")
-    print("| poses a tick | numba kernel (ms) | numpy (ms) | ratio | largest difference (m) |")
-    print("|---:|---:|---:|---:|---:|")
     fast, slow = statistics.median(kernel), statistics.median(plain)
-    print(f"| {statistics.median(poses):.0f} | {fast:.2f} | {slow:.2f} | {slow / fast:.0f} | {worst:.1e} |")
+    cells = (statistics.median(poses), fast, slow, slow / fast, worst)
+    table = [dict(zip(CELLS, cells, strict=True))]
+    text = markdown_table(table, list(CELLS), formatted(CELLS))
+    print(f"The Jackal at {len(ticks)} points of barn_protocol_{args.seed}_000 (CPU ms per dwa tick):\n")
+    print(text)
+    print(
+        "\n".join(
+            f"wrote {path}" for path in write_table(out, "footprint_clearance", table, list(CELLS), text)
+        )
+    )
 
 
 if __name__ == "__main__":
