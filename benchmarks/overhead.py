@@ -18,8 +18,10 @@ time goes; `--plot PNG` draws the ratios. Last, the run loop's own share: a run 
 `open_field` whose planner costs next to nothing (`straight_to_goal`, a unit force toward the
 goal), over its floor.
 
+The table is written to `OUT/overhead.csv`, `.md` and `.json` (with the command and the date).
+
     python benchmarks/overhead.py [SCENARIO ...] [--planners vplane,apf] [--repeat 3] [--no-log] [--profile]
-        [--plot overhead.png]
+        [--plot overhead.png] [--out logs/overhead]
 
 SCENARIO is a built-in name or a scenario file (e.g. one of `vplane-mj generate`).
 """
@@ -39,6 +41,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from vplane_mj.bench.tables import formatted, markdown_table, write_table
+from vplane_mj.files import prepare_out_dir
 from vplane_mj.logs.writer import McapLog
 from vplane_mj.planning import Decision, Observation, Planner, PlannerParams
 from vplane_mj.planning.protocol.registry import register_planner
@@ -52,6 +56,22 @@ from vplane_mj.sim.world import build_model
 DEFAULT_SCENARIOS = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")
 HARNESS_SCENARIO = "open_field"
 """Where `straight_to_goal` reaches its goal: no obstacle between the start and the goal."""
+CELLS = {
+    "scenario": "",
+    "planner": "",
+    "outcome": "",
+    "physics steps": "d",
+    "floor us/step": ".1f",
+    "run / floor": ".2f",
+    "run with log / floor": ".2f",
+    "as built / floor": ".2f",
+    "run / as built": ".2f",
+    "run / floor, wall clock": ".2f",
+    "laser / floor": ".2f",
+    "planner ms/tick": ".3f",
+    "log MB/min": ".2f",
+}
+"""The table's columns and how each is written ("-" where not measured)."""
 
 
 class StraightToGoal(Planner):
@@ -193,10 +213,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-log", action="store_true", help="do not time runs that write their log")
     parser.add_argument("--profile", action="store_true", help="profile one run of the first combination")
     parser.add_argument("--plot", type=Path, help="also draw the ratios into this PNG")
+    parser.add_argument("--out", type=Path, default=Path("logs/overhead"))
     args = parser.parse_args(argv)
     planners = [name.strip() for name in args.planners.split(",")]
+    out = prepare_out_dir(args.out)
     with tempfile.TemporaryDirectory() as tmp:
         rows = report(args.scenarios, planners, args.repeat, None if args.no_log else Path(tmp))
+    table = [table_row(row) for row in rows]
+    text = markdown(table)
+    print(f"median of {args.repeat} interleaved repeats, CPU time; mujoco {mujoco.__version__}\n\n{text}")
+    written = write_table(out, "overhead", table, list(CELLS), text)
     if args.plot:
         plot(rows, args.plot)
         print(f"wrote {args.plot}")
@@ -208,6 +234,7 @@ def main(argv: list[str] | None = None) -> int:
         f"\nThe run loop alone: `{StraightToGoal.name}` ({harness['planner_ms']:.3f} ms a tick) "
         f"{harness['outcome']} on {HARNESS_SCENARIO} at {harness['run']:.2f} times the floor."
     )
+    print("\n".join(f"wrote {path}" for path in written))
     return 0
 
 
@@ -234,29 +261,36 @@ def plot(rows: list[dict], path: Path) -> None:
 
 
 def report(scenarios: list[str], planners: list[str], repeat: int, log_dir: Path | None) -> list[dict]:
-    print(f"median of {repeat} interleaved repeats, CPU time; mujoco {mujoco.__version__}\n")
-    print(
-        "| scenario | planner | outcome | physics steps | floor us/step | run / floor | run with log / floor "
-        "| as built / floor | run / as built | run / floor, wall clock | laser / floor | planner ms/tick "
-        "| log MB/min |"
+    """Every planner on every scenario, measured (see `measure`)."""
+    return [measure(ref, planner, repeat, log_dir) for planner in planners for ref in scenarios]
+
+
+def table_row(row: dict) -> dict:
+    """A measurement as the table's row; what was not measured is None."""
+    values = (
+        row["scenario"],
+        row["planner"],
+        row["outcome"],
+        row["steps"],
+        row["floor_us"],
+        row["run"],
+        row["log"],
+        row["built"],
+        row["run_vs_built"],
+        row["run_wall"],
+        row["laser"],
+        row["planner_ms"],
+        None if row["log"] is None else row["log_mb_per_min"],
     )
-    print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
-    rows = []
-    for planner in planners:
-        for ref in scenarios:
-            row = measure(ref, planner, repeat, log_dir)
-            logged = "-" if row["log"] is None else f"{row['log']:.2f}"
-            size = "-" if row["log"] is None else f"{row['log_mb_per_min']:.2f}"
-            laser = "-" if row["laser"] is None else f"{row['laser']:.2f}"
-            print(
-                f"| {row['scenario']} | `{row['planner']}` | {row['outcome']} | {row['steps']} "
-                f"| {row['floor_us']:.1f} | {row['run']:.2f} | {logged} | {row['built']:.2f} "
-                f"| {row['run_vs_built']:.2f} | {row['run_wall']:.2f} | {laser} | {row['planner_ms']:.3f} "
-                f"| {size} |"
-            )
-            sys.stdout.flush()
-            rows.append(row)
-    return rows
+    return dict(zip(CELLS, values, strict=True))
+
+
+def markdown(table: list[dict]) -> str:
+    """The table as Markdown, planner names as code."""
+    number = formatted(CELLS)
+    return markdown_table(
+        table, list(CELLS), lambda key, value: f"`{value}`" if key == "planner" else number(key, value)
+    )
 
 
 if __name__ == "__main__":
