@@ -35,8 +35,11 @@ thread per core): IR-SIM's lidar multiplies (segments x 2) by (2 x beams) matric
 OpenBLAS's threads spent several times the CPU time on them on a 2-core machine shared with
 other work. The header says what ran.
 
+The three tables are written to `OUT/peer_irsim_scans.md`, `peer_irsim_worlds.md` and
+`peer_irsim.md` (overall), with their `.csv` and `.json` (the command and the date).
+
     python benchmarks/peer_irsim.py [--count 2] [--seed 0] [--time-limit 10] [--repeat 3]
-        [--planners vplane_plus,dwa] [--blas-threads 1]
+        [--planners vplane_plus,dwa] [--blas-threads 1] [--out logs/peer_irsim]
 
 Needs IR-SIM, an optional extra of the benchmarks only: `pip install 'vplane-mj[peers]'`.
 """
@@ -60,7 +63,9 @@ from typing import Any, NamedTuple
 import mujoco
 import numpy as np
 
+from vplane_mj.bench.tables import formatted, markdown_table, write_table
 from vplane_mj.errors import VPlaneError
+from vplane_mj.files import prepare_out_dir
 from vplane_mj.geometry import shapes
 from vplane_mj.robots.profiles import robot_profile
 from vplane_mj.scenario import Scenario, parse_document
@@ -73,6 +78,27 @@ BEAMS = (16, 720)
 STEP_S = 0.02
 """IR-SIM's step (50 Hz), and this project's control period here."""
 IRSIM = "IR-SIM"
+SCAN_CELLS = {"world": "", "cylinders": "d", "720-beam scans at the start: largest difference, mm": ".2f"}
+RATES = {"sim s per CPU s": ".2f", "sim s per wall s": ".2f", "over IR-SIM (CPU)": ".2f"}
+WORLD_CELLS = {
+    "world": "",
+    "simulator": "",
+    "beams": "d",
+    "outcome": "",
+    "simulated s": ".2f",
+    "CPU s": ".3f",
+    **RATES,
+    "planner share of wall": ".0%",
+}
+OVERALL_CELLS = {
+    "simulator": "",
+    "beams": "d",
+    "simulated s": ".2f",
+    "CPU s": ".3f",
+    **RATES,
+    "over IR-SIM (wall)": ".2f",
+}
+"""The three tables' columns (the scans at the start, per world, overall) and how each is written."""
 MISSING_PEERS = (
     "peer_irsim.py compares this project with IR-SIM and needs the benchmarks' `peers` extra, "
     "not installed here ({missing}): pip install 'vplane-mj[peers]' (or pip install ir-sim threadpoolctl)"
@@ -261,45 +287,42 @@ def best_of(
     return worlds
 
 
-def rate(simulated_s: float, seconds: float) -> str:
-    return f"{simulated_s / seconds:.2f}" if seconds > 0 else "-"
+def rate(simulated_s: float, seconds: float) -> float | None:
+    """Simulated seconds per second, None for no time."""
+    return simulated_s / seconds if seconds > 0 else None
 
 
 def label(simulator: str) -> str:
     return IRSIM + " `dash`" if simulator == IRSIM else f"vplane-mj `{simulator}`"
 
 
-def report_scans(cylinders: dict[str, int], differences: dict[str, float]) -> None:
-    print("| world | cylinders | 720-beam scans at the start: largest difference, mm |")
-    print("|---|---:|---:|")
-    for name, count in cylinders.items():
-        print(f"| {name} | {count} | {differences[name]:.2f} |")
+def scan_table(cylinders: dict[str, int], differences: dict[str, float]) -> list[dict]:
+    """Per world: its cylinders and how far apart the two 720-beam scans at the start are."""
+    return [
+        {
+            "world": name,
+            "cylinders": count,
+            "720-beam scans at the start: largest difference, mm": differences[name],
+        }
+        for name, count in cylinders.items()
+    ]
 
 
-def report_worlds(worlds: dict[str, dict[tuple[str, int], Timing]]) -> None:
-    print(
-        "\n| world | simulator | beams | outcome | simulated s | CPU s | sim s per CPU s "
-        "| sim s per wall s | over IR-SIM (CPU) | planner share of wall |"
-    )
-    print("|---|---|---:|---|---:|---:|---:|---:|---:|---:|")
+def world_table(worlds: dict[str, dict[tuple[str, int], Timing]]) -> list[dict]:
+    """Per world and configuration: how the run ended, its times and its rate over IR-SIM's."""
+    table = []
     for name, timings in worlds.items():
         for (simulator, beams), t in timings.items():
             peer = timings[IRSIM, beams]
             over = (t.simulated_s / t.cpu_s) / (peer.simulated_s / peer.cpu_s)
-            share = "-" if t.planner_share is None else f"{t.planner_share:.0%}"
-            print(
-                f"| {name} | {label(simulator)} | {beams} | {t.outcome} "
-                f"| {t.simulated_s:.2f} | {t.cpu_s:.3f} | {rate(t.simulated_s, t.cpu_s)} "
-                f"| {rate(t.simulated_s, t.wall_s)} | {over:.2f} | {share} |"
-            )
+            values = (name, label(simulator), beams, t.outcome, t.simulated_s, t.cpu_s)
+            values += (rate(t.simulated_s, t.cpu_s), rate(t.simulated_s, t.wall_s), over, t.planner_share)
+            table.append(dict(zip(WORLD_CELLS, values, strict=True)))
+    return table
 
 
-def report_overall(worlds: dict[str, dict[tuple[str, int], Timing]]) -> None:
-    print(
-        "\n| overall | beams | simulated s | CPU s | sim s per CPU s | sim s per wall s "
-        "| over IR-SIM (CPU) | over IR-SIM (wall) |"
-    )
-    print("|---|---:|---:|---:|---:|---:|---:|---:|")
+def overall_table(worlds: dict[str, dict[tuple[str, int], Timing]]) -> list[dict]:
+    """Per configuration, summed over the worlds: times, rates and rates over IR-SIM's."""
     keys = next(iter(worlds.values())).keys()
     totals = {
         key: tuple(
@@ -307,14 +330,21 @@ def report_overall(worlds: dict[str, dict[tuple[str, int], Timing]]) -> None:
         )
         for key in keys
     }
+    table = []
     for (simulator, beams), (simulated, cpu, wall) in totals.items():
         peer_simulated, peer_cpu, peer_wall = totals[IRSIM, beams]
         over_cpu = (simulated / cpu) / (peer_simulated / peer_cpu)
         over_wall = (simulated / wall) / (peer_simulated / peer_wall)
-        print(
-            f"| {label(simulator)} | {beams} | {simulated:.2f} | {cpu:.3f} | {rate(simulated, cpu)} "
-            f"| {rate(simulated, wall)} | {over_cpu:.2f} | {over_wall:.2f} |"
-        )
+        values = (label(simulator), beams, simulated, cpu, rate(simulated, cpu), rate(simulated, wall))
+        table.append(dict(zip(OVERALL_CELLS, (*values, over_cpu, over_wall), strict=True)))
+    return table
+
+
+def publish(out: Path, stem: str, table: list[dict], cells: dict[str, str]) -> list[Path]:
+    """`table` printed and written as `stem` into `out`, each column as `cells` says."""
+    text = markdown_table(table, list(cells), formatted(cells))
+    print(f"\n{text}")
+    return write_table(out, stem, table, list(cells), text)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -327,6 +357,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--blas-threads", type=int, default=1, help="threads BLAS may run (0: its own default, one a core)"
     )
+    parser.add_argument("--out", type=Path, default=Path("logs/peer_irsim"))
     args = parser.parse_args(argv)
     if args.count < 1 or args.repeat < 1 or not args.time_limit > 0 or args.blas_threads < 0:
         parser.error("--count and --repeat must be at least 1, --time-limit positive, --blas-threads >= 0")
@@ -335,6 +366,11 @@ def main(argv: list[str] | None = None) -> int:
         print(MISSING_PEERS.format(missing=peers), file=sys.stderr)
         return 2
     planners = [name.strip() for name in args.planners.split(",") if name.strip()]
+    try:
+        out = prepare_out_dir(args.out)
+    except VPlaneError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     cases = generate_protocol(args.count, args.seed)
     cylinders = {
         case.name: sum(ob["kind"] == "cylinder" for ob in case.document["world"]["obstacles"])
@@ -364,11 +400,12 @@ def main(argv: list[str] | None = None) -> int:
     print(
         f"best of {args.repeat} interleaved repeats of the simulation loop; at most {args.time_limit:g} s "
         f"simulated; IR-SIM {peers.irsim.__version__} (kinematic, 50 Hz), mujoco {mujoco.__version__} "
-        f"(physics 500 Hz, control and scans 50 Hz); BLAS: {blas or 'none found'}\n"
+        f"(physics 500 Hz, control and scans 50 Hz); BLAS: {blas or 'none found'}"
     )
-    report_scans(cylinders, differences)
-    report_worlds(worlds)
-    report_overall(worlds)
+    written = publish(out, "peer_irsim_scans", scan_table(cylinders, differences), SCAN_CELLS)
+    written += publish(out, "peer_irsim_worlds", world_table(worlds), WORLD_CELLS)
+    written += publish(out, "peer_irsim", overall_table(worlds), OVERALL_CELLS)
+    print("\n" + "\n".join(f"wrote {path}" for path in written))
     return 0
 
 
