@@ -1,6 +1,6 @@
 """How a run's cost grows with obstacles and sonar rays, and how sweeps scale with workers.
 
-    python benchmarks/scaling.py [--seconds 10] [--sweep 1000]
+    python benchmarks/scaling.py [--seconds 10] [--sweep 1000] [--out logs/scaling]
 
 Obstacles: a 20 x 20 m arena with N random 0.1 m boxes (seeded), the robot driving with
 `apf` for a fixed simulated time; CPU time per physics step of the whole run, of the
@@ -11,7 +11,8 @@ the same 40 runs (paper scenarios, every planner, two seeds with 2 cm sonar nois
 `bench.run_sweep`'s process pool with 1 and 2 workers, side by side (wall clock).
 `--sweep N`: the wall time of a sweep of N runs (the paper scenarios and generated traps
 and clutter, every planner, seeds with 2 cm sonar noise, 60 simulated seconds at most),
-from an empty reference-path cache.
+from an empty reference-path cache. The two tables are written to `OUT/scaling.md` (boxes)
+and `OUT/scaling_rays.md`, with their `.csv` and `.json` (the command and the date).
 """
 
 from __future__ import annotations
@@ -27,6 +28,8 @@ import numpy as np
 import tomli_w
 
 from vplane_mj.bench.sweep import plan_jobs, run_sweep
+from vplane_mj.bench.tables import formatted, markdown_table, write_table
+from vplane_mj.files import prepare_out_dir
 from vplane_mj.geometry.cache import CACHE_ENV
 from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.scenario import parse_scenario
@@ -35,6 +38,7 @@ from vplane_mj.sim.world import build_model
 from vplane_mj.worlds.families import generate
 
 PAPER = ["paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape"]
+COST_COLUMNS = ("CPU us per physics step: run", "floor (sensors off)", "as exported (rays every step)")
 
 
 def clutter_document(count: int, seconds: float, sensors: dict | None = None) -> str:
@@ -102,17 +106,17 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10.0, help="simulated seconds per run")
     parser.add_argument("--sweep", type=int, default=0, help="also time a sweep of this many runs")
+    parser.add_argument("--out", type=Path, default=Path("logs/scaling"))
     args = parser.parse_args()
-    header = "| CPU us per physics step: run | floor (sensors off) | as exported (rays every step) |"
-    print(f"| boxes {header}\n|---:|---:|---:|---:|")
-    for count in (10, 100, 1000):
-        run, floor, built = cost(clutter_document(count, args.seconds))
-        print(f"| {count} | {run:.1f} | {floor:.1f} | {built:.1f} |")
-    print(f"\n| sonars x rays {header}\n|---|---:|---:|---:|")
-    for sonars, rays in ((16, 1), (16, 3), (16, 5), (32, 3)):
-        sensors = {"count": sonars, "rays_per_sonar": rays}
-        run, floor, built = cost(clutter_document(10, args.seconds, sensors))
-        print(f"| {sonars} x {rays} | {run:.1f} | {floor:.1f} | {built:.1f} |")
+    out = prepare_out_dir(args.out)
+    boxes = [(count, cost(clutter_document(count, args.seconds))) for count in (10, 100, 1000)]
+    written = publish(out, "scaling", "boxes", boxes)
+    rings = [
+        (f"{sonars} x {rays}", {"count": sonars, "rays_per_sonar": rays})
+        for sonars, rays in ((16, 1), (16, 3), (16, 5), (32, 3))
+    ]
+    rays = [(name, cost(clutter_document(10, args.seconds, ring))) for name, ring in rings]
+    written += publish(out, "scaling_rays", "sonars x rays", rays)
     jobs = plan_jobs(PAPER, sorted(PLANNERS), [0, 1], ["sensors.noise_std=0.02"])
     rates = {}
     for workers in (1, 2):
@@ -126,7 +130,17 @@ def main() -> int:
     )
     if args.sweep:
         time_sweep(args.sweep)
+    print("\n" + "\n".join(f"wrote {path}" for path in written))
     return 0
+
+
+def publish(out: Path, stem: str, first: str, costs: list[tuple]) -> list[Path]:
+    """The costs per physics step (`first`: what each row varies) printed and written as `stem`."""
+    table = [{first: value, **dict(zip(COST_COLUMNS, cost, strict=True))} for value, cost in costs]
+    columns = [first, *COST_COLUMNS]
+    text = markdown_table(table, columns, formatted(dict.fromkeys(COST_COLUMNS, ".1f")))
+    print(f"\n{text}")
+    return write_table(out, stem, table, columns, text)
 
 
 def time_sweep(count: int) -> None:
