@@ -1,20 +1,25 @@
 """The documentation says what is true: the getting-started page's commands, run as a user types
 them after the set-up, exit 0 and print and write what the page shows; its set-up commands are
-the README's; and every relative link of README.md, CHANGELOG.md and docs/ points at a file (and
-a heading) that exists."""
+the README's; every relative link of README.md, CHANGELOG.md and docs/ points at a file (and
+a heading) that exists; every benchmark table a page includes is a result file that says how and
+when it was measured; and the figures the README quotes from those tables are theirs."""
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import shutil
 import subprocess
 import sysconfig
 from dataclasses import dataclass
+from datetime import datetime
 from pathlib import Path
 from typing import Any
 
 import pytest
+
+from vplane_mj.bench.tables import Measurement
 
 ROOT = Path(__file__).parents[1]
 GETTING_STARTED = ROOT / "docs" / "getting-started.md"
@@ -28,6 +33,47 @@ OMITTED = "..."
 """In a page's output: a line of its own skips any lines; within a line, any text."""
 LINK = re.compile(r"!?\[(?:[^\[\]]|\[[^\]]*\])*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
 INLINE_CODE = re.compile(r"(`+)(?:(?!\1).)+?\1", re.S)
+INCLUDE = re.compile(r'^--8<-- "(benchmarks/results/[^"]+)"$', re.M)
+"""A page's include of a benchmark's result table (pymdownx.snippets)."""
+FIGURE = r"([0-9.]+)%?"
+README_FIGURES = (
+    (
+        "barn_protocol_ten_seeds/barn_protocol.md",
+        rf"`vplane_plus` reached the goal without a collision in all {FIGURE} runs, "
+        rf"mean BARN score {FIGURE}; the footprint-aware `dwa` {FIGURE}, {FIGURE} collisions, {FIGURE}; "
+        rf"BARN's own DWA baseline reports {FIGURE}, {FIGURE} collisions, {FIGURE}",
+        [
+            (("vplane_plus",), "runs"),
+            (("vplane_plus",), "mean_score"),
+            (("dwa",), "success_rate"),
+            (("dwa",), "collision_rate"),
+            (("dwa",), "mean_score"),
+            (("BARN: DWA baseline",), "success_rate"),
+            (("BARN: DWA baseline",), "collision_rate"),
+            (("BARN: DWA baseline",), "mean_score"),
+        ],
+    ),
+    (
+        "dynabarn/dynabarn.md",
+        rf"`apf` reached the goal without a collision in {FIGURE} of the runs "
+        rf"\({FIGURE} on the hard third\), `vplane_plus` {FIGURE} \({FIGURE}\), `dwa` {FIGURE}; "
+        rf"DynaBARN's own DWA baseline reports {FIGURE} / {FIGURE} / {FIGURE} on its easy, medium and hard "
+        rf"thirds. The best planners still collide in {FIGURE} of their runs",
+        [
+            (("apf", "all"), "success_rate"),
+            (("apf", "hard"), "success_rate"),
+            (("vplane_plus", "all"), "success_rate"),
+            (("vplane_plus", "hard"), "success_rate"),
+            (("dwa", "all"), "success_rate"),
+            (("DynaBARN: DWA", "easy"), "success_rate"),
+            (("DynaBARN: DWA", "medium"), "success_rate"),
+            (("DynaBARN: DWA", "hard"), "success_rate"),
+            (("apf", "all"), "collision_rate"),
+        ],
+    ),
+)
+"""What the README quotes from a result table: the table, the README's sentence with each figure as
+a group, and for each group the table's cell it quotes (the leading cells of its row, its column)."""
 
 
 @dataclass(frozen=True)
@@ -237,3 +283,62 @@ def test_the_own_planner_page_s_half_speed_planner_reads_the_robot_it_drives(doc
         times[profile] = summary.time_to_goal_s
     # top speeds 0.5, 0.22 and 1.2 m/s: half of each over the same 5.5 m
     assert times["pioneer3dx"] < times["default"] < times["turtlebot3_burger"]
+
+
+INCLUDED = sorted({match for page in PAGES for match in INCLUDE.findall(page.read_text(encoding="utf-8"))})
+
+
+def table_cells(text: str) -> list[dict[str, str]]:
+    """The rows of every Markdown table in `text`, each as its header's cells -> its cells."""
+    lines = text.splitlines()
+    rows, header = [], []
+    for k, line in enumerate(lines):
+        if not line.startswith("|") or line.startswith("|---"):
+            continue
+        cells = [cell.strip() for cell in line.strip().strip("|").split("|")]
+        if k + 1 < len(lines) and lines[k + 1].startswith("|---"):
+            header = cells
+        else:
+            rows.append(dict(zip(header, cells, strict=True)))
+    return rows
+
+
+def result_cell(table: str, row: tuple[str, ...], column: str) -> str:
+    """The cell of a result table's row (its leading cells) and column."""
+    (found,) = [cells for cells in table_cells(table) if tuple(cells.values())[: len(row)] == row]
+    return found[column]
+
+
+def test_the_pages_include_the_benchmarks_result_tables():
+    assert len(INCLUDED) >= 20
+
+
+@pytest.mark.parametrize("included", INCLUDED)
+def test_an_included_result_table_exists_and_says_how_and_when_it_was_measured(included):
+    table = ROOT / included
+    sidecar = json.loads(table.with_suffix(".json").read_text(encoding="utf-8"))
+    assert sidecar["command"].startswith("python benchmarks/"), sidecar["command"]
+    datetime.fromisoformat(sidecar["date"])  # a date, UTC ISO 8601
+    measurement = Measurement(sidecar["command"], sidecar["date"], sidecar["machine"])
+    text = table.read_text(encoding="utf-8")
+    assert text.rstrip("\n").endswith("\n\n" + measurement.line())
+    assert table_cells(text) and table.with_suffix(".csv").is_file()
+
+
+@pytest.mark.parametrize(
+    ("result", "sentence", "cells"), README_FIGURES, ids=[result for result, _, _ in README_FIGURES]
+)
+def test_the_readme_quotes_its_figures_from_the_result_tables(result, sentence, cells):
+    readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    quoted = re.search(sentence, readme)
+    assert quoted is not None, sentence
+    table = (ROOT / "benchmarks" / "results" / result).read_text(encoding="utf-8")
+    for figure, (row, column) in zip(quoted.groups(), cells, strict=True):
+        assert float(figure) == float(result_cell(table, row, column).rstrip("%")), (row, column)
+
+
+def test_result_cells_are_found_by_row_and_column():
+    table = "| planner | third | rate |\n|---|---|---|\n| apf | easy | 50.0% |\n| apf | all | 7.0% |\n"
+    assert result_cell(table, ("apf", "all"), "rate") == "7.0%"
+    with pytest.raises(ValueError):  # two rows
+        result_cell(table, ("apf",), "rate")
