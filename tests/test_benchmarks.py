@@ -5,8 +5,11 @@ from __future__ import annotations
 
 import csv
 import importlib.util
+import json
 import math
+import os
 import re
+import shlex
 import subprocess
 import sys
 from pathlib import Path
@@ -19,6 +22,8 @@ from vplane_mj.sim.loop import run_scenario
 pytestmark = pytest.mark.slow  # a long suite: `python -m pytest -m slow` runs it
 
 BENCHMARKS = Path(__file__).parents[1] / "benchmarks"
+SCRIPT_ENVIRONMENT = {**os.environ, "PYTHONPATH": str(BENCHMARKS.parent)}
+"""The scripts import this checkout's package, whichever the environment has installed."""
 
 
 def run_benchmark(script: str, *arguments: str, cwd: Path) -> str:
@@ -26,6 +31,7 @@ def run_benchmark(script: str, *arguments: str, cwd: Path) -> str:
     done = subprocess.run(
         [sys.executable, str(BENCHMARKS / script), *arguments],
         cwd=cwd,
+        env=SCRIPT_ENVIRONMENT,
         capture_output=True,
         text=True,
         timeout=600,
@@ -49,10 +55,16 @@ def table_rows(text: str, first_cell: str) -> list[list[str]]:
         ("dm_control_env.py", ("single_box", "--steps", "2", "--repeat", "1"), "pixels top 84 x 84", 1),
     ],
 )
-def test_timing_benchmarks_print_their_table(tmp_path, script, arguments, first_cell, number_column):
+def test_timing_benchmarks_print_their_table_and_write_it_with_its_command(
+    tmp_path, script, arguments, first_cell, number_column
+):
     (row,) = table_rows(run_benchmark(script, *arguments, cwd=tmp_path), first_cell)
     number = row[number_column].split()[0]
     assert float(number) > 0, row
+    stem = script.removesuffix(".py")
+    sidecar = json.loads((tmp_path / "logs" / stem / f"{stem}.json").read_text(encoding="utf-8"))
+    assert sidecar["command"] == shlex.join(["python", f"benchmarks/{script}", *arguments])
+    assert first_cell in (tmp_path / "logs" / stem / f"{stem}.md").read_text(encoding="utf-8")
 
 
 def number(cell: str) -> float:
@@ -207,7 +219,10 @@ def test_log_growth_reports_the_size_per_simulated_minute(tmp_path):
     assert number(half[5]) < number(two[5])  # the path's vertices
     assert (tmp_path / "growth" / "log_growth.csv").is_file()
     refused = subprocess.run(
-        [sys.executable, str(BENCHMARKS / "log_growth.py"), "--minutes", "0"], capture_output=True, text=True
+        [sys.executable, str(BENCHMARKS / "log_growth.py"), "--minutes", "0"],
+        env=SCRIPT_ENVIRONMENT,
+        capture_output=True,
+        text=True,
     )
     assert refused.returncode == 2 and "--minutes: positive numbers" in refused.stderr
 
@@ -229,6 +244,7 @@ def run_peer_irsim(cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
         [sys.executable, str(BENCHMARKS / "peer_irsim.py"), *arguments],
         cwd=cwd,
+        env=SCRIPT_ENVIRONMENT,
         capture_output=True,
         text=True,
         timeout=600,
@@ -261,7 +277,12 @@ def test_peer_irsim_without_irsim_says_what_to_install(tmp_path):
         "runpy.run_path(sys.argv[0], run_name='__main__')"
     )
     done = subprocess.run(
-        [sys.executable, "-c", hide_irsim, script], cwd=tmp_path, capture_output=True, text=True, timeout=600
+        [sys.executable, "-c", hide_irsim, script],
+        cwd=tmp_path,
+        env=SCRIPT_ENVIRONMENT,
+        capture_output=True,
+        text=True,
+        timeout=600,
     )
     assert done.returncode == 2 and "Traceback" not in done.stderr
     assert "pip install 'vplane-mj[peers]'" in done.stderr and "(irsim)" in done.stderr
