@@ -29,8 +29,8 @@ import numpy as np
 
 from vplane_mj.bench.tables import formatted, markdown_table, write_table
 from vplane_mj.files import prepare_out_dir
-from vplane_mj.planning.planners.dwa import DwaPlanner
 from vplane_mj.kernels.motion.footprint_clearance import footprint_clearance
+from vplane_mj.planning.planners.dwa import DwaPlanner
 from vplane_mj.planning.protocol.types import Observation
 from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario import parse_scenario
