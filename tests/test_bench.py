@@ -412,8 +412,10 @@ def test_a_killed_sweep_leaves_a_journal_the_rerun_resumes_from(tmp_path, gate):
     finally:
         end_session(process)
     assert len(read_journal(out_dir / JOURNAL)) == 2
-    assert {path.name for path in out_dir.iterdir()} == {JOURNAL}
+    # The killed sweep's lock file stays, stale (the kernel dropped its lock): the rerun takes it.
+    assert {path.name for path in out_dir.iterdir()} == {JOURNAL, ".bench.lock"}
     assert_the_rerun_completes_the_sweep(out_dir, gate, done=2)
+    assert not (out_dir / ".bench.lock").exists()
 
 
 # ----------------------------------------------------------------- runs that fail, workers that die
