@@ -9,7 +9,7 @@ from vplane_mj.geometry import shapes, synthetic
 from vplane_mj.planning.planners import bug2
 from vplane_mj.planning.protocol.types import Observation
 from vplane_mj.robots.facts import robot_radius_m
-from vplane_mj.robots.profiles import ControllerGains
+from vplane_mj.robots.profiles import DEFAULT
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.control import heading_command
 from vplane_mj.sim.loop import run_scenario
@@ -39,7 +39,6 @@ def observe(footprints, position, yaw, goal, time_s=0.0) -> Observation:
 def drive(footprints, start, goal, seconds, plan=None, dt=0.05):
     """A kinematic unicycle under the real heading control, on synthetic scans; (planner, decisions)."""
     plan = plan or planner()
-    gains = ControllerGains()
     position, yaw = np.asarray(start, float), math.atan2(goal[1] - start[1], goal[0] - start[0])
     decisions = []
     for tick in range(int(seconds / dt)):
@@ -48,7 +47,7 @@ def drive(footprints, start, goal, seconds, plan=None, dt=0.05):
         decisions.append((position.copy(), decision))
         if decision.gave_up or obs.distance_to_goal() <= obs.goal_tolerance:
             break
-        v, w = heading_command(*decision.force, yaw, gains)
+        v, w = heading_command(*decision.force, yaw, DEFAULT.gains, DEFAULT.limits)
         position = position + v * dt * np.array([math.cos(yaw), math.sin(yaw)])
         yaw += w * dt
     return plan, decisions

@@ -4,26 +4,26 @@ import math
 
 import pytest
 
-from vplane_mj.robots.profiles import ControllerGains
+from vplane_mj.robots.profiles import DEFAULT
 from vplane_mj.sim.control import WheelPI, heading_command, wheel_targets, wrap_angle
 
-GAINS = ControllerGains()
+GAINS, LIMITS = DEFAULT.gains, DEFAULT.limits
 
 
 def test_aligned_force_drives_straight_at_limited_speed():
-    v, w = heading_command(10.0, 0.0, 0.0, GAINS)
-    assert v == pytest.approx(GAINS.max_speed) and w == 0.0
+    v, w = heading_command(10.0, 0.0, 0.0, GAINS, LIMITS)
+    assert v == pytest.approx(LIMITS.max_speed_mps) and w == 0.0
 
 
 def test_force_behind_turns_in_place_toward_it():
-    v, w = heading_command(-1.0, 0.1, 0.0, GAINS)
-    assert v == 0.0 and w == pytest.approx(GAINS.max_turn_rate)
-    v, w = heading_command(-1.0, -0.1, 0.0, GAINS)
-    assert w == pytest.approx(-GAINS.max_turn_rate)
+    v, w = heading_command(-1.0, 0.1, 0.0, GAINS, LIMITS)
+    assert v == 0.0 and w == pytest.approx(LIMITS.max_turn_rate_radps)
+    v, w = heading_command(-1.0, -0.1, 0.0, GAINS, LIMITS)
+    assert w == pytest.approx(-LIMITS.max_turn_rate_radps)
 
 
 def test_zero_force_stops():
-    assert heading_command(0.0, 0.0, 1.0, GAINS) == (0.0, 0.0)
+    assert heading_command(0.0, 0.0, 1.0, GAINS, LIMITS) == (0.0, 0.0)
 
 
 def test_wrap_angle_range():

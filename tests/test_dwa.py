@@ -12,7 +12,7 @@ from vplane_mj.planning.planners import dwa
 from vplane_mj.planning.protocol.body import DriveLimits, HeadingGains, RobotBody
 from vplane_mj.planning.protocol.types import Observation
 from vplane_mj.robots.facts import robot_body, robot_radius_m
-from vplane_mj.robots.profiles import PROFILES, ControllerGains
+from vplane_mj.robots.profiles import DEFAULT, PROFILES
 from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim.control import heading_command
 from vplane_mj.sim.loop import Run, run_scenario
@@ -36,7 +36,7 @@ def observe(footprints, time_s, position, yaw, goal=GOAL_FAR):
 
 def command(decision, yaw):
     """The (v, omega) that the run loop's heading controller makes of a decision's force."""
-    return heading_command(*decision.force, yaw, ControllerGains())
+    return heading_command(*decision.force, yaw, DEFAULT.gains, DEFAULT.limits)
 
 
 def drive(planner, footprints, speed, ticks, yaw=0.0, start=(0.0, 0.0)):
@@ -50,8 +50,8 @@ def drive(planner, footprints, speed, ticks, yaw=0.0, start=(0.0, 0.0)):
 
 
 def test_the_default_robots_window_is_the_controllers():
-    gains, limits = ControllerGains(), planner().limits
-    assert (limits.max_speed_mps, limits.max_turn_rate_radps) == (gains.max_speed, gains.max_turn_rate)
+    limits = planner().limits
+    assert limits == DEFAULT.limits
     assert (limits.max_accel_mps2, limits.max_turn_accel_radps2) == (4.0, 30.0)
     assert planner().lookahead == 1.0
 
@@ -61,7 +61,7 @@ def test_the_force_maps_back_to_the_command_through_the_heading_controller(yaw):
     for speed in (0.0, 0.05, 0.3, 0.5):
         for turn in (-2.5, -1.0, 0.0, 0.4, 2.5):
             force = dwa.force_for_command(speed, turn, yaw, HeadingGains())
-            v, omega = heading_command(*force, yaw, ControllerGains())
+            v, omega = heading_command(*force, yaw, DEFAULT.gains, DEFAULT.limits)
             assert v == pytest.approx(speed, abs=2 * dwa.CREEP_SPEED) and omega == pytest.approx(
                 turn, abs=1e-9
             )
@@ -233,13 +233,13 @@ def test_a_scenario_drives_the_jackal_at_barns_baseline_speed(tmp_path):
 
 @pytest.mark.parametrize("profile", ["jackal", "pioneer3dx", "turtlebot3_burger"])
 def test_the_force_maps_back_to_the_command_through_the_robots_own_controller(profile):
-    body, gains = robot_body(profile), PROFILES[profile].gains
+    body, robot = robot_body(profile), PROFILES[profile]
     limits = dwa.DwaPlanner.build({}, body).limits
     for yaw in (0.0, 2.0, -3.0):
         for speed in np.linspace(0.0, limits.max_speed_mps, 5):
             for turn in np.linspace(-limits.max_turn_rate_radps, limits.max_turn_rate_radps, 7):
                 force = dwa.force_for_command(float(speed), float(turn), yaw, body.gains)
-                v, omega = heading_command(*force, yaw, gains)
+                v, omega = heading_command(*force, yaw, robot.gains, robot.limits)
                 assert v == pytest.approx(speed, abs=2 * dwa.CREEP_SPEED)
                 assert omega == pytest.approx(turn, abs=1e-9)
 

@@ -18,6 +18,7 @@ from vplane_mj.planning.protocol import registry
 from vplane_mj.planning.protocol.params import PlannerParams
 from vplane_mj.planning.protocol.types import Decision, Observation
 from vplane_mj.robots.facts import robot_radius_m
+from vplane_mj.robots.profiles import DEFAULT
 from vplane_mj.sim import control
 from vplane_mj.sim import loop as sim
 from vplane_mj.sim.world import build_model
@@ -53,7 +54,7 @@ def test_every_planner_gives_finite_forces_on_adversarial_scans(name, ticks):
         assert np.all(np.isfinite(decision.force)), (name, tick, decision)
         for part in decision.components.values():
             assert np.all(np.isfinite(part)), (name, tick, decision.components)
-        v, omega = control.heading_command(*decision.force, seen["yaw"], control.ControllerGains())
+        v, omega = control.heading_command(*decision.force, seen["yaw"], DEFAULT.gains, DEFAULT.limits)
         assert math.isfinite(v) and math.isfinite(omega)
 
 
@@ -84,7 +85,7 @@ def test_virtual_plane_geometry_with_coincident_points_is_finite(e2, robot, goal
 
 @pytest.mark.parametrize("force", [(math.nan, 0.0), (math.inf, 1.0), (-math.inf, math.inf), (0.0, 0.0)])
 def test_heading_control_stops_on_a_force_without_a_direction(force):
-    assert control.heading_command(*force, 0.3, control.ControllerGains()) == (0.0, 0.0)
+    assert control.heading_command(*force, 0.3, DEFAULT.gains, DEFAULT.limits) == (0.0, 0.0)
 
 
 class _BrokenPlanner:

@@ -107,11 +107,7 @@ def test_the_default_profile_is_todays_robot_exactly():
     assert default.sensor_height_m == SONAR_MOUNT_HEIGHT_M
     facts = robot_facts()
     assert (default.wheel_radius_m, default.track_m) == (facts.wheel_radius_m, facts.track_m)
-    limits = default.limits
-    assert (limits.max_speed_mps, limits.max_turn_rate_radps) == (
-        ControllerGains().max_speed,
-        ControllerGains().max_turn_rate,
-    )
+    assert (default.limits.max_speed_mps, default.limits.max_turn_rate_radps) == (0.5, 2.5)
 
 
 @pytest.mark.parametrize("name", NAMES)

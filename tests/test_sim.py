@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from vplane_mj.planning import Decision, Observation, Planner, register_planner
-from vplane_mj.robots.profiles import ControllerGains
+from vplane_mj.robots.profiles import DEFAULT, PROFILES
 from vplane_mj.sim.control import within_limits
 from vplane_mj.sim.loop import Run, run_scenario
 from vplane_mj.sim.metrics import barn_score
@@ -193,8 +193,34 @@ def test_a_planner_can_command_a_reverse_and_reads_the_wheels_speeds(scenario_fr
     assert max(v for t, (v, _) in run.planner.seen if t > 3.0) > 0.4
 
 
+class _Overdriver(Planner):
+    """Commands far beyond any robot's top speed and turn rate on its first tick, then pulls
+    along the heading with a force far beyond the top speed's."""
+
+    name = "overdriver"
+    summary = "asks for more than the robot can do"
+    citation = ""
+
+    def step(self, obs: Observation) -> Decision:
+        decision = Decision(force=1e3 * np.array([math.cos(obs.yaw), math.sin(obs.yaw)]), mode="normal")
+        if obs.time_s == 0.0:
+            decision.command = (9.0, -9.0)
+        return decision
+
+
+@pytest.mark.parametrize("profile", list(PROFILES))
+def test_a_run_holds_its_commands_within_its_robots_limits(scenario_from, own_registry, profile):
+    register_planner(_Overdriver)
+    run = Run(scenario_from(OPEN.format(yaw=0.0), ["planner.name=overdriver", f"robot.profile={profile}"]))
+    limits = PROFILES[profile].limits
+    run.step()  # the command, clamped
+    assert run.command == (limits.max_speed_mps, -limits.max_turn_rate_radps)
+    run.step()  # the heading controller's answer to the force
+    assert run.command[0] == limits.max_speed_mps and abs(run.command[1]) < limits.max_turn_rate_radps
+
+
 def test_a_commanded_speed_and_turn_rate_are_held_within_the_robot_limits():
-    gains = ControllerGains()
-    assert within_limits((-9.0, 9.0), gains) == (-gains.max_speed, gains.max_turn_rate)
-    assert within_limits((0.2, -0.1), gains) == (0.2, -0.1)
-    assert within_limits((math.nan, 1.0), gains) == (0.0, 0.0)
+    limits = DEFAULT.limits
+    assert within_limits((-9.0, 9.0), limits) == (-limits.max_speed_mps, limits.max_turn_rate_radps)
+    assert within_limits((0.2, -0.1), limits) == (0.2, -0.1)
+    assert within_limits((math.nan, 1.0), limits) == (0.0, 0.0)

@@ -120,7 +120,7 @@ class VPlaneNavDmEnv(dm_env.Environment):
 
     def action_spec(self) -> specs.BoundedArray:
         """(2,) float64, named after the action kind: `force` (world frame, units of force,
-        [-1, 1] each) or `velocity` (v m/s, omega rad/s, within the controller's limits)."""
+        [-1, 1] each) or `velocity` (v m/s, omega rad/s, within the robot's limits)."""
         return self._action_spec
 
     def reward_spec(self) -> specs.Array:

@@ -96,10 +96,9 @@ class PlannerPolicy:
                     "which a force cannot carry: make the environment with action='velocity'"
                 )
             return np.array(decision.force, dtype=float)
-        gains = run.drive.gains
         if decision.command is not None:
-            return np.array(within_limits(decision.command, gains))
+            return np.array(within_limits(decision.command, run.drive.limits))
         fx, fy = float(decision.force[0]), float(decision.force[1])
         if not (math.isfinite(fx) and math.isfinite(fy)):  # the run ends as `error`; so does the episode
             return np.full(2, np.nan)
-        return np.array(heading_command(fx, fy, observation.yaw, gains))
+        return np.array(heading_command(fx, fy, observation.yaw, run.drive.gains, run.drive.limits))

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from vplane_mj.errors import VPlaneError
+from vplane_mj.planning.protocol.body import DriveLimits
 from vplane_mj.planning.protocol.types import Decision, Observation
 from vplane_mj.robots.facts import SONAR_MOUNT_RADIUS_M
 from vplane_mj.robots.profiles import PROFILES, ControllerGains
@@ -130,8 +131,11 @@ class NavigationTask:
         self.reward_weights = reward or Reward()
         self.expose_observation = expose_observation
         first = self.episode_scenario(0)  # the overrides checked now; robot and ring are every episode's
-        self.gains: ControllerGains = PROFILES[first.robot.profile].gains
-        """The robot's controller limits, which bound a `velocity` action."""
+        robot = PROFILES[first.robot.profile]
+        self.gains: ControllerGains = robot.gains
+        """The robot's controller gains, whose heading law a `velocity` action's force follows."""
+        self.limits: DriveLimits = robot.limits
+        """The robot's top speed (m/s) and turn rate (rad/s), which bound a `velocity` action."""
         sensors = first.sensors
         self.sonar_count = sensors.count
         self.reach_m = sensors.range_max + SONAR_MOUNT_RADIUS_M
@@ -220,11 +224,11 @@ class NavigationTask:
         }
 
     def action_bounds(self) -> Bounds:
-        """A world-frame force, or a body speed (m/s) and turn rate (rad/s) within the
-        controller's limits; float64, so that a planner's force passes unchanged."""
+        """A world-frame force, or a body speed (m/s) and turn rate (rad/s) within the robot's
+        top ones (its profile's limits); float64, so that a planner's force passes unchanged."""
         if self.action == "force":
             return Bounds.box((2,), np.float64, -FORCE_BOUND, FORCE_BOUND)
-        high = np.array([self.gains.max_speed, self.gains.max_turn_rate])
+        high = np.array([self.limits.max_speed_mps, self.limits.max_turn_rate_radps])
         return Bounds.box((2,), np.float64, -high, high)
 
     # -- from an action to a decision --------------------------------------------------------
@@ -235,13 +239,13 @@ class NavigationTask:
             raise ValueError(f"step: an action is 2 numbers, got shape {action.shape}")
         if self.action == "force":
             return Decision(force=action.copy(), mode=AGENT_MODE), None
-        gains = self.gains
-        speed = float(np.clip(action[0], -gains.max_speed, gains.max_speed))
-        turn = float(np.clip(action[1], -gains.max_turn_rate, gains.max_turn_rate))
+        top_speed, top_turn = self.limits.max_speed_mps, self.limits.max_turn_rate_radps
+        speed = float(np.clip(action[0], -top_speed, top_speed))
+        turn = float(np.clip(action[1], -top_turn, top_turn))
         if not (math.isfinite(speed) and math.isfinite(turn)):
             return Decision(force=np.full(2, np.nan), mode=AGENT_MODE), None
         # The decision's force is one the heading controller would answer with this speed.
-        force = np.array([math.cos(yaw), math.sin(yaw)]) * speed / gains.speed_gain
+        force = np.array([math.cos(yaw), math.sin(yaw)]) * speed / self.gains.speed_gain
         return Decision(force=force, mode=AGENT_MODE), (speed, turn)
 
     # -- what the agent sees and earns -------------------------------------------------------

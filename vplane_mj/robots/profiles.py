@@ -27,12 +27,11 @@ Point = tuple[float, float]
 
 @dataclass(frozen=True)
 class ControllerGains:
-    """Gains and limits of the controller (units in the field comments)."""
+    """Gains of the controller (units in the field comments); the speed and turn rate it commands
+    are bounded by the profile's `limits`."""
 
     speed_gain: float = 0.5  # k_v: (m/s) per unit of force
     turn_gain: float = 3.0  # k_w: (rad/s) per rad of heading error
-    max_speed: float = 0.5  # m/s
-    max_turn_rate: float = 2.5  # rad/s
     max_wheel_speed: float = 15.0  # rad/s (0.6 m/s at the rim of a 0.04 m wheel)
     wheel_kp: float = 0.06  # N m per rad/s of wheel speed error
     wheel_ki: float = 0.6  # N m per rad of accumulated wheel speed error
@@ -131,12 +130,12 @@ DEFAULT = RobotProfile(
     sources=_frozen(
         {
             "model": "models/robot.xml",
-            "limits": "vplane_mj/control.py ControllerGains (max_speed, max_turn_rate)",
+            "limits": "chosen: the top speed and turn rate the controller always held the robot to",
             "accelerations": "measured: what the 0.3 N m motors deliver from standing, the commands "
             "stepped as today (tests/test_profiles.py): 4.0 m/s^2 straight (10-90 % of the top "
             "speed; 4.6 at the start); turning, 16.5 rad/s^2 from 10 to 90 % of the top turn rate and "
             "37 at the start, of which the dynamic window has always assumed 30",
-            "gains": "vplane_mj/control.py ControllerGains",
+            "gains": "chosen: ControllerGains' defaults, the controller's gains as they always were",
             "sensors": "vplane_mj/scenario/spec.py SensorSpec",
             "imu": "chosen: at the chassis' centre, the Jackal's gyro noise and drift",
         }
@@ -166,8 +165,6 @@ JACKAL = RobotProfile(
     gains=ControllerGains(
         speed_gain=2.0,
         turn_gain=3.0,
-        max_speed=2.0,
-        max_turn_rate=4.0,
         max_wheel_speed=24.5,
         wheel_kp=2.0,
         wheel_ki=20.0,
@@ -289,8 +286,6 @@ PIONEER_3DX = RobotProfile(
     gains=ControllerGains(
         speed_gain=1.2,
         turn_gain=3.0,
-        max_speed=1.2,
-        max_turn_rate=5.236,
         max_wheel_speed=14.8,
         wheel_kp=1.1,
         wheel_ki=11.0,
@@ -362,8 +357,6 @@ TURTLEBOT3_BURGER = RobotProfile(
     gains=ControllerGains(
         speed_gain=0.22,
         turn_gain=3.0,
-        max_speed=0.22,
-        max_turn_rate=2.84,
         max_wheel_speed=8.3,
         wheel_kp=0.016,
         wheel_ki=0.16,

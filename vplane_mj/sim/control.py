@@ -18,8 +18,11 @@ from vplane_mj.planning.protocol.vectors import wrap_angle
 from vplane_mj.robots.profiles import ControllerGains
 
 
-def heading_command(fx: float, fy: float, yaw: float, gains: ControllerGains) -> tuple[float, float]:
-    """(v, omega) that turns the robot toward the force and drives along it when aligned.
+def heading_command(
+    fx: float, fy: float, yaw: float, gains: ControllerGains, limits: DriveLimits
+) -> tuple[float, float]:
+    """(v, omega) in m/s and rad/s that turns the robot toward the force and drives along it
+    when aligned, within the drive's top speed and turn rate.
 
     A force too weak to have a direction, or not finite, stops the robot.
     """
@@ -27,21 +30,20 @@ def heading_command(fx: float, fy: float, yaw: float, gains: ControllerGains) ->
     if magnitude < 1e-9 or not math.isfinite(magnitude):
         return 0.0, 0.0
     error = wrap_angle(math.atan2(fy, fx) - yaw)
-    speed = min(gains.max_speed, gains.speed_gain * magnitude * max(0.0, math.cos(error)))
-    turn = max(-gains.max_turn_rate, min(gains.max_turn_rate, gains.turn_gain * error))
+    top_speed, top_turn = limits.max_speed_mps, limits.max_turn_rate_radps
+    speed = min(top_speed, gains.speed_gain * magnitude * max(0.0, math.cos(error)))
+    turn = max(-top_turn, min(top_turn, gains.turn_gain * error))
     return speed, turn
 
 
-def within_limits(command: tuple[float, float], gains: ControllerGains) -> tuple[float, float]:
-    """A body speed (m/s, either way) and turn rate (rad/s) clamped to the robot's top ones; a
+def within_limits(command: tuple[float, float], limits: DriveLimits) -> tuple[float, float]:
+    """A body speed (m/s, either way) and turn rate (rad/s) clamped to the drive's top ones; a
     non-finite value stops the robot."""
     speed, turn = command
     if not (math.isfinite(speed) and math.isfinite(turn)):
         return 0.0, 0.0
-    return (
-        max(-gains.max_speed, min(gains.max_speed, float(speed))),
-        max(-gains.max_turn_rate, min(gains.max_turn_rate, float(turn))),
-    )
+    top_speed, top_turn = limits.max_speed_mps, limits.max_turn_rate_radps
+    return max(-top_speed, min(top_speed, float(speed))), max(-top_turn, min(top_turn, float(turn)))
 
 
 def wheel_targets(

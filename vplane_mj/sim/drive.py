@@ -54,9 +54,10 @@ class Drive:
         self.model, self.data = model, data
         robot = PROFILES[profile]
         self.gains = robot.gains
+        self.limits = robot.limits
         self.geometry = robot_geometry(profile)
         self.track_m = self.geometry["track_m"] * robot.track_scale
-        self.ramp = CommandRamp(robot.limits) if robot.ramped else None
+        self.ramp = CommandRamp(self.limits) if robot.ramped else None
         dt = model.opt.timestep
         self.motor_steps = max(1, round(1.0 / (self.gains.motor_rate_hz * dt)))
         self.motor_dt = self.motor_steps * dt

@@ -396,11 +396,10 @@ class Run:
         assert self._belief is not None and decision is not None, "reporting a tick not planned"
         believed_xy, believed_yaw = self._belief
         if command is None and decision.command is not None:
-            command = within_limits(decision.command, self.drive.gains)
+            command = within_limits(decision.command, self.drive.limits)
         if command is None:
-            command = heading_command(
-                float(decision.force[0]), float(decision.force[1]), believed_yaw, self.drive.gains
-            )
+            fx, fy = float(decision.force[0]), float(decision.force[1])
+            command = heading_command(fx, fy, believed_yaw, self.drive.gains, self.drive.limits)
         self.command = command
         self.times.append(self.data.time)
         self.positions.append(self.position)
