@@ -57,6 +57,7 @@ def test_a_kind_the_profile_does_not_carry_takes_that_kinds_generic_defaults():
     assert (laser.kind, laser.fov_deg, laser.beams) == ("laser", 360.0, 360)
     sonar = scenario("jackal", ["sensors.kind=sonar"]).sensors
     assert (sonar.kind, sonar.count, sonar.range_max) == ("sonar", 16, 3.0)
+    assert all(getattr(sonar, key) == value for key, value in PROFILES["default"].sensors.items())
     # A key the scenario gives wins over the profile's.
     assert scenario("jackal", ["sensors.beams=16"]).sensors.beams == 16
 

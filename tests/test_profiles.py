@@ -23,7 +23,6 @@ from vplane_mj.robots.facts import (
     robot_facts,
 )
 from vplane_mj.robots.profiles import DRIVES, PROFILES, ControllerGains, RobotProfile, robot_profile
-from vplane_mj.scenario.spec import SensorSpec
 from vplane_mj.sim.control import WheelPI, wheel_targets
 
 PREFIX = "robot/"
@@ -95,14 +94,13 @@ def test_the_default_profile_is_todays_robot_exactly():
     assert default.model_file == "robot.xml"
     assert default.footprint_m is None and default.sonar_mounts is None
     assert default.gains == ControllerGains()
-    spec = SensorSpec()
     assert dict(default.sensors) == {
         "kind": "sonar",
-        "count": spec.count,
-        "rays_per_sonar": spec.rays_per_sonar,
-        "beam_deg": spec.beam_deg,
-        "range_max": spec.range_max,
-        "rate_hz": spec.rate_hz,
+        "count": 16,
+        "rays_per_sonar": 3,
+        "beam_deg": 20.0,
+        "range_max": 3.0,
+        "rate_hz": 20.0,
     }
     assert default.sensor_height_m == SONAR_MOUNT_HEIGHT_M
     facts = robot_facts()

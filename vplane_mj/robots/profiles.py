@@ -136,7 +136,7 @@ DEFAULT = RobotProfile(
             "speed; 4.6 at the start); turning, 16.5 rad/s^2 from 10 to 90 % of the top turn rate and "
             "37 at the start, of which the dynamic window has always assumed 30",
             "gains": "chosen: ControllerGains' defaults, the controller's gains as they always were",
-            "sensors": "vplane_mj/scenario/spec.py SensorSpec",
+            "sensors": "chosen: the sonar ring the robot always had; the [sensors] defaults read it",
             "imu": "chosen: at the chassis' centre, the Jackal's gyro noise and drift",
         }
     ),

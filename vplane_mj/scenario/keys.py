@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from vplane_mj.geometry.shapes import Box, Cup, Cylinder, HShape, Obstacle, Wall
-from vplane_mj.robots.profiles import PROFILES
+from vplane_mj.robots.profiles import DEFAULT, PROFILES
 from vplane_mj.scenario.fields import Field, Invalid, join_key
 
 FORMAT = 1
@@ -94,15 +94,8 @@ KIND_KEYS = {
     "laser": ("fov_deg", "beams", "range_min"),
 }
 """The `[sensors]` keys that belong to one kind of sensor; the rest apply to both."""
-GENERIC_SENSORS: dict[str, dict[str, str | int | float]] = {
-    "sonar": {
-        "kind": "sonar",
-        "count": 16,
-        "rays_per_sonar": 3,
-        "beam_deg": 20.0,
-        "range_max": 3.0,
-        "rate_hz": 20.0,
-    },
+GENERIC_SENSORS: dict[str, Mapping[str, str | int | float]] = {
+    "sonar": DEFAULT.sensors,
     "laser": {
         "kind": "laser",
         "fov_deg": 360.0,
@@ -113,7 +106,8 @@ GENERIC_SENSORS: dict[str, dict[str, str | int | float]] = {
     },
 }
 """The `[sensors]` defaults of a kind the robot's profile does not carry (a laser on the default
-robot, say): a 16-sonar ring as the default robot's, a 360-degree laser of 1-degree beams."""
+robot, say): the default robot's own sonar ring (its profile's table, read), a 360-degree laser
+of 1-degree beams. `SensorSpec`'s defaults are these tables too."""
 
 RUN_FIELDS = {
     "seed": Field("int", ge=0, lt=2**32),

@@ -17,6 +17,9 @@ import tomli_w
 from vplane_mj.files import write_atomically
 from vplane_mj.geometry.motion import Moving
 from vplane_mj.geometry.shapes import Obstacle
+from vplane_mj.scenario.keys import GENERIC_SENSORS
+
+_SONAR, _LASER = GENERIC_SENSORS["sonar"], GENERIC_SENSORS["laser"]
 
 
 @dataclass(frozen=True)
@@ -65,7 +68,8 @@ class SensorSpec:
     """The range sensor, resolved against the robot's profile: its `kind`, noise (m), dropout
     probability, range (m) and rate (Hz); a sonar's layout and beam (deg); a laser's field of
     view (deg), beams and shortest range (m). The keys of the other kind keep their defaults
-    and mean nothing.
+    and mean nothing. The defaults are the default robot's sonar ring and the generic laser's
+    keys (`keys.GENERIC_SENSORS`, read).
 
     Sensor faults: `crosstalk` is the probability that a reading is a spurious short
     echo, `dead` the indices of sonars that never echo. `pose` is where the planner's
@@ -80,15 +84,15 @@ class SensorSpec:
     dead: tuple[int, ...] = ()
     pose: str = "truth"
     odometry_noise: float = 0.0
-    count: int = 16
-    rays_per_sonar: int = 3
-    beam_deg: float = 20.0
-    range_max: float = 3.0
-    rate_hz: float = 20.0
-    fov_deg: float = 360.0
-    beams: int = 360
-    range_min: float = 0.1
-    kind: str = "sonar"
+    count: int = int(_SONAR["count"])
+    rays_per_sonar: int = int(_SONAR["rays_per_sonar"])
+    beam_deg: float = float(_SONAR["beam_deg"])
+    range_max: float = float(_SONAR["range_max"])
+    rate_hz: float = float(_SONAR["rate_hz"])
+    fov_deg: float = float(_LASER["fov_deg"])
+    beams: int = int(_LASER["beams"])
+    range_min: float = float(_LASER["range_min"])
+    kind: str = str(_SONAR["kind"])
 
 
 @dataclass(frozen=True)
