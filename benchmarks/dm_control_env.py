@@ -35,7 +35,7 @@ from vplane_mj.envs.task import NavigationTask
 from vplane_mj.files import model_path, prepare_out_dir
 from vplane_mj.geometry import shapes
 from vplane_mj.robots.facts import BASE_BODY
-from vplane_mj.robots.profiles import PROFILES
+from vplane_mj.robots.profiles import robot_profile
 from vplane_mj.scenario import Scenario, load_scenario
 from vplane_mj.sim.world import BORDER_SIDES, OBSTACLE_HEIGHT_M, SonarLayout, build_model
 
@@ -111,7 +111,7 @@ def mjcf_model(scenario: Scenario) -> mujoco.MjModel:
             shape = {"type": "box", "size": [*piece.half, half_z], "pos": [*piece.center, half_z]}
             shape["euler"] = [0.0, 0.0, piece.yaw]
         statics.add("geom", name=name, material=material, **shape)
-    robot = mjcf.from_path(str(model_path(PROFILES[scenario.robot.profile].model_file)))
+    robot = mjcf.from_path(str(model_path(robot_profile(scenario.robot.profile).model_file)))
     base = robot.find("body", BASE_BODY)
     layout = SonarLayout.from_spec(scenario.sensors, scenario.robot.profile)
     for k, bearing in enumerate(layout.bearings):

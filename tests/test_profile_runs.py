@@ -1,6 +1,7 @@
 """Real runs of the robot profiles: the laser read at its own rate, the footprint in the summary
 and the log, the pioneer's sonars at their places."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -8,7 +9,7 @@ import pytest
 
 import vplane_mj
 from vplane_mj.logs.reader import iter_messages, read_log
-from vplane_mj.robots.profiles import PROFILES
+from vplane_mj.robots.profiles import PROFILES, ProfileError
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.loop import Run
 
@@ -79,3 +80,11 @@ def test_the_pioneer_sonars_show_on_a_one_degree_scan(tmp_path):
     slots = {(heading + 180) % 360 for heading in headings}
     echoes = {index for index, value in enumerate(scan.ranges) if math.isfinite(value)}
     assert echoes and echoes <= slots  # readings only where a sonar looks
+
+
+def test_a_run_of_a_scenario_with_an_unknown_profile_suggests_the_name():
+    # A scenario file is checked as it is read; one changed in code is checked when it runs.
+    scenario = load_scenario("open_field")
+    wrong = dataclasses.replace(scenario, robot=dataclasses.replace(scenario.robot, profile="turtlebot3"))
+    with pytest.raises(ProfileError, match="did you mean 'turtlebot3_burger'"):
+        Run(wrong)

@@ -20,9 +20,19 @@ from vplane_mj.robots.facts import (
     WHEEL_JOINTS,
     WHEEL_MOTORS,
     read_robot_facts,
+    robot_body,
     robot_facts,
+    robot_geometry,
+    robot_radius_m,
 )
-from vplane_mj.robots.profiles import DRIVES, PROFILES, ControllerGains, RobotProfile, robot_profile
+from vplane_mj.robots.profiles import (
+    DRIVES,
+    PROFILES,
+    ControllerGains,
+    ProfileError,
+    RobotProfile,
+    robot_profile,
+)
 from vplane_mj.sim.control import WheelPI, wheel_targets
 
 PREFIX = "robot/"
@@ -85,8 +95,19 @@ def test_profiles_are_named_by_their_keys_and_unknown_names_are_refused():
         if profile.drive == "differential":
             assert profile.track_scale == 1.0
     assert robot_profile("jackal") is PROFILES["jackal"]
-    with pytest.raises(VPlaneError, match="unknown robot profile 'husky'; known: default, jackal"):
+    known = "known: default, jackal, pioneer3dx, turtlebot3_burger"
+    with pytest.raises(ProfileError, match=f"^unknown robot profile 'husky'; {known}$"):
         robot_profile("husky")
+    suggestion = "did you mean 'jackal'\\?"
+    with pytest.raises(ProfileError, match=f"^unknown robot profile 'jackl'; {known}; {suggestion}$"):
+        robot_profile("jackl")
+
+
+@pytest.mark.parametrize("lookup", [robot_facts, robot_geometry, robot_radius_m, robot_body])
+def test_a_profile_named_from_outside_is_looked_up_with_a_suggestion(lookup):
+    with pytest.raises(ProfileError, match="did you mean 'pioneer3dx'") as raised:
+        lookup("pioneer3d")
+    assert isinstance(raised.value, VPlaneError) and not isinstance(raised.value, KeyError)
 
 
 def test_the_default_profile_is_todays_robot_exactly():

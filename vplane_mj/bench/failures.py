@@ -21,7 +21,7 @@ from typing import Any, TypeVar
 from vplane_mj.bench.job import Job
 from vplane_mj.files import write_atomically
 from vplane_mj.planning.protocol.registry import command_line_spec
-from vplane_mj.robots.profiles import PROFILES
+from vplane_mj.robots.profiles import robot_profile
 from vplane_mj.sim.failure import FailureKind, RunFailure, failure_of
 from vplane_mj.sim.summary import Outcome, RunSummary
 from vplane_mj.version import __version__
@@ -74,7 +74,7 @@ def error_row(job: Job, failure: RunFailure) -> dict[str, Any]:
         seed=job.seed,
         outcome=Outcome.ERROR,
         robot_profile=profile,
-        sensor_kind=document.get("sensors", {}).get("kind", PROFILES[profile].sensors["kind"]),
+        sensor_kind=document.get("sensors", {}).get("kind", robot_profile(profile).sensors["kind"]),
         score=0.0,  # not a success: it counts against the planner's mean score
         message=failure.message,
         version=__version__,

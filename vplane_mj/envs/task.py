@@ -23,7 +23,7 @@ from vplane_mj.errors import VPlaneError
 from vplane_mj.planning.protocol.body import DriveLimits
 from vplane_mj.planning.protocol.types import Decision, Observation
 from vplane_mj.robots.facts import SONAR_MOUNT_RADIUS_M
-from vplane_mj.robots.profiles import PROFILES, ControllerGains
+from vplane_mj.robots.profiles import ControllerGains, robot_profile
 from vplane_mj.scenario import MAX_ARENA_M, Scenario, load_scenario, parse_scenario
 from vplane_mj.sim.loop import Run
 from vplane_mj.sim.summary import Outcome
@@ -131,7 +131,7 @@ class NavigationTask:
         self.reward_weights = reward or Reward()
         self.expose_observation = expose_observation
         first = self.episode_scenario(0)  # the overrides checked now; robot and ring are every episode's
-        robot = PROFILES[first.robot.profile]
+        robot = robot_profile(first.robot.profile)
         self.gains: ControllerGains = robot.gains
         """The robot's controller gains, whose heading law a `velocity` action's force follows."""
         self.limits: DriveLimits = robot.limits

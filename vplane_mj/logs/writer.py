@@ -107,7 +107,7 @@ from vplane_mj.logs.scene import (
 from vplane_mj.planning.protocol.events import EVENT_POINTS, Event, EventKind
 from vplane_mj.planning.protocol.types import Decision
 from vplane_mj.robots.facts import robot_body
-from vplane_mj.robots.profiles import PROFILES
+from vplane_mj.robots.profiles import robot_profile
 from vplane_mj.scenario import Scenario
 from vplane_mj.sim.loop import Tick
 from vplane_mj.version import __version__
@@ -265,7 +265,7 @@ class McapLog:
         self._path = PathSimplifier(PATH_TOLERANCE_M, max_vertices=PATH_MAX_VERTICES)
         self._held_paths: list[tuple[fm.SceneUpdate, int]] = []  # /path messages not yet written
         self._next_path_chunk_s = PATH_CHUNK_PERIOD_S
-        self._scan_pose = scene.pose(0.0, 0.0, PROFILES[scenario.robot.profile].sensor_height_m)
+        self._scan_pose = scene.pose(0.0, 0.0, robot_profile(scenario.robot.profile).sensor_height_m)
         self._scan_slots, self._scan_angles = scan_slots(self.bearings)
         self._path_dirty = False
         self._modes: dict[str, str] = {}  # mode -> its JSON string

@@ -20,7 +20,7 @@ import numpy as np
 from vplane_mj.files import model_path
 from vplane_mj.planning.protocol.body import HeadingGains, RobotBody
 from vplane_mj.robots.mjcf_reader import MjcfReader, PosedGeom
-from vplane_mj.robots.profiles import PROFILES
+from vplane_mj.robots.profiles import robot_profile
 
 BASE_BODY = "base_link"
 WHEEL_JOINTS = ("wheel_left", "wheel_right")
@@ -92,7 +92,7 @@ def footprint_radius(geoms: list[PosedGeom], origin: np.ndarray) -> float:
 @functools.cache
 def robot_facts(profile: str = "default") -> RobotFacts:
     """The facts of a profile's model (models/robot.xml for the default robot)."""
-    return read_robot_facts(model_path(PROFILES[profile].model_file))
+    return read_robot_facts(model_path(robot_profile(profile).model_file))
 
 
 def robot_geometry(profile: str = "default") -> dict[str, float]:
@@ -110,7 +110,7 @@ def robot_body(profile: str = "default", sensor_kind: str | None = None) -> Robo
     """The robot as its planner sees it (`vplane_mj.planning.RobotBody`): the profile's outline
     (the model's disc for a round robot), limits, heading gains and sensor kind (default: the
     profile's own)."""
-    chosen = PROFILES[profile]
+    chosen = robot_profile(profile)
     details = {
         "limits": chosen.limits,
         "gains": HeadingGains(chosen.gains.speed_gain, chosen.gains.turn_gain),

@@ -18,7 +18,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
-from vplane_mj.errors import VPlaneError
+from vplane_mj.errors import VPlaneError, did_you_mean, shown
 from vplane_mj.planning.protocol.body import DriveLimits
 
 DRIVES = ("differential", "skid_steer")
@@ -405,8 +405,14 @@ PROFILES: dict[str, RobotProfile] = {
 }
 
 
+class ProfileError(VPlaneError):
+    """A robot profile name that names no profile."""
+
+
 def robot_profile(name: str) -> RobotProfile:
-    """The profile `name`; a VPlaneError names the known ones otherwise."""
+    """The profile `name`: how every module looks a profile up by name. A ProfileError lists
+    the profiles and the closest name otherwise."""
     if name not in PROFILES:
-        raise VPlaneError(f"unknown robot profile {name!r}; known: {', '.join(PROFILES)}")
+        hint = did_you_mean(name, PROFILES)
+        raise ProfileError(f"unknown robot profile {shown(name)}; known: {', '.join(PROFILES)}{hint}")
     return PROFILES[name]

@@ -22,7 +22,7 @@ from vplane_mj.planning.protocol import registry
 from vplane_mj.planning.protocol.params import ParamError
 from vplane_mj.planning.protocol.plugins import is_import_spec
 from vplane_mj.robots.facts import robot_facts
-from vplane_mj.robots.profiles import PROFILES
+from vplane_mj.robots.profiles import robot_profile
 from vplane_mj.scenario.fields import (
     Invalid,
     checked,
@@ -142,7 +142,7 @@ def read_robot(doc: Mapping[str, Any]) -> RobotSpec:
     values = read_fields(sub_table(doc, "robot", required=True), "robot", ROBOT_FIELDS)
     values.setdefault("profile", "default")
     values.setdefault("start_yaw", _facing(values["start"], values["goal"]))
-    values.setdefault("wheel_friction", PROFILES[values["profile"]].wheel_friction)
+    values.setdefault("wheel_friction", robot_profile(values["profile"]).wheel_friction)
     limit = robot_facts(values["profile"]).torque_limit_nm
     for index, bias in enumerate(values.get("motor_bias_nm", ())):
         if abs(bias) > limit:
@@ -174,7 +174,7 @@ def read_planner(
                 "named on the command line (--planner module:Class) or registered in code"
             )
         raise Invalid("planner.name", reason)
-    overrides = {**PROFILES[profile].planner_settings.get(name, {})}
+    overrides = {**robot_profile(profile).planner_settings.get(name, {})}
     overrides.update((key, value) for key, value in table.items() if key != "name")
     try:
         params = registry.PLANNERS[name].Params.checked(overrides, name)
@@ -191,7 +191,7 @@ def read_sensors(doc: Mapping[str, Any], profile: str = "default") -> SensorSpec
     MAX_SONAR_RANGE_M."""
     table = sub_table(doc, "sensors")
     given = read_fields(table, "sensors", SENSOR_FIELDS)
-    robot = PROFILES[profile]
+    robot = robot_profile(profile)
     kind = given.get("kind", robot.sensors["kind"])
     other = next(k for k in KIND_KEYS if k != kind)
     for key in table:

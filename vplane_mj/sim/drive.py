@@ -9,7 +9,7 @@ import mujoco
 import numpy as np
 
 from vplane_mj.robots.facts import BASE_BODY, WHEEL_JOINTS, WHEEL_MOTORS, robot_geometry
-from vplane_mj.robots.profiles import PROFILES
+from vplane_mj.robots.profiles import robot_profile
 from vplane_mj.scenario import Scenario
 from vplane_mj.sim.control import CommandRamp, WheelPI, wheel_targets
 from vplane_mj.sim.imu import Gyro
@@ -52,7 +52,7 @@ class Drive:
         moving: MovingObstacles | None = None,
     ):
         self.model, self.data = model, data
-        robot = PROFILES[profile]
+        robot = robot_profile(profile)
         self.gains = robot.gains
         self.limits = robot.limits
         self.geometry = robot_geometry(profile)
@@ -178,7 +178,7 @@ class Localiser:
         self.odometry: WheelOdometry | FusedOdometry | None = None
         self.largest_error = 0.0
         pose = (*scenario.robot.start, scenario.robot.start_yaw)
-        profile = PROFILES[scenario.robot.profile]
+        profile = robot_profile(scenario.robot.profile)
         radius, track = (
             drive.geometry["wheel_radius_m"],
             drive.geometry["track_m"] * profile.odometry_track_scale,

@@ -24,7 +24,7 @@ import numpy as np
 from vplane_mj.files import model_path
 from vplane_mj.geometry import shapes
 from vplane_mj.robots.facts import BASE_BODY, SONAR_MOUNT_RADIUS_M, WHEEL_JOINTS, WHEEL_MOTORS, robot_facts
-from vplane_mj.robots.profiles import PROFILES
+from vplane_mj.robots.profiles import robot_profile
 from vplane_mj.scenario import RobotSpec, Scenario, SensorSpec
 
 OBSTACLE_HEIGHT_M = 0.5
@@ -82,7 +82,7 @@ class SonarLayout:
     def from_spec(cls, spec: SensorSpec, profile: str = "default") -> SonarLayout:
         """The profile's sonars at their places, or the evenly spaced ring of `spec.count` on a
         circle of SONAR_MOUNT_RADIUS_M."""
-        robot = PROFILES[profile]
+        robot = robot_profile(profile)
         if robot.sonar_mounts is None:
             bearings = np.arange(spec.count) * (2 * math.pi / spec.count)
             mounts = np.array(
@@ -141,7 +141,7 @@ def build_spec(scenario: Scenario, rangefinders: bool = True) -> mujoco.MjSpec:
             intprm=[1, 1, 1],  # data "found", reduce "mindist", one contact
         )
 
-    robot = mujoco.MjSpec.from_file(str(model_path(PROFILES[scenario.robot.profile].model_file)))
+    robot = mujoco.MjSpec.from_file(str(model_path(robot_profile(scenario.robot.profile).model_file)))
     if scenario.sensors.kind == "sonar":
         layout = SonarLayout.from_spec(scenario.sensors, scenario.robot.profile)
         _add_sonar_ring(robot, layout, scenario.sensors, rangefinders)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from vplane_mj.robots.profiles import PROFILES
+from vplane_mj.robots.profiles import robot_profile
 
 if TYPE_CHECKING:
     from vplane_mj.scenario import Scenario
@@ -32,7 +32,7 @@ TIME_LIMIT_S = 100.0
 PROFILE = "jackal"
 """The robot profile of the challenge's robot, a Clearpath Jackal."""
 
-JACKAL_RADIUS_M = PROFILES[PROFILE].footprint_radius_m() or 0.0
+JACKAL_RADIUS_M = robot_profile(PROFILE).footprint_radius_m() or 0.0
 """Half the Jackal's diagonal (0.333 m): the disc that covers its outline at any heading, the
 size a world of this layout must let through."""
 
