@@ -16,7 +16,6 @@ from vplane_mj.errors import VPlaneError
 from vplane_mj.files import model_path
 from vplane_mj.robots.facts import (
     BASE_BODY,
-    SONAR_MOUNT_HEIGHT_M,
     WHEEL_JOINTS,
     WHEEL_MOTORS,
     read_robot_facts,
@@ -123,7 +122,7 @@ def test_the_default_profile_is_todays_robot_exactly():
         "range_max": 3.0,
         "rate_hz": 20.0,
     }
-    assert default.sensor_height_m == SONAR_MOUNT_HEIGHT_M
+    assert default.sensor_height_m == 0.07
     facts = robot_facts()
     assert (default.wheel_radius_m, default.track_m) == (facts.wheel_radius_m, facts.track_m)
     assert (default.limits.max_speed_mps, default.limits.max_turn_rate_radps) == (0.5, 2.5)

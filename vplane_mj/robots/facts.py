@@ -25,8 +25,6 @@ from vplane_mj.robots.profiles import robot_profile
 BASE_BODY = "base_link"
 WHEEL_JOINTS = ("wheel_left", "wheel_right")
 WHEEL_MOTORS = ("wheel_left", "wheel_right")
-SONAR_MOUNT_HEIGHT_M = 0.07
-"""Height of the sonar sites above base_link's origin: above the wheels (top at 0.04 m)."""
 SONAR_MOUNT_RADIUS_M = 0.10
 """Distance of the sonar sites from base_link's vertical axis."""
 RIM_SAMPLES = 73

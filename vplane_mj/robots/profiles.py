@@ -137,6 +137,7 @@ DEFAULT = RobotProfile(
             "37 at the start, of which the dynamic window has always assumed 30",
             "gains": "chosen: ControllerGains' defaults, the controller's gains as they always were",
             "sensors": "chosen: the sonar ring the robot always had; the [sensors] defaults read it",
+            "sensor height": "chosen: the sonar ring sits above the wheels (their top at 0.04 m)",
             "imu": "chosen: at the chassis' centre, the Jackal's gyro noise and drift",
         }
     ),
