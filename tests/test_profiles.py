@@ -14,6 +14,7 @@ import pytest
 
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import model_path
+from vplane_mj.planning.body import RobotBody
 from vplane_mj.robots.facts import (
     BASE_BODY,
     WHEEL_JOINTS,
@@ -126,6 +127,10 @@ def test_the_default_profile_is_todays_robot_exactly():
     facts = robot_facts()
     assert (default.wheel_radius_m, default.track_m) == (facts.wheel_radius_m, facts.track_m)
     assert (default.limits.max_speed_mps, default.limits.max_turn_rate_radps) == (0.5, 2.5)
+    assert (default.gains.speed_gain, default.gains.turn_gain) == (0.5, 3.0)
+    # A planner built from the robot's radius alone plans for this robot's drive and controller.
+    bare = RobotBody.round(robot_radius_m())
+    assert (bare.limits, bare.gains) == (robot_body().limits, robot_body().gains)
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 
 from vplane_mj.errors import VPlaneError, did_you_mean, shown
-from vplane_mj.planning.protocol.body import DriveLimits
+from vplane_mj.planning.protocol.body import DriveLimits, HeadingGains
 
 DRIVES = ("differential", "skid_steer")
 Point = tuple[float, float]
@@ -28,10 +28,11 @@ Point = tuple[float, float]
 @dataclass(frozen=True)
 class ControllerGains:
     """Gains of the controller (units in the field comments); the speed and turn rate it commands
-    are bounded by the profile's `limits`."""
+    are bounded by the profile's `limits`. The defaults are the default robot's, its heading
+    gains those of `HeadingGains`."""
 
-    speed_gain: float = 0.5  # k_v: (m/s) per unit of force
-    turn_gain: float = 3.0  # k_w: (rad/s) per rad of heading error
+    speed_gain: float = HeadingGains.speed_gain  # k_v: (m/s) per unit of force
+    turn_gain: float = HeadingGains.turn_gain  # k_w: (rad/s) per rad of heading error
     max_wheel_speed: float = 15.0  # rad/s (0.6 m/s at the rim of a 0.04 m wheel)
     wheel_kp: float = 0.06  # N m per rad/s of wheel speed error
     wheel_ki: float = 0.6  # N m per rad of accumulated wheel speed error
