@@ -1,7 +1,8 @@
 """Shared fixtures: scenarios from text, and quick access to the shipped ones.
 
 Property-based tests are derandomised: every run of the suite tries the same examples.
-The on-disk cache is a fresh temporary directory for each run of the suite.
+The on-disk cache is a fresh temporary directory for each run of the suite, and so is the
+scratch space of the Dask clusters the tests start.
 """
 
 import json
@@ -28,6 +29,10 @@ from vplane_mj.scenario import build_scenario, load_scenario, parse_scenario, wa
 # The tests keep their cached reference paths apart from the user's (and start without any).
 _CACHE = tempfile.mkdtemp(prefix="vplane-mj-test-cache-")
 os.environ[CACHE_ENV] = _CACHE
+# Dask's workers keep their scratch space (dask-scratch-space, whose lock files outlive the
+# workers) there too, not in the system's temporary directory: read when Dask is first imported,
+# and by the worker processes, which inherit it.
+os.environ["DASK_TEMPORARY_DIRECTORY"] = _CACHE
 
 
 def pytest_sessionfinish(session, exitstatus):
