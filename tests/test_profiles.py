@@ -14,7 +14,7 @@ import pytest
 
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import model_path
-from vplane_mj.planning.body import RobotBody
+from vplane_mj.planning.protocol.body import RobotBody
 from vplane_mj.robots.facts import (
     BASE_BODY,
     WHEEL_JOINTS,
