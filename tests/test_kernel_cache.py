@@ -1,5 +1,6 @@
 """The compiled kernels' cache: never stale, wherever the edit is."""
 
+import json
 import shutil
 import subprocess
 import sys
@@ -46,3 +47,53 @@ def test_a_kernel_whose_callee_in_another_module_changed_is_compiled_again(tmp_p
     callee.write_text(edited)
     after, second_cache = blocked_in(tmp_path)
     assert after == "False" and second_cache != first_cache
+
+
+LOOP = """
+import json
+from vplane_mj import kernels
+from vplane_mj.scenario import load_scenario
+from vplane_mj.sim.loop import Run, kernel_kind
+
+def loaded():
+    return sum(len(dispatcher.overloads) for dispatcher in kernels.DISPATCHERS.values())
+
+run = Run(load_scenario("paper_c_escape", ["planner.name=apf", "run.time_limit_s=8"]))
+before = loaded()
+load_s = kernels.preload(kernel_kind("apf", "sonar"))
+ready = loaded()
+while run.step() is None:
+    pass
+print(json.dumps({"before": before, "ready": ready, "after": loaded(), "load_s": load_s}))
+"""
+
+
+def test_a_run_loads_the_kernels_its_kind_used_before_its_loop(tmp_path):
+    first = run(
+        [
+            "run",
+            "paper_c_escape",
+            "--planner",
+            "apf",
+            "--set",
+            "run.time_limit_s=8",
+            "--no-log",
+            "--no-render",
+            "--out",
+            str(tmp_path),
+        ]
+    )
+    assert first.returncode == 1  # apf stays trapped: the run times out, and its kernels are remembered
+    summary = json.loads((tmp_path / "paper_c_escape-apf-0.json").read_text())
+    assert summary["kernel_load_s"] >= 0.0 and summary["wall_time_s"] > 0.0
+    done = subprocess.run([sys.executable, "-c", LOOP], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-2000:]
+    counts = json.loads(done.stdout)
+    assert counts["ready"] > counts["before"] and counts["load_s"] > 0.0
+    assert counts["after"] == counts["ready"]  # nothing loaded or compiled inside the loop
+
+
+def run(argv: list[str]) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "vplane_mj", *argv], capture_output=True, text=True, timeout=600
+    )

@@ -15,12 +15,21 @@ The kernels compile on their first call and are cached on disk, in a directory n
 digest of this package's sources (`cache_path`): a kernel that calls one of another module is
 compiled again when either changes, where numba's own cache, which checks only the file of
 the function it loads, would run the stale machine code of a caller whose callee was edited.
+
+Loading a kernel from that cache takes a few milliseconds on its first call in a process. A run
+loads the kernels the last runs of its kind used before its loop starts (`preload`), from the
+signatures they left in the cache (`remember`), so the loop's wall time holds no loading.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import importlib
 import os
+import pickle
+import tempfile
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -54,6 +63,8 @@ def cache_path() -> Path:
 
 
 CACHE_PATH = cache_path()
+DISPATCHERS: dict[str, Any] = {}
+"""Every kernel made in this process by `njit`, by its module and name (`module.function`)."""
 
 
 def njit(function: Callable | None = None, **options: Any) -> Any:
@@ -63,8 +74,61 @@ def njit(function: Callable | None = None, **options: Any) -> Any:
         chosen = numba_config.CACHE_DIR  # type: ignore[attr-defined]  # numba sets its config at run time
         numba_config.CACHE_DIR = str(CACHE_PATH)  # type: ignore[attr-defined]  # read by the dispatcher
         try:
-            return numba.njit(cache=True, **options)(py_function)
+            dispatcher = numba.njit(cache=True, **options)(py_function)
         finally:
             numba_config.CACHE_DIR = chosen  # type: ignore[attr-defined]
+        DISPATCHERS[f"{py_function.__module__}.{py_function.__name__}"] = dispatcher
+        return dispatcher
 
     return compile_cached if function is None else compile_cached(function)
+
+
+def _manifest_path(kind: str) -> Path:
+    """Where the kernels that runs of `kind` used are listed (a pickle in CACHE_PATH)."""
+    return CACHE_PATH / f"used-{kind}.pickle"
+
+
+def _manifest(kind: str) -> dict[str, list]:
+    """Kernel name -> the signatures runs of `kind` called it with; empty when none is known."""
+    try:
+        listed = pickle.loads(_manifest_path(kind).read_bytes())
+    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError, TypeError):
+        return {}
+    return listed if isinstance(listed, dict) else {}
+
+
+def preload(kind: str) -> float:
+    """Load (or compile) every kernel that the runs of `kind` before this one used, with the
+    signatures they called it with; the wall time (s) it took. A kernel renamed or gone since
+    is left out."""
+    started = time.perf_counter()
+    for name, signatures in _manifest(kind).items():
+        module, _, function = name.rpartition(".")
+        try:
+            dispatcher = getattr(importlib.import_module(module), function)
+            for signature in signatures:
+                dispatcher.compile(signature)
+        except (ImportError, AttributeError, TypeError, numba.core.errors.NumbaError):
+            continue
+    return time.perf_counter() - started
+
+
+def remember(kind: str) -> None:
+    """Add the kernels this process called, with their signatures, to what runs of `kind` use
+    (written whole, under a temporary name; nothing when the cache cannot be written)."""
+    used = _manifest(kind)
+    for name, dispatcher in DISPATCHERS.items():
+        known = used.setdefault(name, [])
+        known += [signature for signature in dispatcher.signatures if signature not in known]
+    used = {name: signatures for name, signatures in used.items() if signatures}
+    path = _manifest_path(kind)
+    with contextlib.suppress(OSError, pickle.PicklingError):
+        path.parent.mkdir(parents=True, exist_ok=True)
+        handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+        try:
+            with os.fdopen(handle, "wb") as stream:
+                pickle.dump(used, stream)
+            os.replace(temporary, path)
+        except BaseException:
+            os.unlink(temporary)
+            raise

@@ -16,6 +16,7 @@ physics would, never to plan.
 from __future__ import annotations
 
 import math
+import re
 import time
 from dataclasses import dataclass, field
 from typing import Protocol
@@ -211,7 +212,7 @@ class Run:
         self.local_minima = self.escapes = 0
         self.time_to_goal: float | None = None
         self.ending: Ending | None = None
-        self.wall_time_s = 0.0
+        self.wall_time_s = self.kernel_load_s = 0.0
         self._belief: tuple[np.ndarray, float] | None = None
         self._decision: Decision | None = None
         self._observation: Observation | None = None
@@ -248,9 +249,15 @@ class Run:
         return self.apply(decision)
 
     def run(self) -> RunResult:
-        """Step to the end of the run; its result."""
+        """Load the compiled kernels that runs of this kind used (`kernels.preload`, timed apart
+        from the loop as `kernel_load_s`), step to the end of the run; its result."""
+        from vplane_mj import kernels  # numba: the planners and sensors load it anyway
+
+        kind = kernel_kind(self.planner_name, self.scenario.sensors.kind)
+        self.kernel_load_s = kernels.preload(kind)
         while self.step() is None:
             pass
+        kernels.remember(kind)
         return self.result()
 
     def observe(self) -> Observation | None:
@@ -524,6 +531,7 @@ class Run:
             physics_dt_s=self.model.opt.timestep,
             control_hz=scenario.run.control_hz,
             wall_time_s=self.wall_time_s,
+            kernel_load_s=self.kernel_load_s,
             path_length_m=self.path_length,
             collisions=len(self.collisions.points),
             min_clearance_m=None if math.isinf(clearance.robot_minimum) else clearance.robot_minimum,
@@ -559,6 +567,12 @@ class Run:
             planner_params={} if self.planner is None else self.planner.params.as_dict(),
             version=__version__,
         )
+
+
+def kernel_kind(planner: str, sensor_kind: str) -> str:
+    """The kind of a run whose compiled kernels `Run.run` loads before its loop: its planner and
+    sensor, as a file name."""
+    return re.sub(r"[^A-Za-z0-9_]+", "_", f"{planner}-{sensor_kind}")
 
 
 def run_scenario(scenario: Scenario, observers: tuple[Observer, ...] = ()) -> RunResult:

@@ -10,7 +10,7 @@ from enum import StrEnum
 from typing import Any
 
 SUMMARY_FORMAT = 1
-TIMING_KEYS = ("wall_time_s", "planner_cpu_ms_mean", "planner_cpu_ms_max")
+TIMING_KEYS = ("wall_time_s", "kernel_load_s", "planner_cpu_ms_mean", "planner_cpu_ms_max")
 """Summary keys measured on the wall clock: the only ones that differ between identical runs."""
 
 
@@ -45,6 +45,7 @@ class RunSummary:
     physics_dt_s: float | None = None
     control_hz: float | None = None
     wall_time_s: float = 0.0
+    kernel_load_s: float = 0.0
     path_length_m: float = 0.0
     collisions: int = 0
     min_clearance_m: float | None = None
