@@ -102,16 +102,28 @@ def run(
 ) -> RunRecord:
     """Run a scenario (a Scenario, or a file or a built-in scenario's name) headless.
 
-    Into `out` (created with its parents when missing) it writes the `.json` summary, and
-    with `log` the `.mcap` log, with `render` the `.png` render, with `video` an `.mp4`
-    replay (from the log); `out=None` writes nothing. Invalid input raises a VPlaneError
-    before anything is written. Interrupted (KeyboardInterrupt) during the simulation, the
-    log is closed cleanly and kept; files are always whole or absent. A planner whose code
-    raises does not make `run` raise: the run ends with outcome `error`, `summary.message`
-    names the exception and where, `summary.traceback` holds the planner's traceback, and
-    the files are written as for any run (the log up to the failing tick). While another
-    process writes the same files (same `out`, name, planner and seed), `run` refuses with an
-    OutputBusy naming it, before anything is written.
+    Invalid input raises before anything is written. Interrupted (KeyboardInterrupt) during
+    the simulation, the log is closed cleanly and kept; files are always whole or absent. A
+    planner whose code raises does not make `run` raise: the run ends with outcome `error`,
+    `summary.message` names the exception and where, `summary.traceback` holds the planner's
+    traceback, and the files are written as for any run (the log up to the failing tick).
+
+    Args:
+        scenario: The scenario, or the path or built-in name of a scenario file.
+        out: The folder of the files (created with its parents when missing; default
+            ./logs); None writes nothing.
+        log: Write the `.mcap` log.
+        render: Write the `.png` top view of the run.
+        video: Write an `.mp4` replay, made from the log (needs `log`).
+
+    Returns:
+        The scenario run, its summary, trajectory and events, and the files written by role.
+
+    Raises:
+        VPlaneError: Invalid input (a ScenarioError for the scenario), before anything is
+            written.
+        OutputBusy: Another process writes the same files (same `out`, name, planner and
+            seed); nothing is written.
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(os.fspath(scenario))

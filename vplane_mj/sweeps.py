@@ -74,20 +74,36 @@ def sweep(
     report: bool = True,
     wait: bool = False,
 ) -> SweepResult:
-    """Run every scenario (a Scenario, or a file or a built-in scenario's name) with every
-    planner (default: all of them; a name, an import spec `module:Class` or `file.py:Class`, or
-    a `Planner` class, the last two registered here and imported by the workers) and seed (a
-    list, or text like "0-19"), each with the `--set` style `overrides`, in `jobs` worker
-    processes (default: one per core) or on the Dask `scheduler` at that address.
+    """Run every scenario with every planner and seed, as `vplane-mj bench` does.
 
-    As `vplane-mj bench`: every run is validated before any starts (a VPlaneError names the
-    scenario and key), progress is shown on stderr, finished runs are appended to
-    `bench.jsonl` in `out` and the same sweep again runs only what is missing; with `report`
-    the table and figures are written too (bench.csv, bench.json, bench.png,
-    bench-scenarios.png, bench.html). `out=None` keeps nothing: the journal goes to a
-    temporary directory and no report is written. One sweep at a time writes into a folder: while
-    another holds it (its lock file `.bench.lock`), an OutputBusy names that sweep, or with `wait`
-    the sweep waits for it to end and then runs only the jobs it left.
+    Every run is validated before any starts, progress is shown on stderr, finished runs are
+    appended to `bench.jsonl` in `out` and the same sweep again runs only what is missing.
+    One sweep at a time writes into a folder (its lock file `.bench.lock`). Runs that end in
+    `error` are returned as rows all the same, with one SweepErrorWarning.
+
+    Args:
+        scenarios: Each a Scenario, or the path or built-in name of a scenario file.
+        planners: Planner names, import specs (`module:Class`, `file.py:Class`) or `Planner`
+            classes (the last two registered here and imported by the workers); None: all.
+        seeds: The seeds, as integers or as text like "0-19".
+        overrides: `--set KEY=VALUE` strings applied to every run.
+        jobs: Worker processes; None: one per core.
+        scheduler: The address of a Dask scheduler to run on instead of local workers.
+        out: The folder of the journal and the report (default ./logs); None keeps nothing (the journal goes
+            to a temporary folder, no report is written).
+        report: Write the table and figures (bench.csv, bench.json, bench.png,
+            bench-scenarios.png, bench.html).
+        wait: While another sweep holds `out`, wait for it to end and then run only the jobs
+            it left, instead of raising OutputBusy.
+
+    Returns:
+        One row per run (scenario, planner, seed order), the table per planner and the
+        report files written.
+
+    Raises:
+        VPlaneError: Invalid input (a scenario, planner, seed or override; `jobs` below 1),
+            naming the scenario and key, before any run starts.
+        OutputBusy: Another sweep holds `out` and `wait` is False.
     """
     workers = (os.cpu_count() or 1) if jobs is None else jobs
     if workers < 1:

@@ -114,10 +114,21 @@ def _read_text(path: Path, source: str) -> str:
 
 
 def load_scenario(ref: str, overrides: Sequence[str | Override] = ()) -> Scenario:
-    """Read, parse, override and validate the scenario `ref` (a path or a scenario name).
+    """Read, parse, override and validate a scenario file.
 
     The source named in messages and logs is `ref` itself when it is a path, else the file
     found, as `readable` shows it.
+
+    Args:
+        ref: A path, else a name in ./scenarios/, else a built-in scenario's name.
+        overrides: `--set KEY=VALUE` strings (or parsed overrides) applied before validation.
+
+    Returns:
+        The validated scenario.
+
+    Raises:
+        ScenarioError: No such file or scenario, unreadable text, or an invalid key, naming
+            the source, the key path and the reason.
     """
     path = resolve_path(ref)
     source = readable(ref if path == Path(ref) else path)

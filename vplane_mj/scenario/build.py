@@ -32,24 +32,61 @@ Point = Sequence[float]
 
 
 def box(center: Point, size: Point, yaw_deg: float | None = None) -> dict[str, Any]:
-    """A box of `size` = [sx, sy] (m) about `center`, turned by `yaw_deg` (degrees)."""
+    """A box obstacle.
+
+    Args:
+        center: Its centre [x, y] (m).
+        size: Its sides [sx, sy] (m) before it is turned.
+        yaw_deg: Its turn about the centre (degrees, counter-clockwise); None: 0.
+
+    Returns:
+        The `[[world.obstacles]]` table for `build_scenario`.
+    """
     return {"kind": "box", "center": center, "size": size, "yaw_deg": yaw_deg}
 
 
 def wall(start: Point, end: Point, thickness: float | None = None) -> dict[str, Any]:
-    """A wall from `start` to `end` (the file's `from` and `to`), `thickness` metres wide."""
+    """A straight wall.
+
+    Args:
+        start: One end [x, y] (m), the file's `from`.
+        end: The other end [x, y] (m), the file's `to`.
+        thickness: Its width (m); None: the format's default.
+
+    Returns:
+        The `[[world.obstacles]]` table for `build_scenario`.
+    """
     return {"kind": "wall", "from": start, "to": end, "thickness": thickness}
 
 
 def cylinder(center: Point, radius: float) -> dict[str, Any]:
-    """A cylinder of `radius` (m)."""
+    """A round post.
+
+    Args:
+        center: Its axis [x, y] (m).
+        radius: Its radius (m).
+
+    Returns:
+        The `[[world.obstacles]]` table for `build_scenario`.
+    """
     return {"kind": "cylinder", "center": center, "radius": radius}
 
 
 def cup(
     center: Point, width: float, depth: float, yaw_deg: float | None = None, thickness: float | None = None
 ) -> dict[str, Any]:
-    """A U (C) trap, `width` across its mouth and `depth` deep (m); at yaw 0 the mouth faces -x."""
+    """A U (C) trap; at yaw 0 its mouth faces -x.
+
+    Args:
+        center: Its centre [x, y] (m).
+        width: Across its mouth (m).
+        depth: From its mouth to its back (m).
+        yaw_deg: Its turn about the centre (degrees, counter-clockwise); None: 0.
+        thickness: Its walls' width (m); None: the format's default.
+
+    Returns:
+        The `[[world.obstacles]]` table (kind "u") for `build_scenario`.
+    """
     return {
         "kind": "u",
         "center": center,
@@ -63,7 +100,18 @@ def cup(
 def h_shape(
     center: Point, length: float, width: float, yaw_deg: float | None = None, thickness: float | None = None
 ) -> dict[str, Any]:
-    """An H: two posts `length` long, `width` apart (m), and a crossbar; cups open to -x and +x."""
+    """An H: two posts and a crossbar, whose cups open to -x and +x at yaw 0.
+
+    Args:
+        center: Its centre [x, y] (m).
+        length: Each post's length (m).
+        width: The posts' distance apart (m).
+        yaw_deg: Its turn about the centre (degrees, counter-clockwise); None: 0.
+        thickness: Its walls' width (m); None: the format's default.
+
+    Returns:
+        The `[[world.obstacles]]` table (kind "h") for `build_scenario`.
+    """
     return {
         "kind": "h",
         "center": center,
@@ -90,13 +138,33 @@ def build_scenario(
     run: Mapping[str, Any] | None = None,
     overrides: Sequence[str] = (),
 ) -> Scenario:
-    """A scenario from Python values, validated exactly like a file (a ScenarioError otherwise).
+    """A scenario from Python values, validated exactly like a file.
 
-    `size`, `start` and `goal` are `world.size`, `robot.start` and `robot.goal` (m);
-    `robot` holds the further `[robot]` keys (`start_yaw_deg`, `goal_tolerance`, the faults),
-    `planner` and `planner_params` the `[planner]` table, `sensors` and `run` those tables
-    (key for key as in a file, see docs/scenarios.md); `overrides` are `--set`
-    strings applied after. `Scenario.to_toml()` gives the file that loads back equal.
+    Tables are given key for key as in a file (docs/scenarios.md); a value of None is left
+    out, so the key's default applies. `Scenario.to_toml()` gives the file that loads back
+    equal.
+
+    Args:
+        name: The scenario's `name`.
+        size: The arena `world.size` [W, H] (m).
+        start: The robot's start `robot.start` [x, y] (m).
+        goal: The goal `robot.goal` [x, y] (m).
+        obstacles: `[[world.obstacles]]` tables, as `box`, `wall`, `cylinder`, `cup` and
+            `h_shape` give them.
+        border: Whether walls surround the arena (`world.border`).
+        description: The scenario's `description`.
+        robot: Further `[robot]` keys (`start_yaw_deg`, `goal_tolerance`, the faults).
+        planner: The planner's name (`planner.name`).
+        planner_params: The planner's parameters (the rest of the `[planner]` table).
+        sensors: The `[sensors]` table.
+        run: The `[run]` table (`seed`, `time_limit_s`, ...).
+        overrides: `--set KEY=VALUE` strings applied after.
+
+    Returns:
+        The validated scenario; messages name its source `<code>`.
+
+    Raises:
+        ScenarioError: A value the format does not allow, naming the key and the reason.
     """
     try:
         document = _to_toml_value(

@@ -107,10 +107,20 @@ class RunSpec:
 
 @dataclass(frozen=True)
 class Scenario:
-    """A validated scenario. `raw` is the document as read, with overrides applied (read-only).
+    """A validated scenario (`load_scenario`, `build_scenario`); two scenarios of the same
+    content are equal wherever they came from.
 
-    `source` names where it came from in messages (a file, or "<code>"); two scenarios of the
-    same content are equal wherever they came from.
+    Attributes:
+        name: The scenario's name.
+        description: One line about it.
+        source: Where it came from, as messages name it (a file, or "<code>").
+        world: The arena (m) and its obstacles.
+        robot: The robot's profile, start, goal (m), start yaw (rad) and faults.
+        planner: The planner's name.
+        planner_params: The planner's parameters as given (the rest are its defaults).
+        sensors: The range sensor, resolved against the robot's profile.
+        run: Seed, time limit (s), physics step (s) and control rate (Hz).
+        raw: The document as read, with overrides applied (read-only).
     """
 
     name: str
@@ -125,11 +135,22 @@ class Scenario:
     raw: Mapping[str, Any]
 
     def to_toml(self) -> str:
-        """The resolved scenario as TOML text; parsing it back gives an equal Scenario."""
+        """The resolved scenario as TOML text.
+
+        Returns:
+            The text of a scenario file; parsing it back gives an equal Scenario.
+        """
         return tomli_w.dumps(self.raw)
 
     def save(self, path: str | os.PathLike[str]) -> Path:
-        """Write `to_toml()` to `path` (whole or not at all): a file `vplane-mj run` takes and
-        that loads back equal. Returns the path."""
+        """Write `to_toml()` to a file (whole or not at all) that `vplane-mj run` takes and
+        that loads back equal.
+
+        Args:
+            path: The file to write (replaced when it exists).
+
+        Returns:
+            The path written.
+        """
         text = self.to_toml()
         return write_atomically(Path(path), lambda tmp: tmp.write_text(text, encoding="utf-8"))
