@@ -2,10 +2,12 @@
 them after the set-up, exit 0 and print and write what the page shows; its set-up commands are
 the README's; every relative link of README.md, CHANGELOG.md and docs/ points at a file (and
 a heading) that exists; every benchmark table a page includes is a result file that says how and
-when it was measured; and the figures the README quotes from those tables are theirs."""
+when it was measured; the figures the README quotes from those tables are theirs; and every
+public name of `vplane_mj` and `vplane_mj.planning` has its entry on a reference page."""
 
 from __future__ import annotations
 
+import importlib
 import json
 import os
 import re
@@ -19,6 +21,8 @@ from typing import Any
 
 import pytest
 
+import vplane_mj
+import vplane_mj.planning
 from vplane_mj.bench.tables import Measurement
 
 ROOT = Path(__file__).parents[1]
@@ -342,3 +346,45 @@ def test_result_cells_are_found_by_row_and_column():
     assert result_cell(table, ("apf", "all"), "rate") == "7.0%"
     with pytest.raises(ValueError):  # two rows
         result_cell(table, ("apf",), "rate")
+
+
+REFERENCE_PAGES = sorted((ROOT / "docs" / "reference").glob("*.md"))
+DIRECTIVE = re.compile(r"^::: ([\w.]+)[ \t]*$", re.M)
+"""A reference page's mkdocstrings entry: `::: dotted.path` of the object it documents."""
+PUBLIC = [(vplane_mj, name) for name in vplane_mj.__all__] + [
+    (vplane_mj.planning, name) for name in vplane_mj.planning.__all__
+]
+
+
+def reference_entries() -> list[str]:
+    """The dotted paths of every `:::` entry of the reference pages."""
+    return [path for page in REFERENCE_PAGES for path in DIRECTIVE.findall(page.read_text(encoding="utf-8"))]
+
+
+def documented_object(path: str) -> object:
+    """The object an entry's dotted path names: its longest importable module, then attributes."""
+    parts = path.split(".")
+    for split in range(len(parts), 0, -1):
+        try:
+            found: object = importlib.import_module(".".join(parts[:split]))
+        except ModuleNotFoundError:
+            continue
+        for attribute in parts[split:]:
+            found = getattr(found, attribute)
+        return found
+    raise ModuleNotFoundError(path)
+
+
+@pytest.mark.parametrize(("module", "name"), PUBLIC, ids=[f"{m.__name__}.{n}" for m, n in PUBLIC])
+def test_every_public_name_has_an_entry_on_a_reference_page(module, name):
+    exported = getattr(module, name)
+    entries = [path for path in reference_entries() if path.rsplit(".", 1)[-1] == name]
+    assert any(documented_object(path) is exported for path in entries), (
+        f"{module.__name__}.{name}: no `::: ...{name}` entry in docs/reference/ documents it"
+    )
+
+
+def test_reference_entries_are_found_and_resolved():
+    assert "vplane_mj.runner.run" in reference_entries()
+    assert documented_object("vplane_mj.runner.run") is vplane_mj.run
+    assert "vplane_mj.files.OutputBusy" not in DIRECTIVE.findall("Text ::: vplane_mj.files.OutputBusy\n")

@@ -128,7 +128,8 @@ def model_path(filename: str) -> Path:
 
 
 class OutputBusy(VPlaneError):
-    """Another process holds the lock on these outputs."""
+    """Another process holds the lock on these outputs: `run` and `sweep` raise it, naming the
+    outputs, the holder and what to do, before anything is written."""
 
 
 @contextlib.contextmanager
