@@ -26,9 +26,14 @@ from vplane_mj.planning.protocol.types import Decision, Observation
 class Planner(ABC):
     """A local planner. Subclasses set the class attributes and implement `step`.
 
-    `name` names the planner in scenario files (`planner.name`), summaries, output file names
-    and the bench table ([a-z0-9_]+); `summary` is one line for `vplane-mj list`, `citation`
-    where the method comes from, `Params` its frozen `PlannerParams` dataclass.
+    Attributes:
+        name: Names the planner in scenario files (`planner.name`), summaries, output file
+            names and the bench table ([a-z0-9_]+).
+        summary: One line for `vplane-mj list`.
+        citation: Where the method comes from.
+        Params: Its frozen `PlannerParams` dataclass.
+        params: The instance of `Params` it was built with.
+        robot: The robot's body it was built for.
     """
 
     name: ClassVar[str]
@@ -37,8 +42,16 @@ class Planner(ABC):
     Params: ClassVar[type[PlannerParams]] = PlannerParams
 
     def __init__(self, params: PlannerParams, robot: RobotBody | float):
-        """`params`: an instance of `Params`; `robot`: the robot's body, or (as planners written
-        for the first protocol pass it) the radius (m) of a round robot."""
+        """Keep the parameters and the robot's body.
+
+        Args:
+            params: An instance of `Params`.
+            robot: The robot's body, or (as planners written for the first protocol pass it)
+                the radius (m) of a round robot.
+
+        Raises:
+            TypeError: `params` is not an instance of `Params`.
+        """
         if not isinstance(params, self.Params):
             raise TypeError(
                 f"planner {self.name!r} takes {self.Params.__name__}, got {type(params).__name__}"
@@ -50,13 +63,29 @@ class Planner(ABC):
 
     @abstractmethod
     def step(self, obs: Observation) -> Decision:
-        """The decision for this control tick: the force to follow (world frame) and what the
-        planner is doing."""
+        """The decision for this control tick.
+
+        Args:
+            obs: The pose, goal and range scan of this tick.
+
+        Returns:
+            The force to follow (world frame) and what the planner is doing.
+        """
 
     @classmethod
     def build(cls, overrides: Mapping[str, object], robot: RobotBody | float) -> Self:
-        """A fresh planner for `robot` (a body, or a round robot's radius in m), its parameters
-        the defaults updated with `overrides` (each key and value checked: `ParamError`)."""
+        """A fresh planner, its parameters the defaults updated with the overrides.
+
+        Args:
+            overrides: Parameter values by name (each key and value checked).
+            robot: The robot's body, or a round robot's radius (m).
+
+        Returns:
+            The planner.
+
+        Raises:
+            ParamError: An unknown parameter or a bad value.
+        """
         params = cls.Params.resolve(overrides, cls.name)
         body = robot if isinstance(robot, RobotBody) else RobotBody.round(float(robot))
         if not _takes_a_radius(cls):

@@ -66,15 +66,36 @@ def param(
     le: float | None = None,
     integer: bool = False,
 ) -> Any:
-    """A field of a `PlannerParams` dataclass: its default, unit ("" for none), meaning and
-    bounds (exclusive `gt`, inclusive `ge` and `le`); `integer` for counts."""
+    """A field of a `PlannerParams` dataclass, its value checked when the planner is built.
+
+    Args:
+        default: The value when none is given.
+        unit: Its unit as `vplane-mj list` shows it ("m", "rad", "s", ...; "" for none).
+        doc: Its meaning, one line.
+        gt: Exclusive lower bound.
+        ge: Inclusive lower bound.
+        le: Inclusive upper bound.
+        integer: Whether it is a count (an int).
+
+    Returns:
+        The dataclass field, its `Param` in the metadata.
+    """
     spec = Param(default, unit, doc, gt=gt, ge=ge, le=le, integer=integer)
     return field(default=default, metadata={PARAM: spec})
 
 
 def with_default(params: type[PlannerParams], name: str, default: float) -> Any:
-    """The field `name` of `params` with another default (unit, meaning and bounds kept), for a
-    subclass that shares a group's parameter but not its default."""
+    """A group's parameter with another default (unit, meaning and bounds kept), for a subclass
+    that shares the parameter but not its default.
+
+    Args:
+        params: The group (a `PlannerParams` subclass) that declares the parameter.
+        name: The parameter's name.
+        default: Its new default.
+
+    Returns:
+        The dataclass field.
+    """
     spec = params.table()[name]
     return field(default=default, metadata={PARAM: dataclasses.replace(spec, default=default)})
 
@@ -93,7 +114,9 @@ class PlannerParams:
     """The base of every planner's parameters (a frozen dataclass of `param` fields).
 
     Groups combine by inheritance; a dataclass lists the fields of its bases in reverse
-    order of the bases (`class P(B, A)` holds A's fields, then B's, then its own).
+    order of the bases (`class P(B, A)` holds A's fields, then B's, then its own). A
+    subclass is built with its fields as keyword arguments, each defaulting to its `param`'s
+    default; `resolve` builds it from overrides with every key and value checked.
     """
 
     @classmethod
@@ -123,7 +146,18 @@ class PlannerParams:
 
     @classmethod
     def resolve(cls, overrides: Mapping[str, object], planner: str) -> Self:
-        """The defaults updated with the overrides, checked (see `checked`)."""
+        """The defaults updated with the overrides, checked.
+
+        Args:
+            overrides: Parameter values by name.
+            planner: The planner's name, for messages.
+
+        Returns:
+            The parameters.
+
+        Raises:
+            ParamError: An unknown key or a bad value (the first found).
+        """
         return cls(**cls.checked(overrides, planner))
 
     def as_dict(self) -> dict[str, float]:

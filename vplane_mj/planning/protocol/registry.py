@@ -180,14 +180,35 @@ DEFAULT_PLANNER = "vplane"
 
 
 def register_planner(cls: type[Planner]) -> type[Planner]:
-    """Register a planner class under its `name` in this process (also as a class decorator);
-    PlannerError when it is not a valid planner or its name is taken."""
+    """Register a planner class under its `name` in this process (also as a class decorator).
+
+    Args:
+        cls: A `Planner` subclass with `name`, `summary`, `citation` and `Params` set.
+
+    Returns:
+        The class itself, so that it works as a decorator.
+
+    Raises:
+        PlannerError: It is not a valid planner, or its name is a built-in, installed or
+            other registered planner's.
+    """
     return PLANNERS.register(cls)
 
 
 def load_planner(spec: str) -> type[Planner]:
-    """Import and register the planner class `module:Class` or `path/to/file.py:Class` names
-    (the module looked up as `python -m` would, the current directory first)."""
+    """Import and register the planner class an import spec names (once per process).
+
+    Args:
+        spec: `module:Class` (the module looked up as `python -m` would, the current
+            directory first) or `path/to/file.py:Class`.
+
+    Returns:
+        The class, registered under its `name`.
+
+    Raises:
+        PlannerError: The module or class cannot be imported, is not a valid planner, or its
+            name is taken.
+    """
     return PLANNERS.load(spec)
 
 
@@ -219,6 +240,18 @@ def planner_info(name: str) -> PlannerInfo:
 
 
 def make_planner(name: str, params: Mapping[str, object], robot: RobotBody | float) -> Planner:
-    """A fresh planner `name` for `robot` (a body, or a round robot's radius in m), its parameters
-    resolved against the defaults (each checked)."""
+    """A fresh planner, its parameters resolved against the defaults (each checked).
+
+    Args:
+        name: The planner's name (built-in, installed or registered).
+        params: Parameter overrides by name, as a scenario's `[planner]` table holds them.
+        robot: The robot's body, or a round robot's radius (m).
+
+    Returns:
+        The planner, ready for its first `step`.
+
+    Raises:
+        KeyError: No planner has that name.
+        ParamError: An unknown parameter or a bad value.
+    """
     return PLANNERS[name].build(params, robot)

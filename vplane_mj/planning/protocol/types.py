@@ -17,22 +17,28 @@ if TYPE_CHECKING:
 class Observation:
     """The planner's whole view of the world: its pose, its goal and its range scan.
 
-    `ranges` (m) are measured from the robot's centre along `bearings` (rad, robot
-    frame, counter-clockwise from the heading); NaN means no echo. The bearings are any
-    sensor's: an evenly spaced sonar ring, uneven sonar arrays (several beams may share a
-    bearing), or a laser's scan over its field of view, in any order. `beam_width` (rad) is
-    each beam's width, the same for all: an echo lies somewhere within it (a laser's is its
-    angle step). `velocity` is the robot's speed along its heading (m/s, negative when
-    reversing) and turn rate (rad/s), as its wheel encoders measure them.
+    The bearings are any sensor's: an evenly spaced sonar ring, uneven sonar arrays (several
+    beams may share a bearing), or a laser's scan over its field of view, in any order. A
+    sensor slower than the control rate hands one scan to several ticks, each with the pose
+    of its own tick: a planner that maps should fold a scan once, at the pose of the tick it
+    came with.
 
-    `tracks` are the obstacles the run's tracker follows from the scans and the pose alone
-    (`perception.tracker`: each one's estimated disc and velocity, in the same frame as
-    `position`), and `moving_echoes` (beams,) marks the echoes of the tracks that move (None:
-    none is known to); `static_ranges` leaves those out.
-
-    `scan_time_s` is when the sensor took `ranges` (s; None: at `time_s`). A sensor slower
-    than the control rate hands one scan to several ticks, each with the pose of its own
-    tick: a planner that maps should fold a scan once, at the pose of the tick it came with.
+    Attributes:
+        time_s: Simulated time of the tick (s).
+        position: The position the planner believes in, [x, y] (m, world frame).
+        yaw: Its heading (rad, counter-clockwise from +x).
+        goal: The goal [x, y] (m, world frame).
+        goal_tolerance: How close to the goal counts as reaching it (m).
+        bearings: Each beam's bearing (rad, robot frame, counter-clockwise from the heading).
+        ranges: Each beam's range from the robot's centre (m); NaN: no echo.
+        beam_width: Each beam's width (rad), the same for all: an echo lies somewhere within
+            it (a laser's is its angle step).
+        velocity: Speed along the heading (m/s, negative when reversing) and turn rate
+            (rad/s), as the wheel encoders measure them.
+        tracks: The obstacles the run's tracker follows from the scans and the pose alone
+            (each one's estimated disc and velocity, in the frame of `position`).
+        moving_echoes: (beams,) which echoes are of tracks that move; None: none is known to.
+        scan_time_s: When the sensor took `ranges` (s); None: at `time_s`.
     """
 
     time_s: float
@@ -102,14 +108,21 @@ class Observation:
 class Decision:
     """A planner's answer: the total force (world frame) to follow, and what it is doing.
 
-    `components` names the parts of the force (attractive, repulsive, ...) for the log;
-    `events` are what happened this tick (kind, text and numbers);
-    `local_minimum` and `escape_completed` mark a detection and a finished escape;
-    `objective` is the virtual new objective while one exists (world frame, m) and
-    `planes` the virtual planes in force, each as its two end points.
-    `command`, when given, is the body speed (m/s, negative to reverse) and turn rate (rad/s)
-    to drive, within the robot's limits, instead of what the heading controller makes of the
-    force (which is then only shown): for a planner that plans in velocities, or must back off.
+    Args:
+        force: The force to follow, [fx, fy] (world frame); the heading controller turns the
+            robot towards it.
+        mode: What the planner is doing (a short word: the log's and the plots' mode).
+        components: The parts of the force by name (attractive, repulsive, ...), for the log.
+        events: What happened this tick (kind, text and points).
+        local_minimum: A local minimum was detected this tick.
+        escape_completed: An escape finished this tick.
+        gave_up: The planner gives up: the run ends as stuck.
+        objective: The virtual new objective while one exists, [x, y] (m, world frame).
+        planes: The virtual planes in force, each as its two end points (m, world frame).
+        command: The body speed (m/s, negative to reverse) and turn rate (rad/s) to drive,
+            within the robot's limits, instead of what the heading controller makes of the
+            force (which is then only shown): for a planner that plans in velocities, or must
+            back off.
     """
 
     force: np.ndarray
