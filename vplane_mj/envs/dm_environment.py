@@ -32,11 +32,8 @@ from vplane_mj.scenario import Scenario
 class VPlaneNavDmEnv(dm_env.Environment):
     """Drive the robot to the goal through a world of a family, or through one scenario.
 
-    The options are those of `vplane_mj.envs.gym_env.VPlaneNavEnv` (`scenario`, `family`,
-    `overrides`, `action`, `reward`, `expose_observation`), and `seed`: episode k (counting
-    from 0 every episode this environment begins, by `reset` or by a `step` after a LAST
-    step) is world `seed + k` of the family, with `run.seed = seed + k`. `info` is the latest
-    TimeStep's info (the keys of the Gymnasium environment's `info`); `task` is the
+    The options are those of `vplane_mj.envs.gym_env.VPlaneNavEnv`, and `seed`. `info` is the
+    latest TimeStep's info (the keys of the Gymnasium environment's `info`); `task` is the
     NavigationTask behind the environment (its `run` is the episode's Run).
 
     `physics` (dm_control's Physics) is made with the episode's world before the episode
@@ -54,6 +51,27 @@ class VPlaneNavDmEnv(dm_env.Environment):
         expose_observation: bool = False,
         seed: int = 0,
     ):
+        """Build the task and its specs; the first episode begins with `reset` or `step`.
+
+        Args:
+            scenario: The scenario run in every episode (a Scenario, or the path or built-in
+                name of a scenario file); None: each `reset` draws a world of `family`.
+            family: The world family drawn from without a scenario: "traps", "clutter",
+                "corridors" or "barn", as `vplane-mj generate` makes them.
+            overrides: `--set KEY=VALUE` strings applied to every world (faults, sensor
+                noise, the time limit).
+            action: "force": a force (world frame) as a planner's decision; "velocity": the
+                body speed (m/s) and turn rate (rad/s).
+            reward: The weights of the reward's terms; None: the defaults.
+            expose_observation: Put the planner's Observation of each tick in `info` under
+                "observation" (None once the episode is over).
+            seed: Episode k (counting from 0 every episode this environment begins, by
+                `reset` or by a `step` after a LAST step) is world `seed + k` of the family,
+                with `run.seed = seed + k`.
+
+        Raises:
+            VPlaneError: An invalid scenario, family, override or action.
+        """
         self.task = NavigationTask(scenario, family, overrides, action, reward, expose_observation)
         self.seed = seed
         self.episodes = 0

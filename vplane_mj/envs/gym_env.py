@@ -31,12 +31,6 @@ ENV_ID = "vplane_mj/Navigation-v0"
 class VPlaneNavEnv(gymnasium.Env):
     """Drive the robot to the goal through a world of a family, or through one scenario.
 
-    `scenario` (a Scenario, or a file or built-in scenario's name) is run in every episode;
-    without it each `reset` draws a world of `family` (traps, clutter, corridors or barn, as
-    `vplane-mj generate` makes them). `overrides` are `--set` strings applied to every
-    world (faults, sensor noise, the time limit). `action` is "force" or "velocity".
-    `reward` weighs the terms of the reward. With `expose_observation` every `info` holds
-    the planner's Observation of the tick under "observation" (None once the episode is over).
     `task` is the NavigationTask behind the environment (its `run` is the episode's Run).
     """
 
@@ -49,6 +43,24 @@ class VPlaneNavEnv(gymnasium.Env):
         reward: Reward | None = None,
         expose_observation: bool = False,
     ):
+        """Build the task and its spaces; the first episode begins with `reset`.
+
+        Args:
+            scenario: The scenario run in every episode (a Scenario, or the path or built-in
+                name of a scenario file); None: each `reset` draws a world of `family`.
+            family: The world family drawn from without a scenario: "traps", "clutter",
+                "corridors" or "barn", as `vplane-mj generate` makes them.
+            overrides: `--set KEY=VALUE` strings applied to every world (faults, sensor
+                noise, the time limit).
+            action: "force": a force (world frame) as a planner's decision; "velocity": the
+                body speed (m/s) and turn rate (rad/s).
+            reward: The weights of the reward's terms; None: the defaults.
+            expose_observation: Put the planner's Observation of each tick in `info` under
+                "observation" (None once the episode is over).
+
+        Raises:
+            VPlaneError: An invalid scenario, family, override or action.
+        """
         self.task = NavigationTask(scenario, family, overrides, action, reward, expose_observation)
         self.observation_space = spaces.Dict(
             {name: _space(name, bounds) for name, bounds in self.task.observation_bounds().items()}
