@@ -83,6 +83,11 @@ def njit(function: Callable | None = None, **options: Any) -> Any:
     return compile_cached if function is None else compile_cached(function)
 
 
+def loaded() -> int:
+    """How many kernel signatures this process has compiled or loaded."""
+    return sum(len(dispatcher.signatures) for dispatcher in DISPATCHERS.values())
+
+
 def _manifest_path(kind: str) -> Path:
     """Where the kernels that runs of `kind` used are listed (a pickle in CACHE_PATH)."""
     return CACHE_PATH / f"used-{kind}.pickle"

@@ -250,14 +250,18 @@ class Run:
 
     def run(self) -> RunResult:
         """Load the compiled kernels that runs of this kind used (`kernels.preload`, timed apart
-        from the loop as `kernel_load_s`), step to the end of the run; its result."""
+        from the loop as `kernel_load_s`), step to the end of the run; its result. The first run
+        of a process adds the kernels it used to its kind's (`kernels.remember`): in a process
+        that ran others before, which kernels this one used cannot be told apart."""
         from vplane_mj import kernels  # numba: the planners and sensors load it anyway
 
         kind = kernel_kind(self.planner_name, self.scenario.sensors.kind)
+        first = kernels.loaded() == 0
         self.kernel_load_s = kernels.preload(kind)
         while self.step() is None:
             pass
-        kernels.remember(kind)
+        if first:
+            kernels.remember(kind)
         return self.result()
 
     def observe(self) -> Observation | None:
