@@ -36,7 +36,14 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class RunEvent:
-    """One event of a run: its simulated time (s), kind, text for people and points (x, y) in m."""
+    """One event of a run: its simulated time (s), kind, text for people and points (x, y) in m.
+
+    Attributes:
+        time_s: When it happened (s of simulated time).
+        kind: What happened (a local minimum detected, an escape begun, ...).
+        text: The event as a sentence for people.
+        data: Its named points (`point`, `e1`, `e2`, `objective`, `waypoint`): (x, y) in m.
+    """
 
     time_s: float
     kind: EventKind
@@ -46,8 +53,15 @@ class RunEvent:
 
 @dataclass(frozen=True, eq=False)
 class Trajectory:
-    """The robot at every control tick: `times` (n,) in s, `positions` (n, 2) in m, `yaws` (n,)
-    in rad and the planner's `modes`; `final_pose` is x, y (m) and yaw (rad) at the end."""
+    """The robot at every control tick.
+
+    Attributes:
+        times: The ticks' simulated times (n,), s.
+        positions: The robot's centre at each tick (n, 2), m.
+        yaws: Its heading at each tick (n,), rad.
+        modes: The planner's mode at each tick ("normal", "escaping", ...).
+        final_pose: Where the run ended: x, y (m) and yaw (rad).
+    """
 
     times: np.ndarray
     positions: np.ndarray
@@ -58,9 +72,16 @@ class Trajectory:
 
 @dataclass(frozen=True, eq=False)
 class RunRecord:
-    """What a run gave: the scenario it ran, its summary, trajectory and events, and the files
-    written, by role in the order written: "log" (.mcap), "summary" (.json), "render" (.png),
-    "video" (.mp4)."""
+    """What a run gave.
+
+    Attributes:
+        scenario: The scenario it ran, as validated.
+        summary: Its summary, the `.json` file's keys as attributes.
+        trajectory: The robot at every control tick.
+        events: What happened, in order.
+        files: The files written, by role in the order written: "log" (.mcap), "summary"
+            (.json), "render" (.png), "video" (.mp4); empty when nothing was written.
+    """
 
     scenario: Scenario
     summary: RunSummary

@@ -39,9 +39,14 @@ class SweepErrorWarning(UserWarning):
 
 @dataclass(frozen=True, eq=False)
 class SweepResult:
-    """A sweep's rows (one per run, in the order scenario, planner, seed: the run's summary as
-    a dict, its journal `key` and its simplified path `path_xy`), its table (one row per
-    planner, the columns of `vplane_mj.bench.sweep.TABLE_COLUMNS`) and the report files written."""
+    """What a sweep gave.
+
+    Attributes:
+        rows: One per run, in the order scenario, planner, seed: the run's summary as a dict,
+            its journal `key` and its simplified path `path_xy` (m).
+        table: One row per planner, the columns of `vplane_mj.bench.sweep.TABLE_COLUMNS`.
+        files: The report files written (none with `report=False` or `out=None`).
+    """
 
     rows: list[dict]
     table: list[dict]
