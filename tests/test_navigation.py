@@ -9,7 +9,7 @@ import pytest
 
 from vplane_mj.geometry import shapes
 from vplane_mj.planning.protocol.events import EventKind
-from vplane_mj.scenario import parse_scenario
+from vplane_mj.scenario import load_scenario, parse_scenario
 from vplane_mj.sim.loop import run_scenario
 from vplane_mj.worlds.families import cup_case, rotated, trap_suite
 
@@ -121,39 +121,6 @@ def test_a_rotated_trap_gives_the_same_outcome(unrotated_trap, angle):
     assert turned.path_length_m == pytest.approx(base.path_length_m, rel=0.2)
 
 
-WALLED_GOAL = """
-format = 1
-name = "walled_goal"
-description = "The goal inside a closed square of walls: no way leads to it"
-[world]
-size = [10.0, 10.0]
-[[world.obstacles]]
-kind = "wall"
-from = [6.0, 4.0]
-to = [8.0, 4.0]
-[[world.obstacles]]
-kind = "wall"
-from = [8.0, 4.0]
-to = [8.0, 6.0]
-[[world.obstacles]]
-kind = "wall"
-from = [8.0, 6.0]
-to = [6.0, 6.0]
-[[world.obstacles]]
-kind = "wall"
-from = [6.0, 6.0]
-to = [6.0, 4.0]
-[robot]
-start = [2.0, 5.0]
-goal = [7.0, 5.0]
-[planner]
-name = "vplane_plus"
-[run]
-seed = 0
-time_limit_s = 600.0
-"""
-
-
 @pytest.mark.parametrize(
     "sensor, most_s",
     [
@@ -167,7 +134,8 @@ def test_vplane_plus_gives_up_on_a_walled_in_goal(sensor, most_s):
     `no_way_patience_s`, however often its sensor scans (a scan handed to several ticks is
     folded into the map once: folded again at later poses it erased the walls, and the robot
     drove for the whole time limit)."""
-    summary = run_scenario(parse_scenario(WALLED_GOAL, "walled_goal.toml", [sensor])).summary
+    overrides = ["planner.name=vplane_plus", "run.time_limit_s=600", sensor]
+    summary = run_scenario(load_scenario("walled_goal", overrides)).summary
     assert summary.outcome == "stuck", summary
     assert "the map has held no way to the goal" in summary.message
     assert summary.sim_time_s < most_s and summary.path_length_m < 60.0
