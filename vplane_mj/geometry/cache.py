@@ -22,8 +22,9 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
+from vplane_mj.errors import VPlaneError
 from vplane_mj.files import CACHE_ENV as CACHE_ENV
-from vplane_mj.files import cache_dir
+from vplane_mj.files import cache_dir, exclusive
 
 
 def cached(namespace: str, key: dict[str, Any], compute: Callable[[], Any]) -> Any:
@@ -66,17 +67,10 @@ def _write(path: Path, key: dict[str, Any], value: Any) -> None:
 
 @contextlib.contextmanager
 def _locked(path: Path) -> Iterator[None]:
-    """Hold an exclusive lock on `path` (created with its directory); no lock where that fails."""
-    try:
-        import fcntl
-
-        path.parent.mkdir(parents=True, exist_ok=True)
-        stream = open(path, "a")  # noqa: SIM115 - closed below, after the lock is released
-    except (ImportError, OSError):
+    """Hold the lock file `path` (created with its directory; `files.exclusive`, waiting for
+    another holder); no lock where that fails."""
+    with contextlib.ExitStack() as stack:
+        with contextlib.suppress(OSError, VPlaneError):
+            path.parent.mkdir(parents=True, exist_ok=True)
+            stack.enter_context(exclusive(path, "the reference-path cache", "", wait=True))
         yield
-        return
-    try:
-        fcntl.flock(stream, fcntl.LOCK_EX)
-        yield
-    finally:
-        stream.close()
