@@ -16,6 +16,10 @@ digest of this package's sources (`cache_path`): a kernel that calls one of anot
 compiled again when either changes, where numba's own cache, which checks only the file of
 the function it loads, would run the stale machine code of a caller whose callee was edited.
 
+LLVM compiles them for a generic model of the CPU (`COMPILE_FOR_CPU`), with the instruction set
+the CPU has: tuned for the host's own model, the same kernels gave other last bits on two
+machines that differ only in it (see `compile_for_generic_cpu`).
+
 Loading a kernel from that cache takes a few milliseconds on its first call in a process. A run
 loads the kernels the last runs of its kind used before its loop starts (`preload`), from the
 signatures they left in the cache (`remember`), so the loop's wall time holds no loading.
@@ -34,6 +38,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import llvmlite.binding
 import numba
 from numba.core import config as numba_config
 
@@ -62,6 +67,30 @@ def cache_path() -> Path:
     return cache_dir() / name
 
 
+COMPILE_FOR_CPU = "generic"
+"""The CPU model (LLVM's name) the kernels are compiled for."""
+
+
+def compile_for_generic_cpu() -> None:
+    """Have numba compile for `COMPILE_FOR_CPU` unless the user chose a model (`NUMBA_CPU_NAME`)
+    or this process compiled something already (numba then keeps the model it chose).
+
+    Measured on the 308 golden runs: compiled for the host's model (`znver4`) on a CPU with
+    AVX-512, six trajectories differed in their last bits from those of a CPU without it;
+    compiled for `generic` with the same instructions, none did. numba compiles a process's own
+    functions for the same model as these kernels."""
+    from numba.core.registry import cpu_target
+
+    if numba_config.CPU_NAME is None and "_toplevel_target_context" not in vars(cpu_target):  # type: ignore[attr-defined]
+        numba_config.CPU_NAME = COMPILE_FOR_CPU  # type: ignore[attr-defined]  # numba sets its config at run time
+
+
+def compiled_for_cpu() -> str:
+    """The CPU model (LLVM's name) this process's kernels are compiled for."""
+    return numba_config.CPU_NAME or llvmlite.binding.get_host_cpu_name()  # type: ignore[attr-defined]
+
+
+compile_for_generic_cpu()
 CACHE_PATH = cache_path()
 DISPATCHERS: dict[str, Any] = {}
 """Every kernel made in this process by `njit`, by its module and name (`module.function`)."""
