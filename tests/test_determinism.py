@@ -79,3 +79,40 @@ def test_dask_and_the_local_pool_give_identical_rows_with_every_fault_on(tmp_pat
     assert len(local_rows) == 8
     assert local_rows == remote_rows
     assert len({row["trajectory_sha256"] for row in local_rows}) == 8
+
+
+BLAS_FREE_RUNS = """
+from tests.test_golden import GOLDEN_TIME_LIMIT_S, world_texts
+from vplane_mj.kernels import compiled_for_cpu
+from vplane_mj.scenario import load_scenario, parse_scenario
+from vplane_mj.sim.loop import run_scenario
+
+jackal = ['robot.profile="jackal"', 'sensors.pose="ekf"', "run.time_limit_s=8"]
+golden = ["planner.name=vplane", f"run.time_limit_s={GOLDEN_TIME_LIMIT_S}"]
+runs = [
+    parse_scenario(world_texts()["clutter_1_000"], "clutter_1_000", golden),
+    load_scenario("paper_c_escape", [*jackal, "planner.name=dwa"]),
+    load_scenario("paper_c_escape", [*jackal, "planner.name=vplane_plus"]),
+]
+print(compiled_for_cpu(), *(run_scenario(scenario).summary.trajectory_sha256 for scenario in runs))
+"""
+
+
+def _blas_free_runs(**env: str) -> list[str]:
+    finished = subprocess.run(
+        [sys.executable, "-c", BLAS_FREE_RUNS],
+        capture_output=True,
+        text=True,
+        env={**{k: v for k, v in os.environ.items() if k != "NUMBA_CPU_NAME"}, **env},
+        timeout=600,
+    )
+    assert finished.returncode == 0, finished.stderr
+    return finished.stdout.split()
+
+
+def test_trajectories_do_not_depend_on_the_blas_kernels_or_the_cpu_model():
+    """OpenBLAS's baseline kernels (no fused multiply-adds) changed two golden trajectories
+    while products went through BLAS; the kernels compile for a generic CPU unless asked."""
+    usual = _blas_free_runs()
+    assert usual[0] == "generic"
+    assert _blas_free_runs(OPENBLAS_CORETYPE="Prescott") == usual

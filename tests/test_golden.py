@@ -4,13 +4,13 @@ makes of each world what `golden_digests.json` records.
 Each run is cut at `GOLDEN_TIME_LIMIT_S` simulated seconds. On any machine the test compares
 what a run made of its world: its outcome, collisions, local minima and escapes, exactly, and
 its path length to a relative `PATH_RTOL`. The trajectory itself, by its digest, bit for bit,
-is compared only in the environment the file was recorded in (`environment`): floating-point
-results depend on the MuJoCo, numpy and numba builds, on the vector instructions numpy finds on
-the CPU (with AVX-512 it computes sines, arctangents and the like by other routines, which may
-differ in the last bit) and on the kernels OpenBLAS picks for it (with or without fused
-multiply-adds in a matrix product: OpenBLAS's baseline kernels instead of Haswell's change 2 of
-the 308 trajectories; docs/contributing.md says what else was measured). Elsewhere a skipped
-test says that the digests were left out and why.
+is compared where the environment matches the one the file was recorded in (`environment`):
+the MuJoCo, numpy and numba builds, the architecture, whether numpy computes sines, arctangents
+and the like by its AVX-512 routines (which may differ in the last bit) and the CPU model the
+kernels are compiled for (`generic` unless NUMBA_CPU_NAME chooses one). No product in a run
+goes through BLAS, so the kernels OpenBLAS picks for a CPU are not among them (docs/
+contributing.md says what was measured). Elsewhere a skipped test says that the digests were
+left out and why.
 
 A change to the code that is meant to leave behaviour alone must leave every recorded value
 as it is; a change that is meant to alter behaviour is recorded again, from the repository's
@@ -21,7 +21,6 @@ root, with
 
 from __future__ import annotations
 
-import ctypes
 import functools
 import json
 import math
@@ -35,6 +34,7 @@ import numba
 import numpy as np
 import pytest
 
+from vplane_mj.kernels import compiled_for_cpu
 from vplane_mj.planning.protocol.registry import BUILT_IN
 from vplane_mj.scenario import load_scenario, parse_scenario
 from vplane_mj.sim.loop import run_scenario
@@ -68,28 +68,9 @@ def environment() -> dict[str, str]:
         "numpy": np.__version__,
         "numba": numba.__version__,
         "machine": platform.machine(),
-        "numpy_simd": ",".join(numpy_dispatch_targets()),
-        "blas_core": blas_core(),
+        "numpy_avx512": "yes" if "X86_V4" in numpy_dispatch_targets() else "no",
+        "kernels_cpu": compiled_for_cpu(),
     }
-
-
-def blas_core() -> str:
-    """The kernels numpy's OpenBLAS chose for this CPU (e.g. Haswell, SkylakeX, Zen): each sums
-    a product's terms with or without fused multiply-adds, so a matrix product's last bit, and
-    with it a trajectory's, depends on them. "unknown" where it cannot be asked."""
-    np.ones((2, 2)) @ np.ones((2, 2))  # numpy loads OpenBLAS with its first product
-    try:
-        with open("/proc/self/maps", encoding="utf-8") as maps:
-            paths = sorted({line.split()[-1] for line in maps if "openblas" in line.lower()})
-        library = ctypes.CDLL(paths[0])
-    except (OSError, IndexError):
-        return "unknown"
-    for name in ("scipy_openblas_get_corename64_", "scipy_openblas_get_corename", "openblas_get_corename"):
-        corename = getattr(library, name, None)
-        if corename is not None:
-            corename.restype = ctypes.c_char_p
-            return corename().decode()
-    return "unknown"
 
 
 def numpy_dispatch_targets() -> list[str]:

@@ -8,8 +8,9 @@ import numpy as np
 def distances_to_segment(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Distance (m) from each of `points` (N, 2) to the segment a-b (a point when a == b)."""
     ab = b - a
-    length2 = float(ab @ ab)
-    t = np.zeros(len(points)) if length2 == 0.0 else np.clip((points - a) @ ab / length2, 0.0, 1.0)
+    length2 = float(ab[0] * ab[0] + ab[1] * ab[1])
+    along = (points[:, 0] - a[0]) * ab[0] + (points[:, 1] - a[1]) * ab[1]  # not @: no BLAS
+    t = np.zeros(len(points)) if length2 == 0.0 else np.clip(along / length2, 0.0, 1.0)
     return np.hypot(*(points - (a + t[:, None] * ab)).T)
 
 

@@ -35,8 +35,9 @@ class Rect:
         """The four corners (4, 2) in world coordinates, counter-clockwise."""
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         hx, hy = self.half
-        local = np.array([(-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)])
-        return np.asarray(self.center) + local @ np.array([[c, s], [-s, c]])
+        x, y = np.array([-hx, hx, hx, -hx]), np.array([-hy, -hy, hy, hy])
+        turned = np.column_stack((x * c - y * s, x * s + y * c))  # not @: no BLAS in a tick
+        return np.asarray(self.center) + turned
 
 
 @dataclass(frozen=True)

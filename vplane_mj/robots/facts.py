@@ -19,6 +19,7 @@ import numpy as np
 
 from vplane_mj.files import model_path
 from vplane_mj.planning.protocol.body import HeadingGains, RobotBody
+from vplane_mj.planning.protocol.matrices import product
 from vplane_mj.robots.mjcf_reader import MjcfReader, PosedGeom
 from vplane_mj.robots.profiles import robot_profile
 
@@ -82,7 +83,7 @@ def footprint_radius(geoms: list[PosedGeom], origin: np.ndarray) -> float:
         else:
             signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
             local = signs * np.asarray(geom.size[:3])
-        points = geom.pos + local @ geom.rot.T
+        points = geom.pos + product(local, geom.rot.T)
         reach = max(reach, float(np.max(np.hypot(*(points[:, :2] - origin).T))))
     return reach
 

@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from vplane_mj.planning.protocol.matrices import product
+
 MAIN_CLASS = "main"
 """The default class that the top-level `<default>` defines and every class inherits from."""
 GEOM_TYPES = ("sphere", "cylinder", "box")
@@ -96,7 +98,7 @@ class MjcfReader:
             body, inherited, parent_pos, parent_rot = stack.pop()
             cls = body.get("childclass", inherited)
             local_pos, local_rot = self._frame(body, inherited)
-            pos, rot = parent_pos + parent_rot @ local_pos, parent_rot @ local_rot
+            pos, rot = parent_pos + product(parent_rot, local_pos), product(parent_rot, local_rot)
             yield body, cls, pos, rot
             stack.extend((child, cls, pos, rot) for child in body.findall("body"))
 
@@ -117,7 +119,7 @@ class MjcfReader:
                     raise ValueError(f"{self.path}: geom type {kind!r} is not supported by this reader")
                 size = self.numbers(geom, "size", cls) or ()
                 local_pos, local_rot = self._frame(geom, cls)
-                pos, rot = body_pos + body_rot @ local_pos, body_rot @ local_rot
+                pos, rot = body_pos + product(body_rot, local_pos), product(body_rot, local_rot)
                 posed.append(PosedGeom(geom.get("name", ""), body.get("name", ""), kind, size, pos, rot))
         return posed
 
@@ -139,7 +141,7 @@ class MjcfReader:
 
 def quat_to_matrix(quat: tuple[float, ...]) -> np.ndarray:
     """The rotation matrix of a quaternion (w, x, y, z), normalised first as MuJoCo does."""
-    w, x, y, z = np.asarray(quat, float) / np.linalg.norm(quat)
+    w, x, y, z = np.asarray(quat, float) / math.hypot(*quat)
     return np.array(
         [
             [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
@@ -155,4 +157,4 @@ def euler_xyz_to_matrix(angles: tuple[float, ...]) -> np.ndarray:
     rx = np.array([[1, 0, 0], [0, math.cos(a), -math.sin(a)], [0, math.sin(a), math.cos(a)]])
     ry = np.array([[math.cos(b), 0, math.sin(b)], [0, 1, 0], [-math.sin(b), 0, math.cos(b)]])
     rz = np.array([[math.cos(c), -math.sin(c), 0], [math.sin(c), math.cos(c), 0], [0, 0, 1]])
-    return rx @ ry @ rz
+    return product(product(rx, ry), rz)

@@ -22,6 +22,8 @@ import math
 
 import numpy as np
 
+from vplane_mj.planning.protocol.matrices import product, solve
+
 X, Y, YAW, V, W = range(5)
 ODOMETRY_ROWS = np.array([[0, 0, 0, 1, 0], [0, 0, 0, 0, 1]], dtype=float)
 """H of the wheel odometry's (v, w)."""
@@ -61,14 +63,15 @@ class PoseFilter:
         noise = np.zeros((5, 5))
         noise[V, V] = (self.accel_std**2) * dt
         noise[W, W] = (self.turn_accel_std**2) * dt
-        self.cov = jacobian @ self.cov @ jacobian.T + noise
+        self.cov = product(product(jacobian, self.cov), jacobian.T) + noise
 
     def correct(self, rows: np.ndarray, measured: np.ndarray, stds: np.ndarray) -> None:
         """Fold in the measurement `measured` of rows @ state with 1-sigma `stds` (same units)."""
-        residual = measured - rows @ self.state
-        innovation_cov = rows @ self.cov @ rows.T + np.diag(np.asarray(stds, float) ** 2)
-        gain = np.linalg.solve(innovation_cov, rows @ self.cov).T
-        self.state = self.state + gain @ residual
+        residual = measured - product(rows, self.state)
+        innovation_cov = product(product(rows, self.cov), rows.T) + np.diag(np.asarray(stds, float) ** 2)
+        gain = solve(innovation_cov, product(rows, self.cov)).T
+        self.state = self.state + product(gain, residual)
         self.state[YAW] = math.remainder(self.state[YAW], math.tau)
-        keep = np.eye(5) - gain @ rows
-        self.cov = keep @ self.cov @ keep.T + gain @ np.diag(np.asarray(stds, float) ** 2) @ gain.T
+        keep = np.eye(5) - product(gain, rows)
+        noise = product(product(gain, np.diag(np.asarray(stds, float) ** 2)), gain.T)
+        self.cov = product(product(keep, self.cov), keep.T) + noise

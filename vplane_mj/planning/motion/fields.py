@@ -14,7 +14,7 @@ MIN_DISTANCE_M = 1e-3
 
 def attractive_potential(position: np.ndarray, goal: np.ndarray, gain: float, radius: float) -> float:
     """Eq. 2: w|d|^2 for |d| <= r, w(2r|d| - r^2) beyond (continuous at r); d = x - x_goal."""
-    d = float(np.linalg.norm(np.asarray(position, float) - goal))
+    d = float(np.hypot(*(np.asarray(position, float) - goal)))
     if d <= radius:
         return gain * d * d
     return gain * (2.0 * radius * d - radius * radius)

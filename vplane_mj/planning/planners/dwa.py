@@ -90,6 +90,7 @@ from vplane_mj.planning.planners.groups import EvasionParams, LocalMapParams, Mi
 from vplane_mj.planning.protocol.base import Planner
 from vplane_mj.planning.protocol.body import DriveLimits, HeadingGains, RobotBody
 from vplane_mj.planning.protocol.events import Event, EventKind
+from vplane_mj.planning.protocol.matrices import product
 from vplane_mj.planning.protocol.params import param
 from vplane_mj.planning.protocol.types import Decision, Observation
 from vplane_mj.planning.protocol.vectors import evenly_spaced, wrap_angle
@@ -293,7 +294,7 @@ class DwaPlanner(Planner):
         decision = Decision(force=np.zeros(2), mode="normal")
         if admissible.any():
             score = np.where(admissible, self._objective(obs, self.aim(obs), speeds, turns, dist), 0.0)
-            score = self.smooth_speeds @ score @ self.smooth_turns.T
+            score = product(product(self.smooth_speeds, score), self.smooth_turns.T)
             i, j = np.unravel_index(np.argmax(np.where(admissible, score, -np.inf)), score.shape)
             command = float(speeds[i]), float(turns[j])
             if self.blocked:

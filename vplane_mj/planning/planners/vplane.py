@@ -45,7 +45,7 @@ from vplane_mj.planning.protocol.body import RobotBody
 from vplane_mj.planning.protocol.events import Event, EventKind, point
 from vplane_mj.planning.protocol.params import param
 from vplane_mj.planning.protocol.types import Decision, Observation
-from vplane_mj.planning.protocol.vectors import unit
+from vplane_mj.planning.protocol.vectors import dot, unit
 
 CONCAVITY_CHECK_PERIOD_S = 0.2
 """How often (s) the map is examined for a concave obstacle ahead (cheap checks run every tick)."""
@@ -239,7 +239,7 @@ class VPlanePlanner(Planner):
         if len(cells) == 0:
             return None
         rel = cells - position
-        toward_goal = rel @ unit(goal - position)
+        toward_goal = dot(rel, unit(goal - position))
         distance = np.hypot(rel[:, 0], rel[:, 1])
         ahead = toward_goal > 0.5 * distance  # within 60 degrees of the goal direction
         pool = np.flatnonzero(ahead) if ahead.any() else np.arange(len(cells))
@@ -352,8 +352,8 @@ class VPlanePlanner(Planner):
         cells, labels, _ = self.map.clusters(p.map_threshold, self._link_m())
         heading = unit(obs.goal - obs.position)
         rel = cells - obs.position
-        forward = rel @ heading
-        lateral = np.abs(rel @ np.array([-heading[1], heading[0]]))
+        forward = dot(rel, heading)
+        lateral = np.abs(dot(rel, np.array([-heading[1], heading[0]])))
         reach = min(p.lookahead_m, obs.distance_to_goal())
         ahead = (forward > 0) & (forward < reach) & (lateral < self.robot.half_width_m + p.clearance_m)
         if not ahead.any():
@@ -366,9 +366,9 @@ class VPlanePlanner(Planner):
         e1, e2 = cluster[i1], cluster[i2]
         chord = unit(e2 - e1)
         away = np.array([-chord[1], chord[0]])
-        if (e1 - obs.position) @ away < 0:
+        if dot(e1 - obs.position, away) < 0:
             away = -away
-        depth = float(np.max((cluster - e1) @ away))
+        depth = float(np.max(dot(cluster - e1, away)))
         if depth < p.concave_depth_m:
             return None
         via = [np.hypot(*(e - obs.position)) + np.hypot(*(obs.goal - e)) for e in (e1, e2)]
@@ -377,7 +377,7 @@ class VPlanePlanner(Planner):
         # so the straight way there passes the edge at that distance.
         sight = unit(edge - obs.position)
         outward = np.array([-sight[1], sight[0]])
-        if outward @ (edge - (e1 + e2) / 2) < 0:
+        if dot(outward, edge - (e1 + e2) / 2) < 0:
             outward = -outward
         # Just past the edge; farther out when the straight way there grazes the obstacle.
         for offset in EDGE_OFFSETS_M:
@@ -390,7 +390,7 @@ class VPlanePlanner(Planner):
         """No known obstacle cell within the robot's half width plus clearance of the segment
         (the robot drives along it, aligned with it)."""
         span = end - start
-        t = np.clip((cells - start) @ span / max(float(span @ span), 1e-12), 0.0, 1.0)
+        t = np.clip(dot(cells - start, span) / max(float(dot(span, span)), 1e-12), 0.0, 1.0)
         nearest = start + t[:, None] * span
         return bool(
             np.min(np.hypot(*(cells - nearest).T)) > self.robot.half_width_m + self.params.clearance_m

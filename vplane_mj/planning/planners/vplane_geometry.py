@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vplane_mj.planning.motion.fields import MIN_DISTANCE_M
-from vplane_mj.planning.protocol.vectors import unit
+from vplane_mj.planning.protocol.vectors import dot, unit
 
 
 @dataclass(frozen=True)
@@ -81,9 +81,9 @@ def make_plane(
         normal = unit(robot - np.mean(trap_points, axis=0))
         normal = normal if normal.any() else np.array([1.0, 0.0])
         tangent = np.array([normal[1], -normal[0]])
-    if (np.mean(trap_points, axis=0) - e1) @ normal > 0:
+    if dot(np.mean(trap_points, axis=0) - e1, normal) > 0:
         normal = -normal
-    outermost = max(0.0, float(np.max((np.asarray(trap_points) - e1) @ normal))) if to_outermost else 0.0
+    outermost = max(0.0, float(np.max(dot(np.asarray(trap_points) - e1, normal)))) if to_outermost else 0.0
     shift = outermost * normal
     e1, e2 = e1 - extend * tangent + shift, e2 + extend * tangent + shift
     via_e1 = np.hypot(*(e1 - robot)) + np.hypot(*(goal - e1))
@@ -101,7 +101,7 @@ def escape_direction(robot: np.ndarray, e1: np.ndarray, e2: np.ndarray, goal: np
     if not bisector.any():
         t = unit(e2 - e1)
         bisector = np.array([-t[1], t[0]])
-    if bisector @ (goal - robot) > 0:
+    if dot(bisector, goal - robot) > 0:
         bisector = -bisector
     return bisector
 
@@ -124,8 +124,8 @@ def virtual_objective(
     objective = robot + dis * direction
     _, out = plane.frame_coordinates(objective)
     if out < clearance:
-        push = direction if direction @ plane.normal > 0.2 else plane.normal
-        objective = objective + push * (clearance - out) / float(push @ plane.normal)
+        push = direction if dot(direction, plane.normal) > 0.2 else plane.normal
+        objective = objective + push * (clearance - out) / float(dot(push, plane.normal))
     return objective
 
 

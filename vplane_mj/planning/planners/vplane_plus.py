@@ -50,7 +50,7 @@ from vplane_mj.planning.protocol.body import RobotBody
 from vplane_mj.planning.protocol.events import Event, EventKind, point
 from vplane_mj.planning.protocol.params import param, with_default
 from vplane_mj.planning.protocol.types import Decision, Observation
-from vplane_mj.planning.protocol.vectors import unit, wrap_angle
+from vplane_mj.planning.protocol.vectors import dot, unit, wrap_angle
 
 CLOSE_ECHO_MARGIN_M = 0.1
 """An echo this close beyond the robot's disc (m) repels in full, even against the way."""
@@ -305,7 +305,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         gain, influence = p.repulse_gain, p.follow_influence_m
         farther = fade * fields.repulsive_force(obs.position, echoes[~close], gain, influence)
         near = fade * fields.repulsive_force(obs.position, echoes[close], gain, influence)
-        components["repulsive"] = near + farther - min(float(farther @ heading), 0.0) * heading
+        components["repulsive"] = near + farther - min(float(dot(farther, heading)), 0.0) * heading
 
     def _firas(self, obs: Observation) -> dict[str, np.ndarray]:
         """Eq. 6's two terms at the robot (`FieldParams.firas_components`), the repulsion faded
@@ -479,7 +479,7 @@ class VPlanePlusPlanner(VPlanePlanner):
             distance[near],
             labels[i[near], j[near]],
         )
-        ahead = rel @ unit(goal - position) > 0.5 * distance
+        ahead = dot(rel, unit(goal - position)) > 0.5 * distance
         pool = np.flatnonzero(ahead) if ahead.any() else np.arange(len(centres))
         trap = cell_labels == cell_labels[pool[np.argmin(distance[pool])]]
         return centres[trap], centres[~trap]
@@ -490,7 +490,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         if not len(others):
             return False
         span = plane.e2 - plane.e1
-        t = np.clip((others - plane.e1) @ span / max(float(span @ span), 1e-12), 0.0, 1.0)
+        t = np.clip(dot(others - plane.e1, span) / max(float(dot(span, span)), 1e-12), 0.0, 1.0)
         gaps = np.hypot(*(others - (plane.e1 + t[:, None] * span)).T)
         return bool(np.min(gaps) < self._link_m() / 2)
 
@@ -523,7 +523,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         usable = np.isfinite(costs) & seen_around & (window.cost <= roomy)
         centres = window.centres()
         if plane is not None:
-            usable &= (centres - plane.e1) @ plane.normal >= clearance
+            usable &= dot(centres - plane.e1, plane.normal) >= clearance
         cell = window.cell_of(candidate)
         if cell is None or not usable[cell]:
             if not usable.any():

@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from vplane_mj.planning.protocol.vectors import rotated
+
 DISC_SIDES = 32
 """Sides of the regular polygon that stands for a disc-shaped robot's footprint."""
 
@@ -114,13 +116,12 @@ class RobotBody:
 
     def outline_at(self, x: float, y: float, yaw: float) -> np.ndarray:
         """The footprint (k, 2) in the world for the pose x, y (m) and yaw (rad)."""
-        c, s = math.cos(yaw), math.sin(yaw)
-        return self.footprint @ np.array([[c, s], [-s, c]]) + (x, y)
+        return rotated(self.footprint, yaw) + np.array([x, y])
 
 
 def _signed_area(polygon: np.ndarray) -> float:
     x, y = polygon[:, 0], polygon[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+    return 0.5 * float(np.sum(x * np.roll(y, -1)) - np.sum(np.roll(x, -1) * y))
 
 
 def _frozen(array: np.ndarray) -> np.ndarray:

@@ -35,3 +35,20 @@ def unit(v: np.ndarray) -> np.ndarray:
     """v / |v| for a plane vector, or zeros for a (near) zero vector."""
     norm = float(np.hypot(v[0], v[1]))
     return v / norm if norm > 1e-12 else np.zeros(2)
+
+
+def dot(points: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """x vx + y vy of each plane vector of `points` (..., 2) with `v` (2,), rounded as written.
+
+    Not `points @ v`: numpy hands a product to BLAS, whose kernels for the CPU at hand (with
+    fused multiply-adds or without) decide its last bit, and a trajectory's with it."""
+    points = np.asarray(points, float)
+    return points[..., 0] * v[0] + points[..., 1] * v[1]
+
+
+def rotated(points: np.ndarray, yaw: float) -> np.ndarray:
+    """Plane vectors `points` (..., 2) turned by `yaw` (rad) counter-clockwise (no BLAS, as `dot`)."""
+    points = np.asarray(points, float)
+    c, s = math.cos(yaw), math.sin(yaw)
+    x, y = points[..., 0], points[..., 1]
+    return np.stack((x * c - y * s, x * s + y * c), axis=-1)
