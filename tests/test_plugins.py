@@ -126,7 +126,7 @@ def test_the_command_line_imports_a_module_from_the_current_directory(tmp_path):
     [
         ("no_such_module:Planner", "cannot import no_such_module: ModuleNotFoundError"),
         ("side_effect:Missing", "side_effect has no Missing"),
-        ("os:path", "path is not a subclass of vplane_mj.planning.Planner"),
+        ("os:path", "os:path: it is not a subclass of vplane_mj.planning.Planner"),
         ("missing/file.py:Planner", "no such file"),
         (
             "./notes.txt:Planner",
@@ -256,7 +256,10 @@ def test_register_planner_refuses_what_is_no_planner(own_registry):
         gain: float = param(-1.0, "", "a gain", ge=0)
 
     cases = {
-        "its Params is not a frozen dataclass": {"Params": Undecorated},
+        "its Params must be a frozen dataclass: put @dataclass(frozen=True) above its class": {
+            "Params": Undecorated
+        },
+        "its Params must be a subclass of vplane_mj.planning.PlannerParams, not dict": {"Params": dict},
         "its parameter 'gain' is not made by param(...)": {"Params": Plain},
         "the default of its parameter 'gain' must be at least 0, got -1.0": {"Params": OutOfBounds},
         "its name must match [a-z0-9_]+": {"name": "Straight"},

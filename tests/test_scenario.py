@@ -491,7 +491,7 @@ def test_invalid_scenario_names_key_and_reason(text, overrides, key, fragment):
     set_keys = [override.partition("=")[0] for override in overrides]
     if any(key == set_key or key.startswith((f"{set_key}.", f"{set_key}[")) for set_key in set_keys):
         # A key an override set: the message names the override, not the file.
-        assert str(err) == f"--set {key}: {err.reason} (applied to scenarios/x.toml)"
+        assert str(err) == f"overrides {key}: {err.reason} (applied to scenarios/x.toml)"
     else:
         assert str(err) == f"scenarios/x.toml: {key}: {err.reason}"
 
@@ -654,7 +654,7 @@ def test_malformed_override(override, key, fragment):
     text = obstacle('kind = "cylinder"\ncenter = [5, 5]\nradius = 1\n')
     err = errors_of(text, [override])
     assert err.key == key
-    assert fragment in err.reason and str(err).startswith(f"--set {key}".rstrip() + ": ")
+    assert fragment in err.reason and str(err).startswith(f"overrides {key}".rstrip() + ": ")
 
 
 def test_override_is_validated_like_the_file():

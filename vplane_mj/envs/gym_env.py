@@ -20,7 +20,10 @@ try:
     import gymnasium
     from gymnasium import spaces
 except ImportError as exc:  # the optional extra
-    raise ImportError("vplane_mj.envs.gym_env needs Gymnasium: pip install 'vplane-mj[gym]'") from exc
+    raise ImportError(
+        "vplane_mj.envs.gym_env needs Gymnasium: pip install gymnasium "
+        '(or, in a clone of vplane-mj, pip install -e ".[gym]")'
+    ) from exc
 
 from vplane_mj.envs.task import Bounds, NavigationTask, Reward
 from vplane_mj.scenario import Scenario

@@ -16,25 +16,30 @@ from typing import Any
 from vplane_mj.scenario.fields import Invalid, join_key, type_name
 
 SET_OPTION = "--set"
-"""The option of an override given as plain `KEY=VALUE` text."""
+"""The command line's option of an override given as `KEY=VALUE` text."""
+API_OPTION = "overrides"
+"""The Python API's argument of an override given as `KEY=VALUE` text."""
 
 
 @dataclass(frozen=True)
 class Override:
     """One `KEY=VALUE` override and the option that gave it, which its errors name: `--set`
-    (an override given as plain text), or an option that stands for one key (`--seed`)."""
+    (the command line's), `overrides` (text given to the Python API), or an option that
+    stands for one key (`--seed`)."""
 
     text: str
     option: str = SET_OPTION
 
     @classmethod
     def of(cls, override: str | Override) -> Override:
-        """An override given as text or as an Override, as an Override."""
-        return override if isinstance(override, Override) else cls(override)
+        """An override given as an Override, or as text to the Python API, as an Override."""
+        return override if isinstance(override, Override) else cls(override, API_OPTION)
 
     def origin(self, key: str) -> str:
         """How an error at `key` (the key this override set, or one inside it) names it."""
-        return f"{self.option} {key}".rstrip() if self.option == SET_OPTION else self.option
+        if self.option in (SET_OPTION, API_OPTION):
+            return f"{self.option} {key}".rstrip()
+        return self.option
 
 
 _KEY_SEGMENT = re.compile(r"([A-Za-z0-9_-]+)((?:\[[0-9]{1,9}\])*)")

@@ -40,9 +40,9 @@ def planner_problem(cls: object) -> str | None:
     name of [a-z0-9_]+, a summary, a citation, and a frozen `PlannerParams` dataclass whose every
     field is made by `param` with a default within its bounds."""
     if not (inspect.isclass(cls) and issubclass(cls, Planner)):
-        return "is not a subclass of vplane_mj.planning.Planner"
+        return "it is not a subclass of vplane_mj.planning.Planner"
     if inspect.isabstract(cls):
-        return "does not implement step(obs)"
+        return "it does not implement step(obs)"
     name = getattr(cls, "name", None)
     if not isinstance(name, str) or not NAME_PATTERN.fullmatch(name):
         return f"its name must match [a-z0-9_]+ (it names output files), got {name!r}"
@@ -50,13 +50,17 @@ def planner_problem(cls: object) -> str | None:
         return f"its name must be at most {MAX_NAME_LENGTH} characters, got {len(name)}"
     for attribute in ("summary", "citation"):
         if not isinstance(getattr(cls, attribute, None), str):
-            return f"has no {attribute} (a string)"
+            return f"it has no {attribute} (a string class attribute)"
     params = cls.Params
     if not (inspect.isclass(params) and issubclass(params, PlannerParams)):
-        return "its Params is not a subclass of vplane_mj.planning.PlannerParams"
+        got = params.__name__ if inspect.isclass(params) else type(params).__name__
+        return (
+            f"its Params must be a subclass of vplane_mj.planning.PlannerParams, not {got} "
+            "(a planner without parameters leaves Params out)"
+        )
     own = vars(params)  # what @dataclass sets on the class itself, not inherited from a base
     if "__dataclass_fields__" not in own or not getattr(own.get("__dataclass_params__"), "frozen", False):
-        return "its Params is not a frozen dataclass (@dataclass(frozen=True))"
+        return "its Params must be a frozen dataclass: put @dataclass(frozen=True) above its class"
     for field in dataclasses.fields(params):
         spec = field.metadata.get(PARAM)
         if spec is None:
@@ -94,7 +98,7 @@ def import_planner(spec: str) -> type[Planner]:
         raise PlannerError(f"{spec}: {target} has no {class_name}")
     problem = planner_problem(cls)
     if problem:
-        raise PlannerError(f"{spec}: {class_name} {problem}")
+        raise PlannerError(f"{spec}: {problem}")
     return cls
 
 
