@@ -22,7 +22,6 @@ from vplane_mj.worlds.dynabarn_layout import DIFFICULTIES
 from vplane_mj.worlds.families import FAMILIES
 
 if TYPE_CHECKING:
-    from vplane_mj.scenario import Scenario
     from vplane_mj.scenario.overrides import Override
     from vplane_mj.sim.summary import RunSummary
 
@@ -170,6 +169,14 @@ def _add_bench(commands) -> None:
         action="store_true",
         help="if another sweep writes into the output directory, wait for it to end (default: refuse)",
     )
+    sweep.add_argument(
+        "--by-scenario", action="store_true", help="also print the table per scenario and planner"
+    )
+    sweep.add_argument(
+        "--fail-on-collision",
+        action="store_true",
+        help="exit 1 when any run collided (default: 0 once every run finished)",
+    )
     sweep.set_defaults(handler=_bench, draws=False)
 
 
@@ -264,7 +271,7 @@ def _overrides(args: argparse.Namespace) -> list[str | Override]:
         extra.append(Override(f"planner.name={_planner_name(args.planner, '--planner')}", "--planner"))
     if args.seed is not None:
         extra.append(Override(f"run.seed={args.seed}", "--seed"))
-    return [*args.set, *extra]
+    return [*map(Override, args.set), *extra]
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -281,7 +288,7 @@ def _run(args: argparse.Namespace) -> int:
     except Interrupted as exc:
         _report_interrupted_run(exc)
         return exc.exit_status
-    print(_summary_line(scenario, record.summary))
+    print(record.line())
     for path in record.files.values():
         print(f"wrote {path}")
     if record.summary.traceback:
@@ -311,18 +318,9 @@ def _report_interrupted_run(exc: Interrupted) -> None:
         print(f"wrote {path}{closed}", file=sys.stderr)
 
 
-def _summary_line(scenario: Scenario, s: RunSummary) -> str:
-    clearance = "n/a" if s.min_clearance_m is None else f"{s.min_clearance_m:.3f} m"
-    return (
-        f"{scenario.name} [{s.planner}, seed {s.seed}]: {s.outcome} after "
-        f"{s.sim_time_s:.2f} s simulated, path {s.path_length_m:.2f} m, "
-        f"collisions {s.collisions}, min clearance {clearance}, "
-        f"local minima {s.local_minima}, escapes {s.escapes}, wall {s.wall_time_s:.2f} s"
-    )
-
-
 def _bench(args: argparse.Namespace) -> int:
-    from vplane_mj.bench.sweep import error_lines, format_table, parse_seeds
+    from vplane_mj.bench.sweep import collision_line, error_lines, parse_seeds
+    from vplane_mj.scenario.overrides import Override
     from vplane_mj.sweeps import SweepErrorWarning, sweep
 
     if args.jobs < 1:
@@ -338,7 +336,7 @@ def _bench(args: argparse.Namespace) -> int:
                 args.scenarios,
                 planners,
                 seeds,
-                tuple(args.set),
+                tuple(map(Override, args.set)),
                 args.jobs,
                 args.scheduler,
                 out_dir,
@@ -352,11 +350,17 @@ def _bench(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return exc.exit_status
-    print(format_table(result.table))
+    print(result.table_text())
+    if args.by_scenario:
+        print(result.table_text(by_scenario=True))
     for line in error_lines(result.rows, Path(out_dir)):
         print(line)
     for path in result.files:
         print(f"wrote {path}")
+    collided = [row for row in result.rows if row["collisions"] > 0]
+    if args.fail_on_collision and collided:
+        print(collision_line(collided, len(result.rows)), file=sys.stderr)
+        return EXIT_NOT_REACHED
     return 0
 
 

@@ -94,6 +94,21 @@ class RunRecord:
         """Whether the robot reached the goal."""
         return self.summary.reached
 
+    def line(self) -> str:
+        """The run in the one line `vplane-mj run` prints; a goal reached with collisions (not a
+        `success`) in capitals: `REACHED WITH 3 COLLISIONS (not a success)`."""
+        s = self.summary
+        clearance = "n/a" if s.min_clearance_m is None else f"{s.min_clearance_m:.3f} m"
+        outcome = str(s.outcome)
+        if s.reached and not s.success:
+            outcome = f"REACHED WITH {s.collisions} COLLISION{'S' * (s.collisions != 1)} (not a success)"
+        return (
+            f"{self.scenario.name} [{s.planner}, seed {s.seed}]: {outcome} after "
+            f"{s.sim_time_s:.2f} s simulated, path {s.path_length_m:.2f} m, "
+            f"collisions {s.collisions}, min clearance {clearance}, "
+            f"local minima {s.local_minima}, escapes {s.escapes}, wall {s.wall_time_s:.2f} s"
+        )
+
 
 class EventRecorder:
     """An observer of a run that keeps its events, each with its time."""

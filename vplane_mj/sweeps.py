@@ -29,6 +29,7 @@ from vplane_mj.planning.protocol.base import Planner
 from vplane_mj.planning.protocol.plugins import PlannerError, is_import_spec
 from vplane_mj.planning.protocol.registry import for_worker, load_planner, register_planner, unknown_planner
 from vplane_mj.scenario import Scenario, parse_scenario
+from vplane_mj.scenario.overrides import Override
 from vplane_mj.sim.summary import Outcome, RunSummary
 
 
@@ -62,16 +63,21 @@ class SweepResult:
         """The rows as run summaries."""
         return [RunSummary.from_dict(row) for row in self.rows]
 
-    def table_text(self) -> str:
-        """The table as `vplane-mj bench` prints it."""
-        return format_table(self.table)
+    def scenario_table(self) -> list[dict]:
+        """The table with one row per scenario and planner (`vplane-mj bench --by-scenario`)."""
+        return summarize(self.rows, by_scenario=True)
+
+    def table_text(self, by_scenario: bool = False) -> str:
+        """The table as `vplane-mj bench` prints it (`by_scenario`: the table per scenario and
+        planner, as `--by-scenario` prints it after)."""
+        return format_table(self.scenario_table() if by_scenario else self.table)
 
 
 def sweep(
     scenarios: Iterable[Scenario | str | os.PathLike[str]],
     planners: Iterable[str | type[Planner]] | None = None,
     seeds: Iterable[int] | str = (0,),
-    overrides: Sequence[str] = (),
+    overrides: Sequence[str | Override] = (),
     jobs: int | None = None,
     scheduler: str | None = None,
     out: str | os.PathLike[str] | None = DEFAULT_OUT,
@@ -174,7 +180,7 @@ def _plan(
     scenarios: Iterable[Scenario | str | os.PathLike[str]],
     planners: list[str],
     seeds: list[int],
-    overrides: Sequence[str],
+    overrides: Sequence[str | Override],
 ) -> list[Job]:
     """The jobs of every scenario in turn: files and names as `bench` plans them, scenarios
     built in code from their TOML text, each validated with the planner, seed and overrides."""
@@ -188,7 +194,7 @@ def _plan(
 
 
 def _jobs_of(
-    scenario: Scenario, planners: list[str], seeds: list[int], overrides: Sequence[str]
+    scenario: Scenario, planners: list[str], seeds: list[int], overrides: Sequence[str | Override]
 ) -> list[Job]:
     """The jobs of one Scenario object, validated as `plan_jobs` validates a file's."""
     text, jobs = scenario.to_toml(), []

@@ -26,7 +26,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from vplane_mj.bench.job import Job
-from vplane_mj.bench.sweep import PATH_KEY, family_of
+from vplane_mj.bench.sweep import PATH_KEY, TABLE_BASIS, family_of, summarize
 from vplane_mj.bench.tables import markdown_table as markdown_table  # kept here for its callers
 from vplane_mj.bench.tables import write_table as write_table
 from vplane_mj.files import write_atomically, write_csv, write_json
@@ -229,7 +229,10 @@ def write_html_text(
 <p>{len({r["scenario"] for r in rows})} scenarios, planners {html.escape(planners)}, seed(s)
 {html.escape(_seed_text(rows))}. Success means the goal was reached without a collision.</p>
 <h2>Per planner</h2>
+<p>{html.escape(TABLE_BASIS[0].upper() + TABLE_BASIS[1:])}.</p>
 {_table_html(table)}
+<h2>Per scenario</h2>
+{_table_html(summarize(rows, by_scenario=True))}
 <h2>Figures</h2>
 {images}
 <h2>Every run</h2>
@@ -392,7 +395,10 @@ def write_outputs(rows: list[dict], table: list[dict], out_dir: Path, jobs: list
     columns = sorted({key for row in rows for key in row if not isinstance(row[key], dict | list)})
     written = [
         write_csv(out_dir / "bench.csv", rows, columns),
-        write_json(out_dir / "bench.json", {"format": 1, "rows": rows, "table": table}),
+        write_json(
+            out_dir / "bench.json",
+            {"format": 1, "rows": rows, "table": table, "scenario_table": summarize(rows, by_scenario=True)},
+        ),
     ]
     figures = {
         "bench.png": png_bytes(summary_figure(rows)),

@@ -36,6 +36,7 @@ from vplane_mj.terminal import Progress
 JOURNAL = "bench.jsonl"
 TABLE_COLUMNS = (
     "planner",
+    "governor",
     "runs",
     "success_rate",
     "mean_score",
@@ -48,6 +49,12 @@ TABLE_COLUMNS = (
     "median_path_ratio",
     "escapes",
 )
+"""The bench table's columns, per planner (`summarize`); by scenario, `scenario` first."""
+TABLE_BASIS = (
+    "success: reached without a collision; medians over the runs that reached the goal; "
+    "governor: own (the planner drives its body itself), run (the run's governor) or none"
+)
+"""What the table's rates and medians count, printed with it."""
 
 
 MAX_SEEDS = 100_000
@@ -197,7 +204,10 @@ def _dask_results(jobs: list[Job], scheduler: str) -> Generator[tuple[Job, dict 
         from distributed import Client, KilledWorker
         from distributed import as_completed as dask_completed
     except ImportError as exc:
-        raise VPlaneError("--scheduler needs Dask: pip install 'vplane-mj[dask]'") from exc
+        raise VPlaneError(
+            '--scheduler needs Dask: pip install "dask[distributed]" '
+            '(or, in a clone of vplane-mj, pip install -e ".[dask]")'
+        ) from exc
     try:
         client = Client(scheduler, timeout=SCHEDULER_TIMEOUT_S)
     except OSError as exc:
@@ -218,29 +228,33 @@ def _dask_results(jobs: list[Job], scheduler: str) -> Generator[tuple[Job, dict 
     return results()
 
 
-def summarize(rows: list[dict]) -> list[dict]:
-    """One table row per planner (the bench table of docs/interface.md), in first-seen order."""
-    table = []
-    for planner in dict.fromkeys(row["planner"] for row in rows):
-        mine = [row for row in rows if row["planner"] == planner]
-        reached = [row for row in mine if row["reached"]]
-        table.append(
-            {
-                "planner": planner,
-                "runs": len(mine),
-                "success_rate": sum(row["success"] for row in mine) / len(mine),
-                "mean_score": _mean([row["score"] for row in mine if row.get("score") is not None]),
-                "collision_rate": sum(row["collisions"] > 0 for row in mine) / len(mine),
-                "timeouts": sum(row["outcome"] == "timeout" for row in mine),
-                "stuck": sum(row["outcome"] == "stuck" for row in mine),
-                "errors": sum(row["outcome"] == "error" for row in mine),
-                "median_time_to_goal_s": _median([r["time_to_goal_s"] for r in reached]),
-                "median_path_length_m": _median([r["path_length_m"] for r in reached]),
-                "median_path_ratio": _median([r["path_ratio"] for r in reached if r.get("path_ratio")]),
-                "escapes": sum(row["escapes"] for row in mine),
-            }
-        )
-    return table
+def summarize(rows: list[dict], by_scenario: bool = False) -> list[dict]:
+    """The bench table of docs/interface.md: one row per planner, or with `by_scenario` per
+    scenario and planner, in first-seen order (columns TABLE_COLUMNS, counted as TABLE_BASIS)."""
+    names = ("scenario", "planner") if by_scenario else ("planner",)
+    groups: dict[tuple, list[dict]] = {}
+    for row in rows:
+        groups.setdefault(tuple(row[name] for name in names), []).append(row)
+    return [{**dict(zip(names, group, strict=True)), **_statistics(mine)} for group, mine in groups.items()]
+
+
+def _statistics(mine: list[dict]) -> dict:
+    """The table's columns after the planner for the runs `mine`."""
+    reached = [row for row in mine if row["reached"]]
+    return {
+        "governor": "/".join(sorted({row.get("governor") or "-" for row in mine})),
+        "runs": len(mine),
+        "success_rate": sum(row["success"] for row in mine) / len(mine),
+        "mean_score": _mean([row["score"] for row in mine if row.get("score") is not None]),
+        "collision_rate": sum(row["collisions"] > 0 for row in mine) / len(mine),
+        "timeouts": sum(row["outcome"] == "timeout" for row in mine),
+        "stuck": sum(row["outcome"] == "stuck" for row in mine),
+        "errors": sum(row["outcome"] == "error" for row in mine),
+        "median_time_to_goal_s": _median([r["time_to_goal_s"] for r in reached]),
+        "median_path_length_m": _median([r["path_length_m"] for r in reached]),
+        "median_path_ratio": _median([r["path_ratio"] for r in reached if r.get("path_ratio")]),
+        "escapes": sum(row["escapes"] for row in mine),
+    }
 
 
 def _median(values: list[float]) -> float | None:
@@ -253,7 +267,8 @@ def _mean(values: list[float]) -> float | None:
 
 def format_table(table: list[dict]) -> str:
     """The table as text for the terminal (rich's table, plain characters): one row per
-    planner, the columns of TABLE_COLUMNS; numbers with two decimals, "-" where none."""
+    planner (or scenario and planner), its columns; numbers with two decimals, "-" where none;
+    TABLE_BASIS below it."""
     from rich import box
     from rich.console import Console
     from rich.table import Table
@@ -263,14 +278,17 @@ def format_table(table: list[dict]) -> str:
             return "-"
         return f"{value:.2f}" if isinstance(value, float) else str(value)
 
+    columns = list(table[0]) if table else list(TABLE_COLUMNS)
     grid = Table(box=box.SIMPLE_HEAD, pad_edge=False)
-    for column in TABLE_COLUMNS:
-        grid.add_column(column, justify="left" if column == "planner" else "right", no_wrap=True)
+    for column in columns:
+        text = column in ("scenario", "planner", "governor")
+        grid.add_column(column, justify="left" if text else "right", no_wrap=True)
     for row in table:
-        grid.add_row(*(cell(row[column]) for column in TABLE_COLUMNS))
+        grid.add_row(*(cell(row[column]) for column in columns))
     console = Console(file=io.StringIO(), width=400, record=True, color_system=None)
     console.print(grid)
-    return "\n".join(line.rstrip() for line in console.export_text().splitlines() if line.strip())
+    lines = [line.rstrip() for line in console.export_text().splitlines() if line.strip()]
+    return "\n".join([*lines, f"({TABLE_BASIS})"])
 
 
 MAX_ERRORS_LISTED = 10
@@ -295,6 +313,16 @@ def error_lines(rows: list[dict], out_dir: Path) -> list[str]:
     if len(errors) > MAX_ERRORS_LISTED:
         lines.append(f"  and {len(errors) - MAX_ERRORS_LISTED} more (bench.csv has them all)")
     return lines
+
+
+def collision_line(collided: list[dict], runs: int) -> str:
+    """What `bench --fail-on-collision` says when the runs `collided` (of `runs`) collided: their
+    count and the first few, by scenario, planner and seed."""
+    named = ", ".join(
+        f"{row['scenario']} {row['planner']} seed {row['seed']} ({row['collisions']})" for row in collided[:3]
+    )
+    more = f" and {len(collided) - 3} more" if len(collided) > 3 else ""
+    return f"error: {len(collided)} of {runs} runs collided (--fail-on-collision): {named}{more}"
 
 
 def family_of(scenario: str) -> str:
