@@ -14,6 +14,7 @@ import re
 import shutil
 import subprocess
 import sysconfig
+import textwrap
 from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
@@ -31,7 +32,8 @@ PAGES = sorted([ROOT / "README.md", ROOT / "CHANGELOG.md", *(ROOT / "docs").rglo
 REPOSITORY_DATA = ("scenarios", "examples", "tests/data/barn")
 """What the page's commands read from the repository, copied beside them (a user runs them in
 the repository's directory, where the set-up installed the package)."""
-FENCE = re.compile(r"^```(\w*)[^\n]*\n(.*?)^```[ \t]*$", re.M | re.S)
+FENCE = re.compile(r"^([ \t]*)```(\w*)[^\n]*\n(.*?)^\1```[ \t]*$", re.M | re.S)
+"""A fenced code block, at the margin or indented in a list item."""
 NUMBER = re.compile(r"-?\d+(?:\.\d+)?")
 OMITTED = "..."
 """In a page's output: a line of its own skips any lines; within a line, any text."""
@@ -89,8 +91,8 @@ class Step:
 
 
 def fenced_blocks(text: str) -> list[tuple[str, str, int, int]]:
-    """The page's fenced code blocks: (language, body, start, end offset)."""
-    return [(m[1], m[2], m.start(), m.end()) for m in FENCE.finditer(text)]
+    """The page's fenced code blocks: (language, body (dedented), start, end offset)."""
+    return [(m[2], textwrap.dedent(m[3]), m.start(), m.end()) for m in FENCE.finditer(text)]
 
 
 def page_steps(text: str) -> list[Step]:
@@ -116,7 +118,10 @@ def setup_blocks(text: str) -> list[str]:
     return [body.strip() for language, body, _, _ in blocks if language == "sh" and "apt-get" in body]
 
 
-STEPS = page_steps(GETTING_STARTED.read_text(encoding="utf-8"))
+COMMAND_PAGES = {"getting-started": GETTING_STARTED, "own-planner": ROOT / "docs" / "own-planner.md"}
+"""The pages whose every command is run as a user types it, each page in a home of its own."""
+STEPS = {name: page_steps(page.read_text(encoding="utf-8")) for name, page in COMMAND_PAGES.items()}
+COMMANDS = [(name, index) for name, steps in STEPS.items() for index in range(len(steps))]
 
 
 def normalised(line: str) -> str:
@@ -169,15 +174,27 @@ def user_environment(home: Path) -> dict[str, str]:
 
 
 @pytest.fixture(scope="module")
-def session(tmp_path_factory) -> tuple[Path, list[subprocess.CompletedProcess[str]]]:
-    """The page's commands run one after the other in a temporary copy of the repository's data,
-    as one user would: (that directory, what each command did)."""
-    home = tmp_path_factory.mktemp("user")
+def sessions(tmp_path_factory) -> Any:
+    """A page's commands run one after the other in a temporary copy of the repository's data,
+    as one user would: (that directory, what each command did), each page once."""
+    done: dict[str, tuple[Path, list[subprocess.CompletedProcess[str]]]] = {}
+
+    def session(name: str) -> tuple[Path, list[subprocess.CompletedProcess[str]]]:
+        if name not in done:
+            home = tmp_path_factory.mktemp(f"user-{name}")
+            done[name] = home, run_steps(STEPS[name], home)
+        return done[name]
+
+    return session
+
+
+def run_steps(steps: list[Step], home: Path) -> list[subprocess.CompletedProcess[str]]:
+    """Run `steps` one after the other in `home`, a copy of the repository's data."""
     for data in REPOSITORY_DATA:
         shutil.copytree(ROOT / data, home / data)
     environment = user_environment(home)
     done = []
-    for step in STEPS:
+    for step in steps:
         done.append(
             subprocess.run(
                 ["bash", "-e", "-o", "pipefail", "-c", step.command],
@@ -189,20 +206,28 @@ def session(tmp_path_factory) -> tuple[Path, list[subprocess.CompletedProcess[st
                 timeout=600,
             )
         )
-    return home, done
+    return done
 
 
-def test_the_page_has_commands_with_their_output():
-    assert len(STEPS) >= 10
-    assert sum(1 for step in STEPS if step.output) >= 8
-    assert any(step.command.startswith("vplane-mj run paper_c_escape\n") for step in STEPS)
+def test_the_pages_have_commands_with_their_output():
+    started = STEPS["getting-started"]
+    assert len(started) >= 10
+    assert sum(1 for step in started if step.output) >= 8
+    assert any(step.command.startswith("vplane-mj run paper_c_escape\n") for step in started)
+    own = STEPS["own-planner"]
+    assert len(own) >= 3 and sum(1 for step in own if step.output) >= 2
+    assert any("planner.governor=false" in step.command for step in own)
 
 
-@pytest.mark.slow  # the page's commands as processes, one after another: about 20 s
-@pytest.mark.parametrize("index", range(len(STEPS)), ids=[step.command.split("\n")[0][:60] for step in STEPS])
-def test_a_command_of_the_page_exits_0_and_prints_and_writes_what_it_shows(session, index):
-    home, done = session
-    step, result = STEPS[index], done[index]
+@pytest.mark.slow  # the pages' commands as processes, one after another: about a minute
+@pytest.mark.parametrize(
+    ("page", "index"),
+    COMMANDS,
+    ids=[f"{page}: {STEPS[page][index].command.split(chr(10))[0][:60]}" for page, index in COMMANDS],
+)
+def test_a_command_of_the_page_exits_0_and_prints_and_writes_what_it_shows(sessions, page, index):
+    home, done = sessions(page)
+    step, result = STEPS[page][index], done[index]
     assert result.returncode == 0, f"$ {step.command}\n{result.stdout}"
     assert "Traceback" not in result.stdout, result.stdout
     assert unmatched(step.output, result.stdout) == [], f"$ {step.command}\n{result.stdout}"

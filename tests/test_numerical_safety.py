@@ -15,7 +15,7 @@ from vplane_mj.planning.planners.vplane_geometry import (
     virtual_objective,
 )
 from vplane_mj.planning.protocol import registry
-from vplane_mj.planning.protocol.params import PlannerParams
+from vplane_mj.planning.protocol.base import Planner
 from vplane_mj.planning.protocol.types import Decision, Observation
 from vplane_mj.robots.facts import robot_radius_m
 from vplane_mj.robots.profiles import DEFAULT
@@ -88,11 +88,12 @@ def test_heading_control_stops_on_a_force_without_a_direction(force):
     assert control.heading_command(*force, 0.3, DEFAULT.gains, DEFAULT.limits) == (0.0, 0.0)
 
 
-class _BrokenPlanner:
+class _BrokenPlanner(Planner):
     """A planner whose force turns to NaN after a second of driving toward the goal."""
 
-    def __init__(self):
-        self.params = PlannerParams()
+    name = "broken"
+    summary = "NaN after a second"
+    citation = ""
 
     def step(self, obs):
         direction = (obs.goal - obs.position) / max(obs.distance_to_goal(), 1e-9)
@@ -100,7 +101,7 @@ class _BrokenPlanner:
 
 
 def test_a_non_finite_planner_force_ends_the_run_as_error(shipped, monkeypatch):
-    monkeypatch.setattr(sim, "make_planner", lambda *args: _BrokenPlanner())
+    monkeypatch.setattr(sim, "make_planner", lambda _name, _params, body: _BrokenPlanner.build({}, body))
     summary = sim.run_scenario(shipped("open_field")).summary
     assert summary.outcome == "error" and not summary.reached
     assert "non-finite force at t = 1.000 s" in summary.message

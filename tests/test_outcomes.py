@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from vplane_mj.cli import main
-from vplane_mj.planning.protocol.params import PlannerParams
+from vplane_mj.planning.protocol.base import Planner
 from vplane_mj.planning.protocol.types import Decision
 from vplane_mj.sim import loop as sim
 from vplane_mj.sim.world import build_model
@@ -18,11 +18,12 @@ from vplane_mj.sim.world import build_model
 ALL_SONARS_DEAD = "sensors.dead=[" + ",".join(str(i) for i in range(16)) + "]"
 
 
-class _NaNAfterOneSecond:
+class _NaNAfterOneSecond(Planner):
     """A planner that drives toward the goal, then returns a non-finite force after 1 s."""
 
-    def __init__(self):
-        self.params = PlannerParams()
+    name = "nan_after_one_second"
+    summary = "a non-finite force after 1 s"
+    citation = ""
 
     def step(self, obs):
         direction = (obs.goal - obs.position) / max(obs.distance_to_goal(), 1e-9)
@@ -65,7 +66,9 @@ def test_the_log_reproduces_how_the_run_ended(case, tmp_path, capsys, monkeypatc
     if case == "error_mujoco_warning":
         monkeypatch.setattr(sim, "build_model", _unstable_model)
     if case == "error_non_finite_force":
-        monkeypatch.setattr(sim, "make_planner", lambda *args: _NaNAfterOneSecond())
+        monkeypatch.setattr(
+            sim, "make_planner", lambda _name, _params, body: _NaNAfterOneSecond.build({}, body)
+        )
     settings = [item for override in overrides for item in ("--set", override)]
     code = main(["run", name, *settings, "--out", str(tmp_path / "out"), "--no-render"])
     capsys.readouterr()

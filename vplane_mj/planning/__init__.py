@@ -9,9 +9,12 @@ The names for writing a planner of one's own (docs/own-planner.md):
 - `Observation`, `Decision`, `Event`, `EventKind`, `point`: what it receives and returns;
   `Track`, an obstacle the run's tracker follows (`Observation.tracks`);
 - `PlannerParams`, `param`, `with_default`: its parameters as a frozen dataclass;
-- `FieldParams`, `DetectorParams`, `MinimumParams`, `LocalMapParams`, `SonarMapParams`: the
-  parameter groups of the built-in planners with their set-ups (fields, local-minimum
-  detector, sonar map and histogram), `report_trap`, `LocalMinimumDetector`, `LocalMap`;
+- `FieldParams`, `DetectorParams`, `MinimumParams`, `LocalMapParams`, `SonarMapParams`,
+  `MotionParams`: the parameter groups of the built-in planners with their set-ups (fields,
+  local-minimum detector, sonar map and histogram, the governor's margins), `report_trap`,
+  `LocalMinimumDetector`, `LocalMap`;
+- `RunGovernor`: the governor a run drives a planner's forces through when the planner does
+  not drive its body itself;
 - `wrap_angle`, `unit`: angles and vectors;
 - `register_planner`, `load_planner`: registration in code.
 """
@@ -24,8 +27,10 @@ from vplane_mj.planning.planners.groups import (
     FieldParams,
     LocalMapParams,
     MinimumParams,
+    MotionParams,
     SonarMapParams,
 )
+from vplane_mj.planning.planners.run_governor import RunGovernor
 from vplane_mj.planning.protocol.base import Planner
 from vplane_mj.planning.protocol.body import DriveLimits, HeadingGains, RobotBody
 from vplane_mj.planning.protocol.events import Event, EventKind, point
@@ -47,6 +52,7 @@ __all__ = [
     "LocalMapParams",
     "LocalMinimumDetector",
     "MinimumParams",
+    "MotionParams",
     "Observation",
     "Param",
     "ParamError",
@@ -54,6 +60,7 @@ __all__ = [
     "PlannerError",
     "PlannerParams",
     "RobotBody",
+    "RunGovernor",
     "SonarMapParams",
     "Track",
     "load_planner",

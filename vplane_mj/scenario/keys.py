@@ -118,6 +118,11 @@ RUN_FIELDS = {
 
 STRING = Field("str")
 """Any string: an obstacle's `kind`, the planner's `name`."""
+GOVERNOR = Field("bool")
+"""`planner.governor`: whether the run drives the forces of a planner that does not drive its
+body itself through the governor (true by default)."""
+PLANNER_KEYS = ("name", "governor")
+"""The `[planner]` keys that are not the planner's parameters."""
 _CENTER = Field("point", required=True, ge=-MAX_OBSTACLE_M, le=MAX_OBSTACLE_M)
 _LENGTH = Field("number", required=True, gt=0, ge=MIN_OBSTACLE_M, le=MAX_OBSTACLE_M)
 _YAW = Field("number", attr="yaw", convert=math.radians)

@@ -44,7 +44,7 @@ def _build_scenario(doc: dict[str, Any], source: str, recorded: bool) -> Scenari
     run = read_run(doc)
     world = read_world(doc, run.seed)
     robot = read_robot(doc)
-    planner, params = read_planner(doc, recorded, robot.profile)
+    planner, params, governor = read_planner(doc, recorded, robot.profile)
     sensors = read_sensors(doc, robot.profile)
     check_sensor_rate(doc, sensors, run)
     scenario = Scenario(
@@ -55,6 +55,7 @@ def _build_scenario(doc: dict[str, Any], source: str, recorded: bool) -> Scenari
         robot=robot,
         planner=planner,
         planner_params=params,
+        planner_governor=governor,
         sensors=sensors,
         run=run,
         raw=_freeze(doc),

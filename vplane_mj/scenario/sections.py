@@ -34,6 +34,7 @@ from vplane_mj.scenario.fields import (
 from vplane_mj.scenario.keys import (
     FORMAT,
     GENERIC_SENSORS,
+    GOVERNOR,
     KIND_KEYS,
     MAX_NAME_LENGTH,
     MAX_OBSTACLE_M,
@@ -41,6 +42,7 @@ from vplane_mj.scenario.keys import (
     MAX_TICKS_PER_SCAN,
     NAME_PATTERN,
     OBSTACLE_KINDS,
+    PLANNER_KEYS,
     ROBOT_FIELDS,
     RUN_FIELDS,
     SECTIONS,
@@ -153,9 +155,10 @@ def read_robot(doc: Mapping[str, Any]) -> RobotSpec:
 
 def read_planner(
     doc: Mapping[str, Any], recorded: bool = False, profile: str = "default"
-) -> tuple[str, Mapping[str, float]]:
-    """The planner's name and the parameters the file gives (checked against its dataclass),
-    over those the robot's `profile` sets for that planner (`RobotProfile.planner_settings`).
+) -> tuple[str, Mapping[str, float], bool]:
+    """The planner's name, the parameters the file gives (checked against its dataclass), over
+    those the robot's `profile` sets for that planner (`RobotProfile.planner_settings`), and
+    `governor` (true unless the file says false).
 
     `recorded`: the scenario of a finished run (a log's metadata), whose planner was checked
     when it ran and need not be registered in this process; its parameters are kept as given.
@@ -163,8 +166,10 @@ def read_planner(
     table = sub_table(doc, "planner")
     given = "name" in table
     name = checked(table.get("name", registry.DEFAULT_PLANNER), STRING, "planner.name")
+    governor = checked(table.get("governor", True), GOVERNOR, "planner.governor")
+    given_params = {key: value for key, value in table.items() if key not in PLANNER_KEYS}
     if recorded and name not in registry.PLANNERS and NAME_PATTERN.fullmatch(name):
-        return name, MappingProxyType({key: value for key, value in table.items() if key != "name"})
+        return name, MappingProxyType(given_params), governor
     if name not in registry.PLANNERS:
         default = "" if given else " (the default)"
         reason = registry.unknown_planner(name, default)
@@ -175,12 +180,12 @@ def read_planner(
             )
         raise Invalid("planner.name", reason)
     overrides = {**robot_profile(profile).planner_settings.get(name, {})}
-    overrides.update((key, value) for key, value in table.items() if key != "name")
+    overrides.update(given_params)
     try:
         params = registry.PLANNERS[name].Params.checked(overrides, name)
     except ParamError as exc:
         raise Invalid(join_key("planner", exc.key), exc.reason) from None
-    return name, MappingProxyType(params)
+    return name, MappingProxyType(params), governor
 
 
 def read_sensors(doc: Mapping[str, Any], profile: str = "default") -> SensorSpec:

@@ -118,6 +118,8 @@ class Scenario:
         robot: The robot's profile, start, goal (m), start yaw (rad) and faults.
         planner: The planner's name.
         planner_params: The planner's parameters as given (the rest are its defaults).
+        planner_governor: Whether the run drives the forces of a planner that does not drive
+            its body itself through the governor (`planner.governor`).
         sensors: The range sensor, resolved against the robot's profile.
         run: Seed, time limit (s), physics step (s) and control rate (Hz).
         raw: The document as read, with overrides applied (read-only).
@@ -130,6 +132,7 @@ class Scenario:
     robot: RobotSpec
     planner: str
     planner_params: Mapping[str, float]
+    planner_governor: bool
     sensors: SensorSpec
     run: RunSpec
     raw: Mapping[str, Any]

@@ -27,6 +27,8 @@ import numpy as np
 from vplane_mj.errors import VPlaneError
 from vplane_mj.planning.perception.tracker import Track as TrackedObstacle
 from vplane_mj.planning.perception.tracker import Tracker
+from vplane_mj.planning.planners.run_governor import RunGovernor
+from vplane_mj.planning.protocol.base import Planner
 from vplane_mj.planning.protocol.events import Event, EventKind, point
 from vplane_mj.planning.protocol.registry import make_planner
 from vplane_mj.planning.protocol.types import Decision, Observation
@@ -174,15 +176,10 @@ class Run:
         self.radius = self.drive.geometry["radius_m"]
         self.planner_name = EXTERNAL_PLANNER if external else scenario.planner
         self.planner_failure: RunFailure | None = None  # what the planner's code raised, if it did
-        failed: Exception | None = None
-        try:
-            self.planner = (
-                None if external else make_planner(scenario.planner, scenario.planner_params, self.body)
-            )
-        except (VPlaneError, Interrupted):  # no planner by that name, or bad parameters
-            raise
-        except Exception as exc:  # the planner's constructor: the run ends at once as `error`
-            self.planner, failed = None, exc
+        self.planner, failed = (None, None) if external else self._make_planner()
+        self.run_governor = (
+            None if self.planner is None else RunGovernor.offered(self.planner, scenario.planner_governor)
+        )
         self.clearance = robot_clearance(
             scenario, self.body, self.radius, None if self.moving is None else self.moving.pieces()
         )
@@ -225,6 +222,17 @@ class Run:
         if failed is not None:
             self._planner_raised(failed)
 
+    def _make_planner(self) -> tuple[Planner | None, Exception | None]:
+        """The scenario's planner for the robot's body, or what its constructor raised (the run
+        then ends at once as `error`); no planner by that name, or bad parameters, raise."""
+        scenario = self.scenario
+        try:
+            return make_planner(scenario.planner, scenario.planner_params, self.body), None
+        except (VPlaneError, Interrupted):
+            raise
+        except Exception as exc:  # the planner's own code
+            return None, exc
+
     # -- the loop ---------------------------------------------------------------------------
     def step(self) -> Ending | None:
         """One control tick with the planner: `observe`, its decision, `apply`; the ending once
@@ -243,6 +251,8 @@ class Run:
         except Exception as exc:  # the planner's own code: kept with its traceback
             self._observation = None
             return self._planner_raised(exc)
+        if self.run_governor is not None:
+            self.run_governor.drive(decision, observation)
         elapsed = time.perf_counter() - started
         self.planner_cpu.append(elapsed)
         self.wall_time_s += elapsed
@@ -496,6 +506,13 @@ class Run:
                 observer.on_tick(tick)
 
     # -- the result -------------------------------------------------------------------------
+    def governor_kind(self) -> str:
+        """What drives the planner's forces on the robot's body: `own`, `run` or `none`
+        (`RunSummary.governor`)."""
+        if self.planner is not None and self.planner.governs_itself:
+            return "own"
+        return "none" if self.run_governor is None else "run"
+
     def result(self) -> RunResult:
         """The run's summary and path (call once it has ended)."""
         return RunResult(
@@ -569,6 +586,7 @@ class Run:
             message="" if reached or ending.outcome is Outcome.TIMEOUT else ending.event.text,
             traceback=self.planner_failure.traceback if self.planner_failure else "",
             planner_params={} if self.planner is None else self.planner.params.as_dict(),
+            governor=self.governor_kind(),
             version=__version__,
         )
 

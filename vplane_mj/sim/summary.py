@@ -78,6 +78,9 @@ class RunSummary:
     """The planner's traceback when its code raised (outcome `error`, `message` names the
     exception and where); empty otherwise."""
     planner_params: dict[str, float] = field(default_factory=dict)
+    governor: str = "none"
+    """What drove the planner's forces on the robot's body: `own` (the planner drives its
+    body itself, as the built-in planners do), `run` (the run's governor) or `none`."""
     version: str = ""
     format: int = SUMMARY_FORMAT
 

@@ -2,7 +2,7 @@
 
 This is the baseline the paper improves on: it has no escape, so once the
 local-minimum detector has held it trapped for `patience_s` it gives up (outcome
-`stuck`). The governor (motion.py) drives the force on the robot's body.
+`stuck`). The governor (motion/governor.py) drives the force on the robot's body.
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ class ApfPlanner(Planner):
 
     name = "apf"
     summary = "Khatib's artificial potential field from the sonar ring, no escape"
+    governs_itself = True
     citation = "O. Khatib, Real-time obstacle avoidance for manipulators and mobile robots, IJRR 5(1), 1986"
     Params = ApfParams
     params: ApfParams

@@ -7,7 +7,7 @@ the goal direction) it records the hit point and switches to "following", keepin
 on one side at `wall_distance_m`. It leaves the wall when it is back on the m-line closer
 to the goal than the hit point and the way to the goal is clear. It gives up when it comes
 back to the hit point after a loop around the obstacle (the goal is unreachable) or after
-`max_follow_s` of following. The governor (motion.py) drives the force on the robot's body.
+`max_follow_s` of following. The governor (motion/governor.py) drives the force on the robot's body.
 """
 
 from __future__ import annotations
@@ -67,6 +67,7 @@ class Bug2Planner(Planner):
 
     name = "bug2"
     summary = "Bug2: along the start-goal line, sonar wall following around obstacles"
+    governs_itself = True
     citation = (
         "V. Lumelsky and A. Stepanov, Path-planning strategies for a point mobile automaton "
         "moving amidst unknown obstacles of arbitrary shape, Algorithmica 2, 1987"

@@ -248,6 +248,7 @@ class DwaPlanner(Planner):
 
     name = "dwa"
     summary = "dynamic window approach: the best reachable (v, omega) arc on the local map"
+    governs_itself = True
     citation = (
         "D. Fox, W. Burgard, S. Thrun, The dynamic window approach to collision avoidance, "
         "IEEE Robotics & Automation Magazine 4(1), 1997"

@@ -69,7 +69,7 @@ class EvasionParams(PlannerParams):
 
 @dataclass(frozen=True)
 class MotionParams(EvasionParams):
-    """The margins of the governor that drives a force on the robot's body (motion.py), and its
+    """The margins of the governor that drives a force on the robot's body (motion/governor.py), and its
     check against moving tracks."""
 
     stop_margin_m: float = param(

@@ -9,7 +9,7 @@ valleys, the directions half a wide valley in from each border. The cost
 5 |c - goal| + 2 |c - heading| + 2 |c - previous| picks one (VFH+'s weights). The force
 is a unit vector that way, shortened within 1 m of the goal. With no valley the robot
 stops; the local-minimum detector then makes it give up after `patience_s` (`stuck`).
-The governor (motion.py) then drives the force on the robot's body: its commands keep the
+The governor (motion/governor.py) then drives the force on the robot's body: its commands keep the
 footprint off the obstacles over the motion they start.
 """
 
@@ -52,6 +52,7 @@ class VfhPlanner(Planner):
 
     name = "vfh"
     summary = "VFH+ polar-histogram steering toward the goal, from the sonar grid"
+    governs_itself = True
     citation = (
         "J. Borenstein, Y. Koren, The vector field histogram, IEEE TRA 7(3), 1991; "
         "I. Ulrich, J. Borenstein, VFH+, ICRA 1998"
@@ -93,7 +94,7 @@ class VfhPlanner(Planner):
         return decision
 
     def _governed(self, force: np.ndarray, obs: Observation) -> Steering:
-        """The command for the force (motion.py) among the echoes and the mapped cells near it."""
+        """The command for the force (motion/governor.py) among the echoes and the mapped cells near it."""
         if self.governor.idle:
             return Steering(force)
         cells, _ = self.map.cells(self.params.map_threshold, obs.position, self.governor.reach_m)

@@ -4,7 +4,7 @@ On each local-minimum detection a virtual obstacle (a FIRAS repulsive point, eqs
 placed at the robot's position and pushes it out of the minimum. A virtual obstacle is
 cleared after `vobs_lifetime_s`; the robot may then fall back into the same minimum, the
 weakness the virtual-plane method addresses. After `max_virtual` obstacles the planner
-gives up (outcome `stuck`). The governor (motion.py) drives the force on the robot's body.
+gives up (outcome `stuck`). The governor (motion/governor.py) drives the force on the robot's body.
 """
 
 from __future__ import annotations
@@ -37,6 +37,7 @@ class VobsPlanner(Planner):
 
     name = "vobs"
     summary = "APF with a virtual obstacle placed at each local minimum"
+    governs_itself = True
     citation = (
         "M. G. Park, J. H. Jeon, M. C. Lee, Obstacle avoidance for mobile robots using "
         "artificial potential field approach with simulated annealing, ISIE 2001 (the paper's ref. 9)"

@@ -110,6 +110,7 @@ class VPlanePlanner(Planner):
 
     name = "vplane"
     summary = "APF with histogram avoidance, virtual new objective and virtual plane (the paper)"
+    governs_itself = True
     citation = (
         "A Novel Approach to Local Minima Problem in Robot Path Planning Using Artificial "
         "Potential Field (virtual plane method)"
@@ -180,7 +181,7 @@ class VPlanePlanner(Planner):
         return decision
 
     def _governed(self, force: np.ndarray, obs: Observation) -> Steering:
-        """The command for the force (motion.py) among the echoes and the mapped
+        """The command for the force (motion/governor.py) among the echoes and the mapped
         cells around it, which remember what the sensor sees between its beams or behind."""
         if self.governor.idle:
             return Steering(force)

@@ -22,7 +22,7 @@ unknown counted as free):
   map holds no way to the goal at all for `no_way_patience_s`. A dense scan (a laser: scan.py)
   maps the obstacles it sees as they are from the first scan, so with one the robot follows
   the map's way from the start;
-- the governor (motion.py) drives a robot that is not a small disc for the force: its
+- the governor (motion/governor.py) drives a robot that is not a small disc for the force: its
   commands keep the footprint off the echoes and the mapped cells over the motion they start
   (the drive's ramp and the coast of a turn included), and back the robot off where it is shut
   in. On a way of the map such a robot is not repelled by the echoes: the way keeps it off the
@@ -67,7 +67,7 @@ SILENT_FREE_M = 1.0
 OBJECTIVE_ROOM_M = 0.05
 """A virtual objective lies at least this much beyond the robot's disc from every mapped obstacle."""
 BEND_HORIZON_M = 3.0
-"""The way this far ahead (m) bounds the speed by the turns it asks for (motion.py)."""
+"""The way this far ahead (m) bounds the speed by the turns it asks for (motion/governor.py)."""
 TRAP_REACH_M = 2.5
 """Obstacle cells farther than this from the robot are not part of the trap it is in."""
 AIM_AHEAD_M = 8.0
@@ -323,7 +323,7 @@ class VPlanePlusPlanner(VPlanePlanner):
         return min(1.0, obs.distance_to_goal() / p.goal_fade_m) ** 2 if p.goal_fade_m > 0 else 1.0
 
     def _governed(self, force: np.ndarray, obs: Observation) -> Steering:
-        """The command for the force (motion.py) among the echoes and the mapped
+        """The command for the force (motion/governor.py) among the echoes and the mapped
         cells around it (not swept), which remember what the sensor sees between its beams or
         behind; on a way, no faster than lets the robot turn along the way's next
         `BEND_HORIZON_M`."""

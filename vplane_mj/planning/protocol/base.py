@@ -31,7 +31,12 @@ class Planner(ABC):
             names and the bench table ([a-z0-9_]+).
         summary: One line for `vplane-mj list`.
         citation: Where the method comes from.
-        Params: Its frozen `PlannerParams` dataclass.
+        Params: Its frozen `PlannerParams` dataclass (optional: the base class, no
+            parameters, by default).
+        governs_itself: Whether it drives its body itself: it hands its forces to a governor
+            of its own, or checks its motions (the built-in planners). False (the default):
+            the run drives its forces through the governor (`vplane_mj.planning.RunGovernor`)
+            unless the scenario says `planner.governor = false`.
         params: The instance of `Params` it was built with.
         robot: The robot's body it was built for.
     """
@@ -40,6 +45,7 @@ class Planner(ABC):
     summary: ClassVar[str]
     citation: ClassVar[str]
     Params: ClassVar[type[PlannerParams]] = PlannerParams
+    governs_itself: ClassVar[bool] = False
 
     def __init__(self, params: PlannerParams, robot: RobotBody | float):
         """Keep the parameters and the robot's body.
