@@ -31,7 +31,60 @@ class Outcome(StrEnum):
 @dataclass(frozen=True)
 class RunSummary:
     """The `.json` summary of one run; field for field the keys of docs/interface.md section 3
-    and docs/outputs.md's table, in the order they are written."""
+    and docs/outputs.md's table, in the order they are written (`format` first).
+
+    Attributes:
+        scenario: The scenario's name.
+        planner: The planner's name.
+        seed: The run's seed.
+        outcome: How the run ended.
+        reached: The robot's centre came within the goal tolerance.
+        success: Reached with no collision.
+        time_to_goal_s: Simulated time to the goal (s); None when not reached.
+        sim_time_s: Simulated time of the run (s).
+        steps: Physics steps.
+        physics_dt_s: The physics step (s).
+        control_hz: The planner's rate (Hz).
+        wall_time_s: Wall-clock time of the simulation loop (s).
+        kernel_load_s: Wall-clock time spent before the loop loading compiled kernels (s).
+        path_length_m: Length travelled by the robot's centre (m).
+        collisions: Separate contact episodes between the robot and any obstacle or wall.
+        min_clearance_m: Least distance from the footprint to any obstacle or border (m;
+            negative: they overlapped).
+        mean_clearance_m: Mean of that distance over the run (m).
+        moving_obstacles: How many obstacles move.
+        min_clearance_moving_m: Least clearance to the moving obstacles alone (m); None
+            without any.
+        smoothness_rad_per_m: Total absolute heading change per metre travelled (rad/m).
+        oscillation_per_m: Reversals of the turning direction per metre travelled (1/m).
+        planner_cpu_ms_mean: The planner's mean wall-clock time per control tick (ms).
+        planner_cpu_ms_max: Its largest (ms).
+        local_minima: Local-minimum detections.
+        escapes: Completed escapes.
+        robot_radius_m: Radius of the disc about base_link that holds every robot geom (m).
+        robot_profile: The robot profile's name.
+        footprint_m: The footprint polygon in base_link, [[x, y], ...] (m).
+        top_speed_mps: The profile's top speed (m/s).
+        sensor_kind: "sonar" or "laser".
+        reference_length_m: The reference shortest path from start to goal (m); None when
+            no path exists.
+        optimal_length_m: The reference path to the goal tolerance (m).
+        path_ratio: `path_length_m` over `optimal_length_m`; None when not reached.
+        score: The BARN score, between 0.125 and 0.5 for a success, 0 otherwise; None
+            without a reference path.
+        score_path_m: The path length the score's optimal time was taken from (m).
+        score_path_source: Whence: "world" (the scenario's `score_path_m`) or "reference".
+        final_distance_to_goal_m: Distance from the robot's centre to the goal at the end (m).
+        odometry_error_m: Distance between the believed and the true position at the end
+            (m); None on the true pose.
+        odometry_error_max_m: Its largest over the run (m).
+        trajectory_sha256: SHA-256 of the positions at every control tick and the final pose.
+        message: Why the run ended `error` or `stuck`; else empty.
+        traceback: The planner's traceback when its code raised; else empty.
+        planner_params: The resolved planner parameters, by name.
+        version: The package version that ran it.
+        format: The summary format, 1.
+    """
 
     scenario: str
     planner: str
@@ -75,8 +128,6 @@ class RunSummary:
     trajectory_sha256: str = ""
     message: str = ""
     traceback: str = ""
-    """The planner's traceback when its code raised (outcome `error`, `message` names the
-    exception and where); empty otherwise."""
     planner_params: dict[str, float] = field(default_factory=dict)
     governor: str = "none"
     """What drove the planner's forces on the robot's body: `own` (the planner drives its
