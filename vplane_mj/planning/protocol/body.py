@@ -23,12 +23,19 @@ DISC_SIDES = 32
 
 @dataclass(frozen=True)
 class DriveLimits:
-    """What the drive can do: top speed (m/s), top turn rate (rad/s), forward acceleration and
-    braking (m/s^2), turn-rate acceleration (rad/s^2), how long (s) the robot's turn rate
-    trails its drive's turn command (`turn_lag_s`: a skid-steer robot's tyres slip before they
-    turn it), and the braking (m/s^2) the body still gets while it turns at half its top turn
-    rate or faster (`turning_brake_mps2`: a skid-steer's tyres spend their grip dragging
-    sideways; None: `max_accel_mps2`). The defaults are the default robot's."""
+    """What the drive can do. The defaults are the default robot's.
+
+    Attributes:
+        max_speed_mps: Top speed (m/s).
+        max_turn_rate_radps: Top turn rate (rad/s).
+        max_accel_mps2: Forward acceleration and braking (m/s^2).
+        max_turn_accel_radps2: Turn-rate acceleration (rad/s^2).
+        turn_lag_s: How long the robot's turn rate trails its drive's turn command (s): a
+            skid-steer robot's tyres slip before they turn it.
+        turning_brake_mps2: The braking the body still gets while it turns at half its top
+            turn rate or faster (m/s^2): a skid-steer's tyres spend their grip dragging
+            sideways; None: `max_accel_mps2`.
+    """
 
     max_speed_mps: float = 0.5
     max_turn_rate_radps: float = 2.5
@@ -46,9 +53,14 @@ class DriveLimits:
 
 @dataclass(frozen=True)
 class HeadingGains:
-    """The heading controller's law (vplane_mj/control.py): v = speed_gain |F| max(0, cos e) and
-    omega = turn_gain e, e the angle from the heading to the force F, both limited by the drive.
-    The defaults are the default robot's: (m/s) per unit of force, and 1/s."""
+    """The heading controller's law (vplane_mj/sim/control.py): v = speed_gain |F| max(0, cos e)
+    and omega = turn_gain e, e the angle from the heading to the force F, both limited by the
+    drive. The defaults are the default robot's.
+
+    Attributes:
+        speed_gain: Speed per unit of force ((m/s) per unit).
+        turn_gain: Turn rate per radian of heading error (1/s).
+    """
 
     speed_gain: float = 0.5
     turn_gain: float = 3.0
@@ -58,9 +70,17 @@ class HeadingGains:
 class RobotBody:
     """A robot's footprint, limits, controller gains and sensor kind (see the module docstring).
 
-    `footprint` is a convex polygon (k, 2), counter-clockwise, in base_link (m); `disc` says the
-    robot is round, its footprint then the regular polygon about the disc of `radius_m`.
-    `radius_m` is the circumscribed radius about base_link's origin (m).
+    Attributes:
+        footprint: A convex polygon (k, 2), counter-clockwise, in base_link (m; x forward, y
+            left), read-only; for a round robot the regular polygon about its disc.
+        radius_m: The circumscribed radius about base_link's origin (m): what a turn in
+            place sweeps.
+        disc: Whether the robot is round (its footprint then stands for the disc of
+            `radius_m`).
+        limits: What the drive can do.
+        gains: The heading controller's gains.
+        sensor_kind: "sonar" or "laser".
+        profile: The robot profile's name ("default", "jackal", ...).
     """
 
     footprint: np.ndarray
