@@ -28,7 +28,14 @@ from vplane_mj.planning.protocol.types import Observation
 
 @dataclass(frozen=True)
 class FieldParams(PlannerParams):
-    """Khatib's FIRAS attraction and repulsion (the paper's eqs. 2-6)."""
+    """Khatib's FIRAS attraction and repulsion (the paper's eqs. 2-6).
+
+    Attributes:
+        attract_gain: The attraction gain, omega of eqs. 2-3 (1/m).
+        attract_radius: Where the attraction turns from quadratic to conic, r of eqs. 2-3 (m).
+        repulse_gain: The repulsion gain per sonar echo, eta of eqs. 4-5 (m).
+        influence: An echo's distance of influence, f0 of eqs. 4-5 (m).
+    """
 
     attract_gain: float = param(0.5, "1/m", "omega of eqs. 2-3, attraction gain", gt=0)
     attract_radius: float = param(1.0, "m", "r of eqs. 2-3, quadratic-to-conic switch distance", gt=0)
@@ -50,7 +57,13 @@ class FieldParams(PlannerParams):
 
 @dataclass(frozen=True)
 class EvasionParams(PlannerParams):
-    """How commands are checked against the moving tracks in time (evasion.py)."""
+    """How commands are checked against the moving tracks in time (evasion.py).
+
+    Attributes:
+        evade_horizon_s: How long a command's motion is checked against the moving tracks (s).
+        evade_margin_m: How far the footprint keeps from a moving track's predicted disc (m).
+        evade_growth_mps: How much a moving track's predicted disc grows per second ahead (m/s).
+    """
 
     evade_horizon_s: float = param(
         3.0, "s", "how long a command's motion is checked against the moving tracks", gt=0, le=10.0
@@ -69,8 +82,17 @@ class EvasionParams(PlannerParams):
 
 @dataclass(frozen=True)
 class MotionParams(EvasionParams):
-    """The margins of the governor that drives a force on the robot's body (motion/governor.py), and its
-    check against moving tracks."""
+    """The margins of the governor that drives a force on the robot's body (motion/governor.py),
+    and its check against moving tracks.
+
+    Attributes:
+        evade_horizon_s: How long a command's motion is checked against the moving tracks (s).
+        evade_margin_m: How far the footprint keeps from a moving track's predicted disc (m).
+        evade_growth_mps: How much a moving track's predicted disc grows per second ahead (m/s).
+        stop_margin_m: The room a turning robot's disc needs to creep ahead, and in which
+            backing off brakes (m).
+        turn_margin_m: How far turns and predicted motions keep the footprint from obstacles (m).
+    """
 
     stop_margin_m: float = param(
         0.1,
@@ -91,7 +113,14 @@ class MotionParams(EvasionParams):
 
 @dataclass(frozen=True)
 class DetectorParams(PlannerParams):
-    """The local-minimum detector's parameters (planners with an escape use only these)."""
+    """The local-minimum detector's parameters (planners with an escape use only these).
+
+    Attributes:
+        stuck_window_s: The window of the local-minimum criteria, t (s).
+        stuck_displacement_m: The least travel over the window, d_th (m).
+        stuck_speed_mps: The speed below which the robot counts as halted, v_th (m/s).
+        startup_s: No detection during this time after the start (s).
+    """
 
     stuck_window_s: float = param(4.0, "s", "t: window of the local-minimum criteria", gt=0)
     stuck_displacement_m: float = param(0.2, "m", "d_th: least travel over the window", gt=0)
@@ -110,14 +139,28 @@ class DetectorParams(PlannerParams):
 
 @dataclass(frozen=True)
 class MinimumParams(DetectorParams):
-    """The detector's parameters plus the patience of a planner without an escape."""
+    """The detector's parameters plus the patience of a planner without an escape.
+
+    Attributes:
+        stuck_window_s: The window of the local-minimum criteria, t (s).
+        stuck_displacement_m: The least travel over the window, d_th (m).
+        stuck_speed_mps: The speed below which the robot counts as halted, v_th (m/s).
+        startup_s: No detection during this time after the start (s).
+        patience_s: Time spent trapped before giving up, outcome `stuck` (s).
+    """
 
     patience_s: float = param(15.0, "s", "time spent trapped before giving up (outcome stuck)", gt=0)
 
 
 @dataclass(frozen=True)
 class LocalMapParams(PlannerParams):
-    """The sonar certainty grid (localmap.py), shared by the planners that keep one."""
+    """The sonar certainty grid (localmap.py), shared by the planners that keep one.
+
+    Attributes:
+        map_cell_m: Cell size of the local sonar map (m).
+        map_size_m: Side of the square local map that follows the robot (m).
+        map_threshold: Certainty at which a map cell counts as an obstacle.
+    """
 
     map_cell_m: float = param(0.1, "m", "cell size of the local sonar map", ge=0.05, le=1.0)
     map_size_m: float = param(8.0, "m", "side of the square local map that follows the robot", gt=0, le=20.0)
@@ -137,6 +180,14 @@ class SonarMapParams(LocalMapParams):
 
     The bounds keep the grid (at most 400 x 400 cells) and the histogram (at most 720 sectors)
     small enough to update at the control rate.
+
+    Attributes:
+        map_cell_m: Cell size of the local sonar map (m).
+        map_size_m: Side of the square local map that follows the robot (m).
+        map_threshold: Certainty at which a map cell counts as an obstacle.
+        sector_deg: Width of a polar histogram sector (deg).
+        window_m: Radius of the histogram's active window (m).
+        histogram_threshold: Sector density above which a sector is blocked.
     """
 
     sector_deg: float = param(5.0, "deg", "polar histogram sector width", ge=0.5, le=45)
