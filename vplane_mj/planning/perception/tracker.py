@@ -94,12 +94,18 @@ from vplane_mj.planning.protocol.params import PlannerParams, param
 class Track:
     """A confirmed track: an obstacle's estimated disc and motion, in the planner's world frame.
 
-    `position` (m) and `velocity` (m/s) are the estimate at `stamp_s` (s, the tracker's last
-    scan), read-only; `radius_m` that of a disc about `position` that holds what was seen of
-    it; `position_std_m` and `velocity_std_mps` the 1-sigma of the estimates along their
-    least certain direction; `first_seen_s` and `last_seen_s` (s) its first and last
-    measurement (earlier than `stamp_s` while it coasts unseen); `moving` whether it is
-    confidently moving (see `TrackerParams`).
+    Attributes:
+        track_id: The track's number, counting up from 1 in the order tracks start.
+        position: The estimated centre [x, y] at `stamp_s` (m), read-only.
+        velocity: The estimated velocity [vx, vy] at `stamp_s` (m/s), read-only.
+        radius_m: Radius of a disc about `position` that holds what was seen of it (m).
+        position_std_m: 1-sigma of `position` along its least certain direction (m).
+        velocity_std_mps: 1-sigma of `velocity` along its least certain direction (m/s).
+        first_seen_s: Time of its first measurement (s).
+        last_seen_s: Time of its last measurement (s; earlier than `stamp_s` while it coasts
+            unseen).
+        moving: Whether it is confidently moving (see `TrackerParams`).
+        stamp_s: Time of the tracker's last scan, when the estimates hold (s).
     """
 
     track_id: int
