@@ -58,7 +58,21 @@ _NONE = np.zeros((0, 0), dtype=bool)
 
 
 class LocalMap:
-    """Certainty grid of obstacle cells around the robot (see the module docstring)."""
+    """Certainty grid of obstacle cells around the robot (see the module docstring).
+
+    Attributes:
+        cell_m (float): Side of a cell (m).
+        n (int): Cells along each side of the grid.
+        hit (int): Certainty an arc cell gains from a reading.
+        miss (int): Certainty a cone cell loses to a reading.
+        max_certainty (int): The most certainty a cell holds.
+        hit_range_m (float): Echoes farther than this only clear their cone (m).
+        track_seen (bool): Whether the map keeps `seen`.
+        silent_free_m (float): How far a reading without an echo shows its cone free (m; 0
+            without `track_seen`).
+        origin (numpy.ndarray | None): World cell index (i, j) of grid[0, 0]; None before the
+            first `update` or `sweep` places the grid.
+    """
 
     def __init__(
         self,
@@ -71,6 +85,21 @@ class LocalMap:
         track_seen: bool = False,
         silent_free_m: float = 0.0,
     ):
+        """An empty grid; the first `update` or `sweep` places it about the robot.
+
+        Args:
+            cell_m: Side of a cell (m).
+            size_m: Side of the square grid (m), at least 8 cells.
+            hit: Certainty an arc cell gains from a reading.
+            miss: Certainty a cone cell loses to a reading.
+            max_certainty: The most certainty a cell holds.
+            hit_range_m: Echoes farther than this only clear their cone (m); an arc at most a
+                cell wide (a laser's) marks at any range.
+            track_seen: Keep `seen`: the cells a reading has shown free or the robot's disc
+                has covered.
+            silent_free_m: With `track_seen`, how far a reading without an echo shows its cone
+                free (m).
+        """
         from vplane_mj.kernels.maps import grid, map_update  # numba: loaded by the first map a run makes
 
         self._fold_scan = map_update.fold_scan
