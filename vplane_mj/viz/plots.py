@@ -57,9 +57,15 @@ def plot_log(path: Path, contents: LogContents, scenario: Scenario, track: Track
 
 
 def draw_world(axes, scenario: Scenario, margin_m: float = 0.2) -> None:
-    """Draw a scenario's world on matplotlib `axes`, in metres: the obstacles and border walls
+    """Draw a scenario's world on matplotlib axes, in metres: the obstacles and border walls
     (dark blue), the start (green dot, label "start") and the goal (gold disc of the goal
-    tolerance, label "goal"); equal aspect, the arena and `margin_m` around it in view."""
+    tolerance, label "goal"); equal aspect, the arena and the margin around it in view.
+
+    Args:
+        axes (matplotlib.axes.Axes): The axes to draw on.
+        scenario: The scenario whose world, start and goal are drawn.
+        margin_m: Room shown around the arena (m).
+    """
     _draw_obstacles(axes, scenario)
     axes.plot(*scenario.robot.start, "o", color="green", ms=9, label="start")
     axes.add_patch(Circle(scenario.robot.goal, scenario.robot.goal_tolerance, color="gold", label="goal"))
@@ -74,10 +80,16 @@ def draw_world(axes, scenario: Scenario, margin_m: float = 0.2) -> None:
 
 
 def draw_path(axes, positions: np.ndarray, modes: Sequence[str], linewidth: float = 2.0) -> None:
-    """Draw a path, positions (n, 2) in m, each segment in the colour of the planner mode at its
-    start (`modes`, n of them), as the render colours them: red `normal`, orange `avoiding`,
-    blue `escaping`, purple `trapped`, green `following`, grey any other mode; above the world,
-    below markers."""
+    """Draw a path, each segment in the colour of the planner mode at its start, as the render
+    colours them: red `normal`, orange `avoiding`, blue `escaping`, purple `trapped`, green
+    `following`, grey any other mode; above the world, below markers.
+
+    Args:
+        axes (matplotlib.axes.Axes): The axes to draw on.
+        positions: The robot's centre at each tick, (n, 2) in m (`Trajectory.positions`).
+        modes: The planner's mode at each tick, n of them (`Trajectory.modes`).
+        linewidth: The line's width (points).
+    """
     points = np.asarray(positions, float)
     segments = list(np.stack([points[:-1], points[1:]], axis=1))  # (2, 2) arrays, as LineCollection takes
     colours = [MODE_RGBA.get(mode, OTHER_MODE_RGBA) for mode in modes[: len(segments)]]
@@ -85,8 +97,13 @@ def draw_path(axes, positions: np.ndarray, modes: Sequence[str], linewidth: floa
 
 
 def label_modes(axes, modes: Iterable[str]) -> None:
-    """Add a legend entry "path: MODE" for each of `modes` that draw_path has a colour for, in
-    the order normal, avoiding, escaping, trapped, following."""
+    """Add a legend entry "path: MODE" for each mode that `draw_path` has a colour for, in the
+    order normal, avoiding, escaping, trapped, following (shown by the next `axes.legend()`).
+
+    Args:
+        axes (matplotlib.axes.Axes): The axes that `draw_path` drew on.
+        modes: The modes the path shows (`Trajectory.modes`; repeats count once).
+    """
     present = set(modes)
     for mode, rgba in MODE_RGBA.items():
         if mode in present:
