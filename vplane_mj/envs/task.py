@@ -49,7 +49,14 @@ AGENT_MODE = "agent"
 class Reward:
     """The reward of one step: `progress` per metre that the distance to the goal shrinks,
     minus `collision` per new contact episode, minus `time_per_s` per simulated second, plus
-    `success` when the goal is reached."""
+    `success` when the goal is reached.
+
+    Attributes:
+        progress: Reward per metre the distance to the goal shrinks (1/m).
+        collision: Penalty per new contact episode.
+        time_per_s: Penalty per simulated second (1/s).
+        success: Reward for reaching the goal.
+    """
 
     progress: float = 1.0
     collision: float = 1.0

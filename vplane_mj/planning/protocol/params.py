@@ -28,7 +28,17 @@ PARAM = "vplane_mj.param"
 
 @dataclass(frozen=True)
 class Param:
-    """One numeric planner parameter. Bounds are exclusive (`gt`) or inclusive (`ge`, `le`)."""
+    """One numeric planner parameter, as `param` declares it.
+
+    Attributes:
+        default: The value when none is given.
+        unit: Its unit as `vplane-mj list` shows it ("m", "rad", "s", ...; "" for none).
+        doc: Its meaning, one line.
+        gt: Exclusive lower bound; None: none.
+        ge: Inclusive lower bound; None: none.
+        le: Inclusive upper bound; None: none.
+        integer: Whether it is a count (an int).
+    """
 
     default: float
     unit: str
