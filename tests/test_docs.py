@@ -2,12 +2,18 @@
 them after the set-up, exit 0 and print and write what the page shows; its set-up commands are
 the README's; every relative link of README.md, CHANGELOG.md and docs/ points at a file (and
 a heading) that exists; every benchmark table a page includes is a result file that says how and
-when it was measured; the figures the README quotes from those tables are theirs; and every
-public name of `vplane_mj` and `vplane_mj.planning` has its entry on a reference page."""
+when it was measured; the figures the README quotes from those tables are theirs; every
+public name of `vplane_mj` and `vplane_mj.planning` has its entry on a reference page; and
+what those entries show is whole: every field of a documented dataclass in its docstring's
+table, every member of a documented enum with its docstring."""
 
 from __future__ import annotations
 
+import ast
+import dataclasses
+import enum
 import importlib
+import inspect
 import json
 import os
 import re
@@ -413,3 +419,117 @@ def test_reference_entries_are_found_and_resolved():
     assert "vplane_mj.runner.run" in reference_entries()
     assert documented_object("vplane_mj.runner.run") is vplane_mj.run
     assert "vplane_mj.files.OutputBusy" not in DIRECTIVE.findall("Text ::: vplane_mj.files.OutputBusy\n")
+
+
+SECTION_ENTRY = re.compile(r"^    (\w+)(?: \([^)]*\))?: ?(.*)$")
+"""An entry of a Google-style docstring section: `name: text` or `name (type): text`."""
+
+
+def docstring_section(doc: str, title: str) -> dict[str, str]:
+    """The entries of a docstring's section (`Attributes`, `Args`, ...): name -> its text, its
+    continuation lines joined, in the docstring's order; empty without the section."""
+    entries: dict[str, str] = {}
+    inside, name = False, None
+    for line in inspect.cleandoc(doc).splitlines():
+        if not line.startswith(" "):
+            inside, name = line == f"{title}:", None
+            continue
+        if inside:
+            entry = SECTION_ENTRY.match(line)
+            if entry:
+                name = entry[1]
+                entries[name] = entry[2]
+            elif name is not None and line.startswith("        "):
+                entries[name] += " " + line.strip()
+    return entries
+
+
+def field_table(cls: type) -> dict[str, str]:
+    """The entries of a dataclass's docstring that stand for its fields: its Attributes section,
+    or for a dataclass the caller fills in (`Decision`), its Args section."""
+    doc = cls.__doc__ or ""
+    return docstring_section(doc, "Attributes") or docstring_section(doc, "Args")
+
+
+def member_docstrings(cls: type) -> dict[str, str | None]:
+    """Each attribute assigned in a class's body -> the string literal right under it, if any."""
+    (node,) = ast.parse(textwrap.dedent(inspect.getsource(cls))).body
+    assert isinstance(node, ast.ClassDef)
+    found: dict[str, str | None] = {}
+    for statement, after in zip(node.body, [*node.body[1:], None], strict=True):
+        if isinstance(statement, ast.Assign | ast.AnnAssign):
+            targets = statement.targets if isinstance(statement, ast.Assign) else [statement.target]
+            docstring = None
+            if isinstance(after, ast.Expr) and isinstance(after.value, ast.Constant):
+                docstring = str(after.value.value)
+            for target in targets:
+                if isinstance(target, ast.Name):
+                    found[target.id] = docstring
+    return found
+
+
+DOCUMENTED = {path: documented_object(path) for path in reference_entries()}
+DATACLASSES = sorted(
+    path
+    for path, found in DOCUMENTED.items()
+    if isinstance(found, type) and dataclasses.is_dataclass(found) and dataclasses.fields(found)
+)
+"""The dataclasses the reference pages document that have fields."""
+ENUMS = sorted(path for path, found in DOCUMENTED.items() if isinstance(found, enum.EnumMeta))
+"""The enums the reference pages document."""
+
+
+@pytest.mark.parametrize("path", DATACLASSES)
+def test_a_documented_dataclass_lists_every_field_in_its_docstring_s_table(path):
+    cls = DOCUMENTED[path]
+    fields = [item.name for item in dataclasses.fields(cls)]
+    assert list(field_table(cls)) == fields, f"{path}: its Attributes section, in the fields' order"
+
+
+@pytest.mark.parametrize("path", [path for path in DATACLASSES if hasattr(DOCUMENTED[path], "table")])
+def test_a_documented_parameter_group_gives_each_parameter_s_unit(path):
+    entries = field_table(DOCUMENTED[path])
+    for name, spec in DOCUMENTED[path].table().items():
+        if spec.unit:
+            assert f"({spec.unit})" in entries[name], f"{path}.{name}: ({spec.unit}) in its entry"
+
+
+@pytest.mark.parametrize("path", ENUMS)
+def test_every_member_of_a_documented_enum_has_its_docstring(path):
+    members = member_docstrings(DOCUMENTED[path])
+    assert list(members) == [member.name for member in DOCUMENTED[path]]
+    assert [name for name, doc in members.items() if not doc] == [], f"{path}: members without docstring"
+
+
+def test_docstring_tables_are_read_and_judged():
+    @dataclass
+    class Pair:
+        """Two numbers.
+
+        Attributes:
+            first: The first (m), on a line
+                and the next.
+            second (float): The second.
+
+        Raises:
+            ValueError: never.
+        """
+
+        first: float
+        second: float
+        third: float = 0.0
+
+    assert docstring_section(Pair.__doc__ or "", "Attributes") == {
+        "first": "The first (m), on a line and the next.",
+        "second": "The second.",
+    }
+    assert list(field_table(Pair)) != [item.name for item in dataclasses.fields(Pair)]  # third
+    assert "vplane_mj.planning.planners.groups.FieldParams" in DATACLASSES
+    assert "vplane_mj.planning.protocol.events.EventKind" in ENUMS
+
+    class Kind(enum.StrEnum):
+        A = "a"
+        """Documented."""
+        B = "b"
+
+    assert member_docstrings(Kind) == {"A": "Documented.", "B": None}
