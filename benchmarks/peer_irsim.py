@@ -35,7 +35,8 @@ thread per core): IR-SIM's lidar multiplies (segments x 2) by (2 x beams) matric
 OpenBLAS's threads spent several times the CPU time on them on a 2-core machine shared with
 other work. The header says what ran.
 
-The three tables are written to `OUT/peer_irsim_scans.md`, `peer_irsim_worlds.md` and
+The four tables are written to `OUT/peer_irsim_scans.md`, `peer_irsim_worlds.md`,
+`peer_irsim_rates.md` (per world, the rates side by side: what the documentation shows) and
 `peer_irsim.md` (overall), with their `.csv` and `.json` (the command and the date).
 
     python benchmarks/peer_irsim.py [--count 2] [--seed 0] [--time-limit 10] [--repeat 3]
@@ -98,7 +99,10 @@ OVERALL_CELLS = {
     **RATES,
     "over IR-SIM (wall)": ".2f",
 }
-"""The three tables' columns (the scans at the start, per world, overall) and how each is written."""
+"""The three tables' columns (the scans at the start, per world, overall) and how each is written;
+the per-world rates side by side take theirs from the configurations (`rates_table`)."""
+OVER_IRSIM = " over IR-SIM"
+"""Ends the name of a rates-table column that holds a rate over IR-SIM's at the same beams."""
 MISSING_PEERS = (
     "peer_irsim.py compares this project with IR-SIM and needs the benchmarks' `peers` extra, "
     "not installed here ({missing}): pip install 'vplane-mj[peers]' (or pip install ir-sim threadpoolctl)"
@@ -321,6 +325,45 @@ def world_table(worlds: dict[str, dict[tuple[str, int], Timing]]) -> list[dict]:
     return table
 
 
+def rate_column(simulator: str, beams: int) -> str:
+    """The rates table's column of a configuration: "IR-SIM 16", "`dwa` 720", ..."""
+    return f"{IRSIM} {beams}" if simulator == IRSIM else f"`{simulator}` {beams}"
+
+
+def rates_table(
+    worlds: dict[str, dict[tuple[str, int], Timing]], cylinders: dict[str, int]
+) -> tuple[list[dict], list[str]]:
+    """Per world, its cylinders and each configuration's simulated seconds per CPU second, and
+    for this project's, that rate over IR-SIM's at the same beams; the rows and the columns."""
+    table, columns = [], ["world", "cylinders"]
+    for name, timings in worlds.items():
+        row: dict = {"world": name, "cylinders": cylinders[name]}
+        for (simulator, beams), t in timings.items():
+            peer = timings[IRSIM, beams]
+            column = rate_column(simulator, beams)
+            row[column] = rate(t.simulated_s, t.cpu_s)
+            if simulator != IRSIM:
+                row[column + OVER_IRSIM] = (t.simulated_s / t.cpu_s) / (peer.simulated_s / peer.cpu_s)
+        columns += [key for key in row if key not in columns]
+        table.append(row)
+    return table, columns
+
+
+def rates_markdown(table: list[dict], columns: list[str]) -> str:
+    """The rates table as the documentation shows it: a configuration's rate, and in brackets
+    its rate over IR-SIM's ("47.41 (7.82x)")."""
+    shown = [column for column in columns if not column.endswith(OVER_IRSIM)]
+
+    def cell(row: dict, column: str) -> str:
+        value, over = row.get(column), row.get(column + OVER_IRSIM)
+        if column in ("world", "cylinders") or value is None:
+            return "-" if value is None else str(value)
+        return f"{value:.2f}" + ("" if over is None else f" ({over:.2f}x)")
+
+    cells = [{column: cell(row, column) for column in shown} for row in table]
+    return markdown_table(cells, shown, lambda _, text: str(text))
+
+
 def overall_table(worlds: dict[str, dict[tuple[str, int], Timing]]) -> list[dict]:
     """Per configuration, summed over the worlds: times, rates and rates over IR-SIM's."""
     keys = next(iter(worlds.values())).keys()
@@ -404,6 +447,10 @@ def main(argv: list[str] | None = None) -> int:
     )
     written = publish(out, "peer_irsim_scans", scan_table(cylinders, differences), SCAN_CELLS)
     written += publish(out, "peer_irsim_worlds", world_table(worlds), WORLD_CELLS)
+    rates, rate_columns = rates_table(worlds, cylinders)
+    text = rates_markdown(rates, rate_columns)
+    print(f"\n{text}")
+    written += write_table(out, "peer_irsim_rates", rates, rate_columns, text)
     written += publish(out, "peer_irsim", overall_table(worlds), OVERALL_CELLS)
     print("\n" + "\n".join(f"wrote {path}" for path in written))
     return 0

@@ -1,8 +1,11 @@
 """A benchmark's result table: its Markdown, CSV and the sidecar saying how and when it was measured."""
 
 import csv
+import importlib.util
 import json
+import sys
 from datetime import datetime
+from pathlib import Path
 
 from vplane_mj.bench import report
 from vplane_mj.bench.tables import (
@@ -66,4 +69,44 @@ def test_formatted_cells_take_their_column_s_format():
         "2.00",
         "a",
         "-",
+    ]
+
+
+def benchmark_script(name: str):
+    """A benchmark script of `benchmarks/`, imported as a module (its `main` not run)."""
+    path = Path(__file__).parents[1] / "benchmarks" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(f"benchmark_{name}", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # where its dataclasses look their annotations up
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_peer_irsim_sets_each_world_s_rates_side_by_side_with_their_ratio_to_irsim_s():
+    peer = benchmark_script("peer_irsim")
+    timings = {
+        (peer.IRSIM, 16): peer.Timing(20.0, 4.0, 4.0, "collided, stopped"),
+        (peer.IRSIM, 720): peer.Timing(20.0, 40.0, 40.0, "collided, stopped"),
+        ("dwa", 16): peer.Timing(20.0, 2.0, 2.0, "timeout"),
+        ("dwa", 720): peer.Timing(10.0, 2.5, 2.5, "reached"),
+    }
+    table, columns = peer.rates_table({"w": timings}, {"w": 150})
+    assert table == [
+        {
+            "world": "w",
+            "cylinders": 150,
+            "IR-SIM 16": 5.0,
+            "IR-SIM 720": 0.5,
+            "`dwa` 16": 10.0,
+            "`dwa` 16 over IR-SIM": 2.0,
+            "`dwa` 720": 4.0,
+            "`dwa` 720 over IR-SIM": 8.0,
+        }
+    ]
+    assert columns == list(table[0])
+    assert peer.rates_markdown(table, columns).splitlines() == [
+        "| world | cylinders | IR-SIM 16 | IR-SIM 720 | `dwa` 16 | `dwa` 720 |",
+        "|---|---|---|---|---|---|",
+        "| w | 150 | 5.00 | 0.50 | 10.00 (2.00x) | 4.00 (8.00x) |",
     ]
