@@ -2,7 +2,8 @@
 them after the set-up, exit 0 and print and write what the page shows; its set-up commands are
 the README's; every relative link of README.md, CHANGELOG.md and docs/ points at a file (and
 a heading) that exists; every benchmark table a page includes is a result file that says how and
-when it was measured; the figures the README quotes from those tables are theirs; every
+when it was measured; the figures the README quotes are those tables' (or, where no script
+writes a table, the figures of the dated record a page keeps); every
 public name of `vplane_mj` and `vplane_mj.planning` has its entry on a reference page; and
 what those entries show is whole: every field of a documented dataclass in its docstring's
 table, every member of a documented enum with its docstring."""
@@ -23,6 +24,7 @@ import sysconfig
 import textwrap
 from dataclasses import dataclass
 from datetime import datetime
+from decimal import ROUND_HALF_UP, Decimal
 from pathlib import Path
 from typing import Any
 
@@ -48,9 +50,20 @@ INLINE_CODE = re.compile(r"(`+)(?:(?!\1).)+?\1", re.S)
 INCLUDE = re.compile(r'^--8<-- "(benchmarks/results/[^"]+)"$', re.M)
 """A page's include of a benchmark's result table (pymdownx.snippets)."""
 FIGURE = r"([0-9.]+)%?"
+RESULTS = "benchmarks/results/"
+RANGE = rf"{FIGURE}-{FIGURE}"
+"""Two figures of the README, "1.47-1.50"."""
+TARGETS = {
+    "vplane": ("`vplane` on a U escape and a BARN world",),
+    "vplane_plus": ("`vplane_plus` on the same",),
+    "dwa": ("`dwa` on the same",),
+    "jackal": ("Jackal, laser, `vplane_plus` on a protocol world",),
+}
+"""The rows of the run-loop overhead's targets (docs/benchmarks/overhead.md, a dated record)."""
+TRAINING = "mean BARN score (BARN's OT)"
 README_FIGURES = (
     (
-        "barn_protocol_ten_seeds/barn_protocol.md",
+        RESULTS + "barn_protocol_ten_seeds/barn_protocol.md",
         rf"`vplane_plus` reached the goal without a collision in all {FIGURE} runs, "
         rf"mean BARN score {FIGURE}; the footprint-aware `dwa` {FIGURE}, {FIGURE} collisions, {FIGURE}; "
         rf"BARN's own DWA baseline reports {FIGURE}, {FIGURE} collisions, {FIGURE}",
@@ -66,7 +79,19 @@ README_FIGURES = (
         ],
     ),
     (
-        "dynabarn/dynabarn.md",
+        "docs/barn.md",
+        rf"`vplane_plus` reaches {FIGURE} of the goals without a collision, mean score {FIGURE} "
+        rf"\({FIGURE} on the EKF pose a real stack drives on, `--set sensors.pose=ekf`\), "
+        rf"beside the 2024 challenge winner's {FIGURE} on the test worlds' leaderboard",
+        [
+            (("`vplane_plus`, true pose (seeds 0-2)",), "success"),
+            (("`vplane_plus`, true pose (seeds 0-2)",), TRAINING),
+            (("`vplane_plus`, EKF (seeds 0-2)",), TRAINING),
+            (("BARN 2024 winner (leaderboard; test worlds)",), TRAINING),
+        ],
+    ),
+    (
+        RESULTS + "dynabarn/dynabarn.md",
         rf"`apf` reached the goal without a collision in {FIGURE} of the runs "
         rf"\({FIGURE} on the hard third\), `vplane_plus` {FIGURE} \({FIGURE}\), `dwa` {FIGURE}; "
         rf"DynaBARN's own DWA baseline reports {FIGURE} / {FIGURE} / {FIGURE} on its easy, medium and hard "
@@ -83,9 +108,42 @@ README_FIGURES = (
             (("apf", "all"), "collision_rate"),
         ],
     ),
+    (
+        "docs/benchmarks/overhead.md",
+        rf"A `vplane` run of `paper_c_escape` costs {RANGE} times MuJoCo's bare physics of the same "
+        rf"world and steps \({RANGE} with its MCAP log\), `vplane_plus` {RANGE} and `dwa` {FIGURE}; "
+        rf"the Jackal's governed, laser-mapping `vplane_plus` {RANGE} on BARN protocol worlds "
+        rf"\({RANGE} with its log\)",
+        [
+            (TARGETS["vplane"], "measured without log", 0),  # paper_c_escape, then the BARN world
+            (TARGETS["vplane"], "measured without log", 1),
+            (TARGETS["vplane"], "measured with log", 0),
+            (TARGETS["vplane"], "measured with log", 1),
+            (TARGETS["vplane_plus"], "measured without log", 0),
+            (TARGETS["vplane_plus"], "measured without log", 1),
+            (TARGETS["dwa"], "measured without log", 0),
+            (TARGETS["jackal"], "measured without log", 0),  # the least of world 1, the most of world 10
+            (TARGETS["jackal"], "measured without log", 3),
+            (TARGETS["jackal"], "measured with log", 0),
+            (TARGETS["jackal"], "measured with log", 3),
+        ],
+    ),
+    (
+        RESULTS + "overhead_dynabarn/overhead.md",
+        rf"Among DynaBARN's moving cylinders a run costs more, {RANGE} times its floor for `apf` "
+        rf"and {RANGE} for `vplane_plus`",
+        [
+            (("dynabarn_0_hard_041", "`apf`"), "run / floor"),
+            (("dynabarn_0_medium_020", "`apf`"), "run / floor"),
+            (("dynabarn_0_hard_041", "`vplane_plus`"), "run / floor"),
+            (("dynabarn_0_medium_020", "`vplane_plus`"), "run / floor"),
+        ],
+    ),
 )
-"""What the README quotes from a result table: the table, the README's sentence with each figure as
-a group, and for each group the table's cell it quotes (the leading cells of its row, its column)."""
+"""What the README quotes from a table: the file that holds it (a result table, or the page that
+keeps it as a dated record), the README's sentence with each figure as a group, and for each
+group the table's cell it quotes (the leading cells of its row, its column, and which of the
+cell's numbers when it holds several, the first by default)."""
 
 
 @dataclass(frozen=True)
@@ -344,6 +402,17 @@ def result_cell(table: str, row: tuple[str, ...], column: str) -> str:
     return found[column]
 
 
+CELL_NUMBER = re.compile(r"\d+(?:\.\d+)?")
+"""A number of a table's cell ("1.47-1.50, 1.62-1.67" holds four, none negative)."""
+
+
+def quotes(figure: str, cell: str, which: int = 0) -> bool:
+    """Whether a figure the README quotes is the `which`-th number of a table's cell, as the cell
+    writes it or rounded half up to the figure's decimals ("3.2" quotes "3.15")."""
+    quoted = Decimal(figure)
+    return Decimal(CELL_NUMBER.findall(cell)[which]).quantize(quoted, rounding=ROUND_HALF_UP) == quoted
+
+
 def test_the_pages_include_the_benchmarks_result_tables():
     assert len(INCLUDED) >= 20
 
@@ -361,15 +430,16 @@ def test_an_included_result_table_exists_and_says_how_and_when_it_was_measured(i
 
 
 @pytest.mark.parametrize(
-    ("result", "sentence", "cells"), README_FIGURES, ids=[result for result, _, _ in README_FIGURES]
+    ("source", "sentence", "cells"), README_FIGURES, ids=[source for source, _, _ in README_FIGURES]
 )
-def test_the_readme_quotes_its_figures_from_the_result_tables(result, sentence, cells):
+def test_the_readme_quotes_its_figures_from_the_tables(source, sentence, cells):
     readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
     quoted = re.search(sentence, readme)
     assert quoted is not None, sentence
-    table = (ROOT / "benchmarks" / "results" / result).read_text(encoding="utf-8")
-    for figure, (row, column) in zip(quoted.groups(), cells, strict=True):
-        assert float(figure) == float(result_cell(table, row, column).rstrip("%")), (row, column)
+    table = (ROOT / source).read_text(encoding="utf-8")
+    for figure, (row, column, *which) in zip(quoted.groups(), cells, strict=True):
+        cell = result_cell(table, row, column)
+        assert quotes(figure, cell, *which), (figure, row, column, cell)
 
 
 def test_result_cells_are_found_by_row_and_column():
@@ -377,6 +447,9 @@ def test_result_cells_are_found_by_row_and_column():
     assert result_cell(table, ("apf", "all"), "rate") == "7.0%"
     with pytest.raises(ValueError):  # two rows
         result_cell(table, ("apf",), "rate")
+    assert quotes("7.0", "7.0%") and quotes("7", "7.0%") and not quotes("7.1", "7.0%")
+    assert quotes("3.2", "3.15") and quotes("2.8", "2.81") and not quotes("3.1", "3.15")
+    assert quotes("1.94", "1.85-1.89, 1.87-1.94", 3) and not quotes("1.89", "1.85-1.89, 1.87-1.94", 3)
 
 
 REFERENCE_PAGES = sorted((ROOT / "docs" / "reference").glob("*.md"))
