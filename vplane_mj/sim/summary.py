@@ -82,6 +82,9 @@ class RunSummary:
         message: Why the run ended `error` or `stuck`; else empty.
         traceback: The planner's traceback when its code raised; else empty.
         planner_params: The resolved planner parameters, by name.
+        governor: What drove the planner's forces on the robot's body: `own` (the planner
+            drives its body itself, as the built-in planners do), `run` (the run's governor)
+            or `none`.
         version: The package version that ran it.
         format: The summary format, 1.
     """
@@ -130,8 +133,6 @@ class RunSummary:
     traceback: str = ""
     planner_params: dict[str, float] = field(default_factory=dict)
     governor: str = "none"
-    """What drove the planner's forces on the robot's body: `own` (the planner drives its
-    body itself, as the built-in planners do), `run` (the run's governor) or `none`."""
     version: str = ""
     format: int = SUMMARY_FORMAT
 
