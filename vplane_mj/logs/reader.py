@@ -60,7 +60,8 @@ class LogContents:
     file ended with its footer (False for a file whose writer was killed);
     `obstacle_times_ns` (M,) and `obstacle_places` (M, count, 2; m): the `/world/moving`
     messages, where the moving obstacles stood, in each message's order of entities (the
-    scenario's `world.moving`); none in a world without any.
+    scenario's `world.moving`); none in a world without any. `messages`: the decoded messages
+    of the topics `read_log` was asked to keep, in file order.
     """
 
     metadata: dict[str, dict[str, str]]
@@ -74,6 +75,7 @@ class LogContents:
     message_encodings: dict[str, str] = field(default_factory=dict)
     obstacle_times_ns: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.int64))
     obstacle_places: np.ndarray = field(default_factory=lambda: np.empty((0, 0, 2)))
+    messages: list[LogMessage] = field(default_factory=list)
 
     def obstacles_at_poses(self) -> np.ndarray | None:
         """Where the moving obstacles stood at each pose of `times_ns` (N, count, 2; m): the last
@@ -179,8 +181,9 @@ def iter_messages(path: Path, topics: tuple[str, ...] | None = None) -> Iterator
         )
 
 
-def read_log(path: Path) -> LogContents:
-    """Read a log written by `McapLog`, also one whose writer was killed.
+def read_log(path: Path, keep: tuple[str, ...] = ()) -> LogContents:
+    """Read a log written by `McapLog`, also one whose writer was killed; with the decoded
+    messages of the topics `keep` in `messages` (read in the same pass).
 
     The file is read front to back with the `mcap` package's `StreamReader` (never
     seeking to the summary section, which a killed writer never wrote), through a
@@ -201,25 +204,31 @@ def read_log(path: Path) -> LogContents:
     events: list[LoggedEvent] = []
     obstacle_times: list[int] = []
     obstacle_places: list[list[tuple[float, float]]] = []
+    kept: list[LogMessage] = []
+    read = (*keep, "/robot/pose", "/metrics", MOVING_TOPIC, EVENTS_DATA_TOPIC)
     for schema, channel, record in scan.messages():
         topic = channel.topic
-        entry = counts.setdefault(topic, [schema.name if schema is not None else "", 0])
+        schema_name = schema.name if schema is not None else ""
+        entry = counts.setdefault(topic, [schema_name, 0])
         entry[1] += 1
         encodings[topic] = channel.message_encoding
+        if topic not in read:
+            continue
+        message = decoders.decode(schema, channel, record.data)
         if topic == "/robot/pose":
-            pose = decoders.decode(schema, channel, record.data).pose
+            pose = message.pose
             q = pose.orientation
             times.append(record.log_time)
             poses.append((pose.position.x, pose.position.y, 2 * math.atan2(q.z, q.w)))
         elif topic == "/metrics":
-            modes.append(str(decoders.decode(schema, channel, record.data).get("mode", "")))
+            modes.append(str(message.get("mode", "")))
         elif topic == MOVING_TOPIC:
             obstacle_times.append(record.log_time)
-            obstacle_places.append(entity_centres(decoders.decode(schema, channel, record.data)))
+            obstacle_places.append(entity_centres(message))
         elif topic == EVENTS_DATA_TOPIC:
-            events.append(
-                LoggedEvent.from_json(record.log_time, decoders.decode(schema, channel, record.data))
-            )
+            events.append(LoggedEvent.from_json(record.log_time, message))
+        if topic in keep:
+            kept.append(LogMessage(topic, schema_name, record.log_time, message))
     pose_array = np.array(poses, dtype=float).reshape(-1, 3)
     return LogContents(
         metadata=scan.metadata,
@@ -235,6 +244,7 @@ def read_log(path: Path) -> LogContents:
         obstacle_places=np.array(obstacle_places, dtype=float).reshape(len(obstacle_times), -1, 2)
         if obstacle_times
         else np.empty((0, 0, 2)),
+        messages=kept,
     )
 
 

@@ -53,12 +53,13 @@ COMPARED_KEYS = (
 """The summary keys that a log reproduces."""
 
 
-def load_log(path: Path) -> tuple[LogContents, Scenario]:
-    """The log's contents and the scenario stored in its metadata; VPlaneError if unreadable."""
+def load_log(path: Path, keep: tuple[str, ...] = ()) -> tuple[LogContents, Scenario]:
+    """The log's contents (with the decoded messages of the topics `keep`, as `read_log` reads
+    them) and the scenario stored in its metadata; VPlaneError if unreadable."""
     if not path.is_file():
         raise VPlaneError(f"{path}: no such log file")
     try:
-        contents = read_log(path)
+        contents = read_log(path, keep)
     except Exception as exc:
         raise VPlaneError(f"{path}: not a readable vplane-mj MCAP log ({exc})") from exc
     info = contents.metadata.get(METADATA_NAME)
