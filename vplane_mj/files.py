@@ -1,5 +1,6 @@
 """The project's files: the shipped data (`models/`, `scenarios/`), and run outputs written so
-that every file appears complete under its name, or not at all, by one writer at a time.
+that every file (or directory) appears complete under its name, or not at all, by one writer
+at a time.
 
 Exclusive locks keep two processes from writing the same outputs at once. A lock is a file
 beside the outputs (`.NAME.lock`) on which its holder keeps an advisory `flock`: the kernel
@@ -17,6 +18,7 @@ import io
 import json
 import os
 import secrets
+import shutil
 import socket
 import sys
 import tempfile
@@ -96,6 +98,30 @@ def write_atomically(path: Path, write: Callable[[Path], object]) -> Path:
     except BaseException:
         temporary.unlink(missing_ok=True)
         raise
+    return path
+
+
+def write_directory_atomically(path: Path, write: Callable[[Path], object]) -> Path:
+    """Let `write` make the directory it is given, named as `path` inside a temporary directory
+    beside it (`partial_path`), then move that into place: a directory already at `path` is
+    replaced, and is gone only once the new one is whole. The temporary directory is removed
+    whatever happens, so a failure leaves `path` as it was."""
+    temporary = partial_path(path)
+    try:
+        temporary.mkdir()
+        made = temporary / path.name
+        write(made)
+        replaced = temporary / f"{path.name}.replaced"
+        if path.is_dir():
+            os.replace(path, replaced)
+        try:
+            os.replace(made, path)
+        except BaseException:
+            if replaced.exists():
+                os.replace(replaced, path)
+            raise
+    finally:
+        shutil.rmtree(temporary, ignore_errors=True)
     return path
 
 
