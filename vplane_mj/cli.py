@@ -141,6 +141,11 @@ def _add_run(commands) -> None:
     run.add_argument("--no-log", action="store_true", help="do not write the .mcap log")
     run.add_argument("--no-render", action="store_true", help="do not write the .png render")
     run.add_argument("--video", action="store_true", help="also write an .mp4 replay of the run")
+    run.add_argument(
+        "--ros2",
+        action="store_true",
+        help="also write a ROS 2 bag of the run (a .ros2 directory, from the log)",
+    )
     run.set_defaults(handler=_run)
 
 
@@ -229,7 +234,7 @@ def _add_world_commands(commands) -> None:
 
 
 def _add_log_commands(commands) -> None:
-    """`vplane-mj summary`, `render`, `plot` and `video`: what a run's log gives again."""
+    """`vplane-mj summary`, `render`, `plot`, `video` and `export`: what a run's log gives again."""
     summary = commands.add_parser("summary", help="recompute a run's summary from its MCAP log")
     summary.add_argument("log", type=Path, metavar="LOG.mcap")
     summary.set_defaults(handler=_summary, draws=False)
@@ -251,6 +256,15 @@ def _add_log_commands(commands) -> None:
         "--speed", type=float, default=1.0, help="simulated seconds per video second (default 1: real time)"
     )
     video.set_defaults(handler=_video)
+
+    export = commands.add_parser("export", help="convert a run's MCAP log for other tools")
+    formats = export.add_subparsers(dest="format", required=True, metavar="FORMAT")
+    ros2 = formats.add_parser(
+        "ros2", help="a ROS 2 bag (rosbag2 directory) for ros2 bag play, RViz 2, PlotJuggler, Foxglove"
+    )
+    ros2.add_argument("log", type=Path, metavar="LOG.mcap")
+    ros2.add_argument("-o", "--output", type=Path, required=True, metavar="DIR")
+    ros2.set_defaults(handler=_export_ros2, draws=False)
 
 
 def _planner_name(reference: str, option: str) -> str:
@@ -279,12 +293,20 @@ def _run(args: argparse.Namespace) -> int:
     from vplane_mj.scenario import load_scenario
 
     scenario = load_scenario(args.scenario, _overrides(args))
-    if args.video and args.no_log:
-        raise VPlaneError("--video: the video is made from the log: drop --no-log")
+    for option, made in (("--video", "the video"), ("--ros2", "the bag")):
+        if getattr(args, option[2:]) and args.no_log:
+            raise VPlaneError(f"{option}: {made} is made from the log: drop --no-log")
     out_dir = prepare_out_dir(args.out or DEFAULT_OUT)
     try:
         with signals_raise_interrupted():
-            record = run(scenario, out_dir, log=not args.no_log, render=not args.no_render, video=args.video)
+            record = run(
+                scenario,
+                out_dir,
+                log=not args.no_log,
+                render=not args.no_render,
+                video=args.video,
+                ros2=args.ros2,
+            )
     except Interrupted as exc:
         _report_interrupted_run(exc)
         return exc.exit_status
@@ -507,6 +529,15 @@ def _video(args: argparse.Namespace) -> int:
     _check_parent(args.output)
     write_video(args.log, args.output, args.speed)
     print(f"wrote {args.output}")
+    return 0
+
+
+def _export_ros2(args: argparse.Namespace) -> int:
+    from vplane_mj.logs.ros2 import RVIZ_CONFIG, export_ros2
+
+    target = export_ros2(args.log, args.output)
+    print(f"wrote {target}")
+    print(f"RViz 2 configuration: {RVIZ_CONFIG}")
     return 0
 
 

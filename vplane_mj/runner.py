@@ -80,7 +80,8 @@ class RunRecord:
         trajectory: The robot at every control tick.
         events: What happened, in order.
         files: The files written, by role in the order written: "log" (.mcap), "summary"
-            (.json), "render" (.png), "video" (.mp4); empty when nothing was written.
+            (.json), "render" (.png), "video" (.mp4), "ros2" (the .ros2 bag directory); empty
+            when nothing was written.
     """
 
     scenario: Scenario
@@ -135,6 +136,7 @@ def run(
     log: bool = True,
     render: bool = True,
     video: bool = False,
+    ros2: bool = False,
 ) -> RunRecord:
     """Run a scenario (a Scenario, or a file or a built-in scenario's name) headless.
 
@@ -151,6 +153,7 @@ def run(
         log: Write the `.mcap` log.
         render: Write the `.png` top view of the run.
         video: Write an `.mp4` replay, made from the log (needs `log`).
+        ros2: Write the `.ros2` directory, a ROS 2 bag made from the log (needs `log`).
 
     Returns:
         The scenario run, its summary, trajectory and events, and the files written by role.
@@ -163,8 +166,9 @@ def run(
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(os.fspath(scenario))
-    if video and not log:
-        raise VPlaneError("video: the video is made from the log: keep log=True")
+    for option, wanted, made in (("video", video, "the video"), ("ros2", ros2, "the bag")):
+        if wanted and not log:
+            raise VPlaneError(f"{option}: {made} is made from the log: keep log=True")
     recorder = EventRecorder()
     if out is None:
         return _record(scenario, run_scenario(scenario, (recorder,)), recorder, {})
@@ -174,7 +178,7 @@ def run(
     with exclusive(base.with_name(f".{base.name}.lock"), what, "wait for it to end or choose another --out"):
         result = _simulate(scenario, base, log, recorder, files)
         try:
-            _write_outputs(scenario, result, base, render, video, files)
+            _write_outputs(scenario, result, base, render, video, ros2, files)
         except Interrupted as exc:
             exc.written = dict(files)
             raise
@@ -182,9 +186,16 @@ def run(
 
 
 def _write_outputs(
-    scenario: Scenario, result: RunResult, base: Path, render: bool, video: bool, files: dict[str, Path]
+    scenario: Scenario,
+    result: RunResult,
+    base: Path,
+    render: bool,
+    video: bool,
+    ros2: bool,
+    files: dict[str, Path],
 ) -> None:
-    """The files made after the run: its summary, with `render` the render, with `video` the video."""
+    """The files made after the run: its summary, with `render` the render, with `video` the
+    video, with `ros2` the ROS 2 bag."""
     files["summary"] = write_json(base.with_suffix(".json"), result.summary.to_dict())
     if render:
         from vplane_mj.viz.render import render_top_view, run_caption, write_png
@@ -195,6 +206,10 @@ def _write_outputs(
         from vplane_mj.viz.video import write_video
 
         files["video"] = write_video(files["log"], base.with_suffix(".mp4"))
+    if ros2:
+        from vplane_mj.logs.ros2 import export_ros2
+
+        files["ros2"] = export_ros2(files["log"], base.with_suffix(".ros2"))
 
 
 def _simulate(
