@@ -286,3 +286,20 @@ def test_peer_irsim_without_irsim_says_what_to_install(tmp_path):
     )
     assert done.returncode == 2 and "Traceback" not in done.stderr
     assert "pip install 'vplane-mj[peers]'" in done.stderr and "(irsim)" in done.stderr
+
+
+def test_ros2_export_reports_its_time_and_the_bag_s_size_per_minute(tmp_path):
+    out = run_benchmark("ros2_export.py", *("--seconds", "2", "--repeat", "1", "--out", "bags"), cwd=tmp_path)
+    (jackal,) = table_rows(out, "jackal, laser 720 beams, 50 Hz")
+    (default,) = table_rows(out, "default, 16 sonars, 20 Hz")
+    assert number(jackal[2]) == 101 and number(default[2]) == 41  # ticks: 2 s at 50 and 20 Hz
+    assert number(jackal[5]) > number(default[5]) > 0  # MB per minute: 720 beams at 50 Hz weigh more
+    assert number(jackal[6]) > 0 and number(default[6]) > 0  # the export's seconds
+    assert (tmp_path / "bags" / "ros2_export.csv").is_file()
+    refused = subprocess.run(
+        [sys.executable, str(BENCHMARKS / "ros2_export.py"), "--repeat", "0"],
+        env=SCRIPT_ENVIRONMENT,
+        capture_output=True,
+        text=True,
+    )
+    assert refused.returncode == 2 and "--repeat at least 1" in refused.stderr
