@@ -299,3 +299,18 @@ def test_the_api_writes_the_bag_last_and_names_it(tmp_path):
     with pytest.raises(VPlaneError, match="ros2: the bag is made from the log"):
         run("single_box", tmp_path / "none", log=False, ros2=True)
     assert not (tmp_path / "none").exists()
+
+
+def test_bench_writes_each_run_s_log_and_bag_beside_it(tmp_path, capsys):
+    argv = ["bench", "single_box", "--planners", "apf", "--seeds", "0-1", "--jobs", "1"]
+    argv += ["--out", str(tmp_path)]
+    assert main([*argv, "--ros2"]) == 0
+    for seed in (0, 1):
+        log, bag = tmp_path / f"single_box-apf-{seed}.mcap", tmp_path / f"single_box-apf-{seed}.ros2"
+        clocks = read_bag(bag)["/clock"]
+        assert len(clocks) == log_counts(log)["/robot/pose"]
+    assert not list(tmp_path.glob(".*.partial"))
+    capsys.readouterr()
+    assert main([*argv, "--ros2", "--scheduler", "tcp://127.0.0.1:9"]) == 2
+    refused = "error: --ros2: the bags are written by local workers: drop --scheduler\n"
+    assert capsys.readouterr().err == refused

@@ -182,6 +182,11 @@ def _add_bench(commands) -> None:
         action="store_true",
         help="exit 1 when any run collided (default: 0 once every run finished)",
     )
+    sweep.add_argument(
+        "--ros2",
+        action="store_true",
+        help="each run also writes its log and a ROS 2 bag of it into the output directory",
+    )
     sweep.set_defaults(handler=_bench, draws=False)
 
 
@@ -347,6 +352,8 @@ def _bench(args: argparse.Namespace) -> int:
 
     if args.jobs < 1:
         raise VPlaneError(f"--jobs: must be at least 1, got {args.jobs}")
+    if args.ros2 and args.scheduler:
+        raise VPlaneError("--ros2: the bags are written by local workers: drop --scheduler")
     references = sorted(PLANNERS) if args.planners is None else [p.strip() for p in args.planners.split(",")]
     planners = [_planner_name(reference, "--planners") for reference in references]
     seeds = parse_seeds(args.seeds)
@@ -363,6 +370,7 @@ def _bench(args: argparse.Namespace) -> int:
                 args.scheduler,
                 out_dir,
                 wait=args.wait,
+                ros2=args.ros2,
             )
     except Interrupted as exc:
         end_of_progress_bar = "\n" if sys.stderr.isatty() else ""

@@ -5,6 +5,7 @@ cluster, the table and the report); the command line's `bench` is this call with
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import sys
 import tempfile
@@ -84,6 +85,7 @@ def sweep(
     *,
     report: bool = True,
     wait: bool = False,
+    ros2: bool = False,
 ) -> SweepResult:
     """Run every scenario with every planner and seed, as `vplane-mj bench` does.
 
@@ -106,6 +108,8 @@ def sweep(
             bench-scenarios.png, bench.html).
         wait: While another sweep holds `out`, wait for it to end and then run only the jobs
             it left, instead of raising OutputBusy.
+        ros2: Each run the sweep runs also writes its log and its ROS 2 bag into `out`
+            (`<name>-<planner>-<seed>.mcap` and `.ros2`); with local workers only.
 
     Returns:
         One row per run (scenario, planner, seed order), the table per planner and the
@@ -121,9 +125,13 @@ def sweep(
         raise VPlaneError(f"jobs: must be at least 1, got {workers}")
     chosen = sorted(registry.PLANNERS) if planners is None else [planner_name(p) for p in planners]
     seed_list = parse_seeds(seeds) if isinstance(seeds, str) else list(seeds)
+    if ros2 and (scheduler or out is None):
+        raise VPlaneError("ros2: local workers write the bags into `out`: give `out`, no `scheduler`")
 
     def sweep_into(out_dir: Path, report: bool) -> SweepResult:
         planned = _plan(scenarios, chosen, seed_list, overrides)
+        if ros2:
+            planned = [dataclasses.replace(job, files=str(out_dir)) for job in planned]
         rows = run_sweep(planned, out_dir, workers, scheduler)
         table = summarize(rows)
         files: tuple[Path, ...] = ()

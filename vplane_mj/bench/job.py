@@ -15,8 +15,9 @@ class Job:
     `registered_planner` is the job's planner when it was registered in the calling process,
     as the worker registers it before it reads the scenario (`registry.for_worker`: an import
     spec such as `module:Class` or `/abs/path/file.py:Class`, or a class of the calling
-    script); None for a built-in or installed one. It is not part of the key: a run is the
-    same run whichever way its planner was found.
+    script); None for a built-in or installed one. `files` is the folder into which the run
+    writes its log and its ROS 2 bag (`bench --ros2`), None for none. Neither is part of the
+    key: a run is the same run whichever way its planner was found and whatever it writes.
     """
 
     scenario: str
@@ -24,6 +25,7 @@ class Job:
     seed: int
     toml: str
     registered_planner: WorkerPlanner | None = None
+    files: str | None = None
 
     @property
     def key(self) -> str:

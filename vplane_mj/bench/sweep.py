@@ -109,7 +109,8 @@ PATH_TOLERANCE_M = 0.02
 
 def run_job(job: Job) -> dict:
     """Run one job (in a worker process): its summary, the job's key and, under PATH_KEY,
-    the travelled path simplified to PATH_TOLERANCE_M (for the report's picture of it)."""
+    the travelled path simplified to PATH_TOLERANCE_M (for the report's picture of it); with
+    `job.files`, the run's log and ROS 2 bag written into that folder."""
     from vplane_mj.geometry.polyline import PathSimplifier
     from vplane_mj.planning.protocol.registry import register_in_worker
     from vplane_mj.scenario import parse_scenario
@@ -117,7 +118,13 @@ def run_job(job: Job) -> dict:
 
     if job.registered_planner is not None:
         register_in_worker(job.registered_planner)
-    result = run_scenario(parse_scenario(job.toml, f"{job.scenario} (bench)"))
+    scenario = parse_scenario(job.toml, f"{job.scenario} (bench)")
+    if job.files is None:
+        result = run_scenario(scenario)
+    else:
+        from vplane_mj.bench.run_files import run_with_bag
+
+        result = run_with_bag(scenario, Path(job.files))
     path = PathSimplifier(PATH_TOLERANCE_M)
     for x, y in (*result.positions, result.final_pose[:2]):
         path.add(x, y)
