@@ -314,3 +314,16 @@ def test_bench_writes_each_run_s_log_and_bag_beside_it(tmp_path, capsys):
     assert main([*argv, "--ros2", "--scheduler", "tcp://127.0.0.1:9"]) == 2
     refused = "error: --ros2: the bags are written by local workers: drop --scheduler\n"
     assert capsys.readouterr().err == refused
+
+
+def test_moving_obstacles_are_drawn_where_the_log_has_them(tmp_path):
+    assert main(["generate", "dynabarn", "--count", "1", "--seed", "0", "--out", str(tmp_path)]) == 0
+    (world,) = tmp_path.glob("*.toml")
+    log, bag = run_with_bag(tmp_path, f"{world.stem}-vplane-0", str(world), "--set", "run.time_limit_s=2")
+    logged = read_log(log)
+    moving = read_bag(bag)["/markers/moving"]
+    assert [ns for ns, _ in moving] == list(logged.obstacle_times_ns)
+    for (_, array), places in zip(moving, logged.obstacle_places, strict=True):
+        centres = [(m.pose.position.x, m.pose.position.y) for m in array.markers if m.action == 0]
+        assert np.allclose(centres, places, rtol=0.0, atol=1e-12)
+        assert {m.header.frame_id for m in array.markers} == {"map"}
