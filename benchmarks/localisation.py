@@ -57,7 +57,8 @@ def run_one(job: tuple[str, str, str, int, float]) -> dict:
         pass
     summary = run.summary()
     belief = run.localiser.odometry
-    heading = 0.0 if belief is None else math.degrees(abs(math.remainder(belief.yaw - run.yaw, math.tau)))
+    true_yaw = run.drive.yaw()
+    heading = 0.0 if belief is None else math.degrees(abs(math.remainder(belief.yaw - true_yaw, math.tau)))
     return {
         "pose": pose,
         "success": bool(summary.success),

@@ -85,3 +85,18 @@ def test_the_jackal_on_its_ekf_reaches_the_goal_believing_where_it_is():
 def test_the_true_pose_has_no_belief_to_err():
     summary = run_summary("truth")
     assert summary.odometry_error_m is None and summary.odometry_error_max_m is None
+
+
+@pytest.mark.parametrize("pose", ["ekf", "odometry"])
+def test_the_summary_measures_the_belief_of_the_final_instant(pose):
+    """The run ends a tick after the pose was last sensed; the summary folds that tick's wheel
+    travel in before it compares the belief with the true pose, so nothing is left to fold."""
+    run = Run(parse_document(jackal_world(pose), f"{pose}.toml"))
+    while run.step() is None:
+        pass
+    summary = run.summary()
+    odometry = run.localiser.odometry
+    measured = (odometry.x, odometry.y)
+    run.localiser.pose(run.position, run.yaw)
+    assert (odometry.x, odometry.y) == measured
+    assert summary.odometry_error_m == pytest.approx(math.dist(measured, run.position), abs=1e-12)

@@ -484,8 +484,11 @@ class Run:
         return ending
 
     def _finish(self, ending: Ending) -> None:
-        """Note how the run ended and show the observers the state it ended in."""
+        """Note how the run ended, bring the believed pose to the final instant (the summary's
+        odometry errors compare it with the true pose there, not with the one a tick before)
+        and show the observers the state it ended in."""
         self.ending = ending
+        self.localiser.pose(self.position, self.yaw)
         self._note(ending.event)
         self.clearance.flush()
         if self.observers and (not self.times or self.data.time > self.times[-1]):
