@@ -158,8 +158,9 @@ def test_compare_planners_sweeps_the_custom_planner_with_built_in_ones(tmp_path)
         if (fields := line.split()) and fields[0] in ("random_walk", "apf", "vplane")
     }
     assert set(table) == {"random_walk", "apf", "vplane"}
-    assert all(fields[1] == "1" for fields in table.values())  # runs
-    assert float(table["vplane"][2]) == 1.0 and float(table["apf"][2]) == 0.0  # success_rate
+    assert table["random_walk"][1] == "run" and table["apf"][1] == table["vplane"][1] == "own"  # governor
+    assert all(fields[2] == "1" for fields in table.values())  # runs
+    assert float(table["vplane"][3]) == 1.0 and float(table["apf"][3]) == 0.0  # success_rate
     assert re.search(r"^paper_c_escape +[01]/1 +0/1 +1/1$", stdout, re.M)
     paths = written(stdout)
     report_files = {"bench.csv", "bench.json", "bench.png", "bench-scenarios.png", "bench.html"}

@@ -515,11 +515,11 @@ def test_the_documented_planner_snippets_run_as_a_script(tmp_path, doc_examples)
     lines = done.stdout.splitlines()
     assert lines[0] == "reached 0.6"
     header, *table = lines[1:]
-    assert header.split()[:3] == ["planner", "runs", "success_rate"]
+    assert header.split()[:4] == ["planner", "governor", "runs", "success_rate"]
     rows = [row.split() for row in table if row.split() and row.split()[0].isidentifier()]  # no rules
-    assert [(row[0], row[1]) for row in rows] == [
-        ("apf", "4"),
-        ("cautious", "4"),
-        ("random_walk", "4"),
+    assert [(row[0], row[1], row[2]) for row in rows] == [
+        ("apf", "own", "4"),
+        ("cautious", "run", "4"),
+        ("random_walk", "run", "4"),
     ]
     assert "SweepErrorWarning" not in done.stderr
