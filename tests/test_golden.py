@@ -6,8 +6,9 @@ what a run made of its world: its outcome, collisions, local minima and escapes,
 its path length to a relative `PATH_RTOL`. The trajectory itself, by its digest, bit for bit,
 is compared where the environment matches the one the file was recorded in (`environment`):
 the MuJoCo, numpy and numba builds, the architecture, whether numpy computes sines, arctangents
-and the like by its AVX-512 routines (which may differ in the last bit) and the CPU model the
-kernels are compiled for (`generic` unless NUMBA_CPU_NAME chooses one). No product in a run
+and the like by its AVX-512 routines (which may differ in the last bit), the CPU model the
+kernels are compiled for (`generic` unless NUMBA_CPU_NAME chooses one) and the C library whose
+mathematical functions they call. No product in a run
 goes through BLAS, so the kernels OpenBLAS picks for a CPU are not among them (docs/
 contributing.md says what was measured). Elsewhere a skipped test says that the digests were
 left out and why.
@@ -70,7 +71,25 @@ def environment() -> dict[str, str]:
         "machine": platform.machine(),
         "numpy_avx512": "yes" if "X86_V4" in numpy_dispatch_targets() else "no",
         "kernels_cpu": compiled_for_cpu(),
+        "libm": libm(),
     }
+
+
+def libm() -> str:
+    """The C library whose `sin`, `atan2`, `exp` and the like the kernels call, and whether the
+    CPU has fused multiply-adds (glibc picks other builds of them then, e.g. glibc 2.36, fma)."""
+    name, version = platform.libc_ver()
+    fma = _cpu_features().get("FMA3", False)
+    return f"{name or 'unknown'} {version}, {'fma' if fma else 'no fma'}"
+
+
+def _cpu_features() -> dict[str, bool]:
+    """What numpy found the CPU to have (empty where it cannot say)."""
+    try:
+        from numpy._core._multiarray_umath import __cpu_features__
+    except ImportError:
+        return {}
+    return dict(__cpu_features__)
 
 
 def numpy_dispatch_targets() -> list[str]:
