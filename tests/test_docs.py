@@ -567,6 +567,42 @@ def test_a_documented_parameter_group_gives_each_parameter_s_unit(path):
             assert f"({spec.unit})" in entries[name], f"{path}.{name}: ({spec.unit}) in its entry"
 
 
+def parameters_to_document(found: object) -> list[str]:
+    """The parameters a documented function, or a class that is not a dataclass (its
+    constructor), takes: those its Args section must name."""
+    target = found.__init__ if isinstance(found, type) else found  # type: ignore[misc]
+    if isinstance(found, type) and (dataclasses.is_dataclass(found) or target is object.__init__):
+        return []
+    try:
+        signature = inspect.signature(target)
+    except (TypeError, ValueError):
+        return []
+    skipped = (inspect.Parameter.VAR_POSITIONAL, inspect.Parameter.VAR_KEYWORD)
+    return [
+        name
+        for name, p in signature.parameters.items()
+        if name not in ("self", "cls") and p.kind not in skipped
+    ]
+
+
+CALLABLES = sorted(
+    path
+    for path, found in DOCUMENTED.items()
+    if callable(found) and not isinstance(found, enum.EnumMeta) and parameters_to_document(found)
+)
+"""The functions and classes the reference pages document that take parameters."""
+
+
+@pytest.mark.parametrize("path", CALLABLES)
+def test_a_documented_callable_names_every_parameter_in_its_args(path):
+    found = DOCUMENTED[path]
+    documented = docstring_section(found.__doc__ or "", "Args")
+    if isinstance(found, type) and not documented:
+        documented = docstring_section(found.__init__.__doc__ or "", "Args")
+    missing = [name for name in parameters_to_document(found) if name not in documented]
+    assert missing == [], f"{path}: parameters without an Args entry"
+
+
 @pytest.mark.parametrize("path", ENUMS)
 def test_every_member_of_a_documented_enum_has_its_docstring(path):
     members = member_docstrings(DOCUMENTED[path])

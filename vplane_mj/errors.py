@@ -23,7 +23,15 @@ class VPlaneError(Exception):
 
 class ScenarioError(VPlaneError):
     """Invalid scenario input: names the file, the key path and the reason; or, when an
-    override (`--set KEY=VALUE`, `--seed N`) set the key, that override (`origin`) first."""
+    override (`--set KEY=VALUE`, `--seed N`, the Python API's `overrides`) set the key, that
+    override (`origin`) first.
+
+    Args:
+        source: The file (or `<code>`) the scenario came from.
+        key: The key path (`world.obstacles[2].radius`), empty for the document itself.
+        reason: Why it is refused.
+        origin: The override that set the key, as its errors name it; empty for the file.
+    """
 
     def __init__(self, source: str, key: str, reason: str, origin: str = ""):
         self.source = source

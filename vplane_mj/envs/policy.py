@@ -33,12 +33,15 @@ if TYPE_CHECKING:
 
 
 class PlannerPolicy:
-    """Drives `environment` (a VPlaneNavDmEnv, or a wrapper of one) with a planner.
+    """Drives `environment` with a planner; every episode gets a fresh planner for its robot
+    (profile, footprint, limits, sensor kind).
 
-    `planner` is a registered planner's name or a Planner class; None: each episode's
-    scenario's own planner with the scenario's parameters. `params` are the planner's
-    parameters (default: its defaults; with `planner=None`, the scenario's). Every episode gets a
-    fresh planner for its robot (profile, footprint, limits, sensor kind).
+    Args:
+        environment: A VPlaneNavDmEnv, or a wrapper of one.
+        planner: A registered planner's name or a Planner class; None: each episode's
+            scenario's own planner.
+        params: The planner's parameters (default: its defaults; with `planner=None`, the
+            scenario's).
     """
 
     def __init__(

@@ -35,7 +35,14 @@ _FREE = MinimumState(False, False, 0.0)
 
 
 class LocalMinimumDetector:
-    """Feeds on (time, position) samples at the control rate; see the module docstring."""
+    """Feeds on (time, position) samples at the control rate; see the module docstring.
+
+    Args:
+        window_s: t, the window of the criteria (s).
+        displacement_m: d_th, the least travel over the window (m).
+        speed_mps: v_th, the speed below which the robot counts as halted (m/s).
+        startup_s: No detection during this time after the start (s).
+    """
 
     def __init__(self, window_s: float, displacement_m: float, speed_mps: float, startup_s: float):
         self.window_s = window_s
@@ -103,8 +110,15 @@ class LocalMinimumDetector:
 def report_trap(
     detector: LocalMinimumDetector, obs: Observation, decision: Decision, patience_s: float
 ) -> None:
-    """Feed the detector; mark a new local minimum, the trapped mode, and giving up after
-    `patience_s` trapped (for planners that have no escape)."""
+    """Feed the detector and mark the decision: a new local minimum (with its event), the
+    trapped mode, and giving up once trapped for `patience_s` (for planners without an escape).
+
+    Args:
+        detector: The planner's local-minimum detector.
+        obs: This tick's observation (its time, pose and goal).
+        decision: This tick's decision, changed in place.
+        patience_s: How long (s) a trapped planner waits before it gives up.
+    """
     near_goal = obs.distance_to_goal() <= obs.goal_tolerance
     state = detector.update(obs.time_s, obs.position, near_goal)
     if state.new:

@@ -97,5 +97,12 @@ class Event:
 
 
 def point(xy) -> tuple[float, float]:
-    """A point for an event's data: (x, y) as plain floats, rounded to the millimetre."""
+    """A point for an event's data.
+
+    Args:
+        xy: A plane point (m), any pair of numbers.
+
+    Returns:
+        (x, y) as plain floats, rounded to the millimetre.
+    """
     return (round(float(xy[0]), 3), round(float(xy[1]), 3))

@@ -111,7 +111,12 @@ def with_default(params: type[PlannerParams], name: str, default: float) -> Any:
 
 
 class ParamError(VPlaneError):
-    """A planner parameter that is unknown or has a bad value: `key` and `reason`."""
+    """A planner parameter that is unknown or has a bad value.
+
+    Args:
+        key: The parameter's name (the message says `planner.KEY`).
+        reason: Why it is refused.
+    """
 
     def __init__(self, key: str, reason: str):
         self.key = key

@@ -11,7 +11,14 @@ Angle = TypeVar("Angle", float, np.ndarray)
 
 
 def wrap_angle(angle: Angle) -> Angle:
-    """The same angle (rad) in [-pi, pi): a float for a float, element-wise for an array."""
+    """The same angle in [-pi, pi).
+
+    Args:
+        angle: An angle (rad), a float or an array.
+
+    Returns:
+        The angle wrapped (rad): a float for a float, element-wise for an array.
+    """
     return (angle + math.pi) % (2 * math.pi) - math.pi
 
 
@@ -32,7 +39,14 @@ def evenly_spaced(start: float, stop: float, count: int) -> np.ndarray:
 
 
 def unit(v: np.ndarray) -> np.ndarray:
-    """v / |v| for a plane vector, or zeros for a (near) zero vector."""
+    """The unit vector along a plane vector.
+
+    Args:
+        v: A plane vector (2,).
+
+    Returns:
+        v / |v|, or zeros for a vector shorter than 1e-12.
+    """
     norm = float(np.hypot(v[0], v[1]))
     return v / norm if norm > 1e-12 else np.zeros(2)
 
