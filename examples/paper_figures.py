@@ -3,8 +3,9 @@
 Runs the built-in scenarios paper_c_avoid, paper_c_escape, paper_h_avoid and paper_h_escape
 with `vplane` (and `apf` for contrast), headless, prints each run's summary line, writes each
 run's `.json` summary and one figure: a row per scenario, a column per planner, the world and
-the path travelled, coloured by planner mode, with the virtual objectives (blue stars), the
-virtual planes (purple lines), the local minima (black crosses) and any collision.
+the path travelled, coloured by planner mode, with the virtual objectives (sky-blue dots), the
+virtual planes (dashed black lines), the local minima (black crosses) and any collision, in the
+render's colours (`vplane_mj.viz.palette`).
 
     python examples/paper_figures.py                      # logs/paper_figures/paper_figures.png
     python examples/paper_figures.py --planners vplane,vplane_plus,apf --seed 3 --noise 0.01
@@ -25,6 +26,7 @@ import numpy as np
 
 import vplane_mj
 from vplane_mj import EventKind, RunRecord
+from vplane_mj.viz import palette
 from vplane_mj.viz.plots import draw_path, draw_world, label_modes
 
 PAPER_SCENARIOS = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")
@@ -71,13 +73,22 @@ def draw_events(axes, record: RunRecord) -> None:
         return label
 
     times, positions = record.trajectory.times, record.trajectory.positions
+    objective, plane = palette.OBJECTIVE, palette.PLANE
     for event in record.events:
         data = event.data
         if event.kind is EventKind.ESCAPE_STARTED and "objective" in data:
-            axes.plot(*data["objective"], "*", color="#1a5ae6", ms=15, label=once("virtual objective"))
+            axes.plot(
+                *data["objective"],
+                "o",
+                mfc=objective.rgba,
+                mec=objective.rim,
+                mew=1.5,
+                ms=9,
+                label=once(objective.label),
+            )
         if event.kind in PLANE_EVENTS and {"e1", "e2"} <= data.keys():
             (x1, y1), (x2, y2) = data["e1"], data["e2"]
-            axes.plot([x1, x2], [y1, y2], color="#8e24aa", lw=4, label=once("virtual plane"))
+            axes.plot([x1, x2], [y1, y2], color=plane.rgba, lw=3, ls="--", label=once(plane.label))
         if event.kind is EventKind.LOCAL_MINIMUM:  # no point of its own: where the robot was
             where = positions[min(np.searchsorted(times, event.time_s), len(positions) - 1)]
             axes.plot(*where, "X", color="black", ms=10, label=once("local minimum"))

@@ -366,8 +366,8 @@ def test_the_drawing_helpers_draw_the_world_and_a_path_by_mode():
     from matplotlib.collections import LineCollection
     from matplotlib.colors import to_rgba
 
+    from vplane_mj.viz.palette import MODE_RGBA, OTHER_MODE_RGBA
     from vplane_mj.viz.plots import draw_path, draw_world, label_modes
-    from vplane_mj.viz.render import MODE_RGBA, OTHER_MODE_RGBA
 
     scenario = load_scenario("paper_c_escape")
     figure, axes = plt.subplots()

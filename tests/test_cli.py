@@ -16,6 +16,7 @@ import vplane_mj
 from vplane_mj.cli import main
 from vplane_mj.geometry.cache import CACHE_ENV
 from vplane_mj.logs.reader import read_log
+from vplane_mj.viz import palette
 
 BAD_SCENARIO = """
 format = 1
@@ -59,11 +60,11 @@ def test_run_writes_summary_and_render_and_exits_0_on_reach(tmp_path, capsys):
 def test_render_shows_the_path_in_its_colour(tmp_path, capsys):
     run_cli(capsys, "run", "open_field", "--planner", "apf", "--out", str(tmp_path))
     image = matplotlib.image.imread(tmp_path / "open_field-apf-0.png")[..., :3]
-    red = (image[..., 0] > 0.7) & (image[..., 1] < 0.3) & (image[..., 2] < 0.3)
-    # The diagonal path from (1, 1) to (5, 5) in a 6 x 6 arena: red pixels on the diagonal.
-    rows, cols = np.nonzero(red)
+    normal = (np.abs(image - palette.MODE_RGBA["normal"][:3]) < 0.02).all(axis=-1)
+    # The diagonal path from (1, 1) to (5, 5) in a 6 x 6 arena: pixels of `normal` on the diagonal.
+    rows, cols = np.nonzero(normal)
     assert len(rows) > 200
-    h, w = red.shape
+    h, w = normal.shape
     assert np.corrcoef(cols / w, 1 - rows / h)[0, 1] > 0.95
 
 

@@ -19,6 +19,7 @@ from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim.loop import Tick, run_scenario
 from vplane_mj.sim.sensors import scan_bearings
 from vplane_mj.sim.world import OBSTACLE_HEIGHT_M, top_view_extent
+from vplane_mj.viz import palette
 from vplane_mj.viz.render import render_top_view
 from vplane_mj.viz.video import FrameCanvas
 
@@ -248,11 +249,11 @@ def test_the_render_draws_traces_where_the_obstacles_went_and_leaves_the_rest_al
     for xy in cylinder[away]:
         row, column = to_pixel(scenario, image, xy)
         red, green, blue = image[row, column]
-        assert differs[row, column] and green > red and blue > red, xy  # teal, faded or not
+        assert differs[row, column] and red == green == blue, xy  # the obstacles' grey, faded or not
 
 
-OBSTACLE_GREY = np.array([0x5A, 0x5F, 0x6E])
-"""The video's obstacles' colour."""
+OBSTACLE_GREY = np.round(np.array(palette.MOVING_OBSTACLE.rgba[:3]) * 255)
+"""The video's moving obstacles' colour."""
 
 
 def test_the_video_moves_the_obstacles(run):

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from vplane_mj.cli import main
+from vplane_mj.viz import palette
 
 
 def run_logged(tmp_path, capsys, *argv):
@@ -65,10 +66,11 @@ def test_render_from_the_log_matches_the_run_render(tmp_path, capsys):
 def test_render_colours_the_path_by_planner_mode(tmp_path, capsys):
     run_logged(tmp_path, capsys, "paper_c_escape")
     image = matplotlib.image.imread(tmp_path / "paper_c_escape-vplane-0.png")[..., :3]
-    red = (image[..., 0] > 0.7) & (image[..., 1] < 0.25) & (image[..., 2] < 0.25)  # normal
-    blue = (image[..., 2] > 0.75) & (image[..., 0] < 0.25) & (image[..., 1] < 0.5)  # escaping
-    orange = (image[..., 0] > 0.85) & (image[..., 1] > 0.35) & (image[..., 1] < 0.6) & (image[..., 2] < 0.2)
-    assert red.sum() > 200 and blue.sum() > 50 and orange.sum() > 100
+    pixels = {
+        mode: (np.abs(image - palette.MODE_RGBA[mode][:3]) < 0.02).all(axis=-1).sum()
+        for mode in ("normal", "escaping", "avoiding")
+    }
+    assert pixels["normal"] > 200 and pixels["escaping"] > 50 and pixels["avoiding"] > 100, pixels
 
 
 @pytest.mark.parametrize("content", [None, b"not an mcap file"])

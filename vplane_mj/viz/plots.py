@@ -28,13 +28,13 @@ from vplane_mj.planning.planners.groups import FieldParams
 from vplane_mj.planning.protocol.events import EventKind
 from vplane_mj.scenario import Scenario
 from vplane_mj.sim.loop import Track
-from vplane_mj.viz.render import MODE_RGBA, OTHER_MODE_RGBA
+from vplane_mj.viz import palette
+from vplane_mj.viz.palette import MODE_RGBA, OTHER_MODE_RGBA
 
 FIELD_HALF_WIDTH_M = 2.0
 """Half the side of the square around the local minimum where the field is drawn."""
 BOUNDARY_STEP_M = 0.05
 """Spacing of the obstacle boundary points that stand in for sonar echoes in the field."""
-OBSTACLE_COLOUR = "#2a3f7f"
 PATH_ZORDER = 1.9
 """A path lies above the obstacles and the goal (zorder 1), below the markers (2), whatever the
 order they are drawn in."""
@@ -57,9 +57,10 @@ def plot_log(path: Path, contents: LogContents, scenario: Scenario, track: Track
 
 
 def draw_world(axes, scenario: Scenario, margin_m: float = 0.2) -> None:
-    """Draw a scenario's world on matplotlib axes, in metres: the obstacles and border walls
-    (dark blue), the start (green dot, label "start") and the goal (gold disc of the goal
-    tolerance, label "goal"); equal aspect, the arena and the margin around it in view.
+    """Draw a scenario's world on matplotlib axes, in metres, in the render's colours: the
+    obstacles and border walls (dark grey), the start (white dot in a black rim, label "start")
+    and the goal (yellow disc of the goal tolerance, label "goal"); equal aspect, the arena and
+    the margin around it in view.
 
     Args:
         axes (matplotlib.axes.Axes): The axes to draw on.
@@ -67,8 +68,12 @@ def draw_world(axes, scenario: Scenario, margin_m: float = 0.2) -> None:
         margin_m: Room shown around the arena (m).
     """
     _draw_obstacles(axes, scenario)
-    axes.plot(*scenario.robot.start, "o", color="green", ms=9, label="start")
-    axes.add_patch(Circle(scenario.robot.goal, scenario.robot.goal_tolerance, color="gold", label="goal"))
+    start = palette.START
+    axes.plot(
+        *scenario.robot.start, "o", mfc=start.rgba, mec=start.rim, mew=1.5, ms=9, label="start", zorder=2.5
+    )
+    goal = Circle(scenario.robot.goal, scenario.robot.goal_tolerance, color=palette.GOAL.rgba, label="goal")
+    axes.add_patch(goal)
     w, h = scenario.world.size
     axes.set(
         xlim=(-margin_m, w + margin_m),
@@ -81,8 +86,8 @@ def draw_world(axes, scenario: Scenario, margin_m: float = 0.2) -> None:
 
 def draw_path(axes, positions: np.ndarray, modes: Sequence[str], linewidth: float = 2.0) -> None:
     """Draw a path, each segment in the colour of the planner mode at its start, as the render
-    colours them: red `normal`, orange `avoiding`, blue `escaping`, purple `trapped`, green
-    `following`, grey any other mode; above the world, below markers.
+    colours them: vermillion `normal`, orange `avoiding`, blue `escaping`, reddish purple
+    `trapped`, bluish green `following`, grey any other mode; above the world, below markers.
 
     Args:
         axes (matplotlib.axes.Axes): The axes to draw on.
@@ -116,9 +121,9 @@ def _draw_obstacles(axes, scenario: Scenario) -> None:
         pieces += list(shapes.border_footprint(scenario.world.size))
     for piece in pieces:
         if isinstance(piece, shapes.Disc):
-            axes.add_patch(Circle(piece.center, piece.radius, color=OBSTACLE_COLOUR))
+            axes.add_patch(Circle(piece.center, piece.radius, color=palette.OBSTACLE.rgba))
             continue
-        axes.add_patch(Polygon(piece.corners(), color=OBSTACLE_COLOUR))
+        axes.add_patch(Polygon(piece.corners(), color=palette.OBSTACLE.rgba))
 
 
 def _draw_map(axes, contents: LogContents, scenario: Scenario, track: Track) -> None:
@@ -130,10 +135,21 @@ def _draw_map(axes, contents: LogContents, scenario: Scenario, track: Track) -> 
     for k, t in enumerate(minima):
         where = points[min(int(np.searchsorted(times, t)), len(points) - 1)]
         axes.plot(*where, "X", color="black", ms=10, label="local minimum" if k == 0 else None)
-    for k, objective in enumerate(track.objectives):
-        axes.plot(*objective, "*", color="#1a5ae6", ms=14, label="virtual objective" if k == 0 else None)
+    objective, plane = palette.OBJECTIVE, palette.PLANE
+    for k, point in enumerate(track.objectives):
+        axes.plot(
+            *point,
+            "o",
+            mfc=objective.rgba,
+            mec=objective.rim,
+            mew=1.5,
+            ms=8,
+            label=objective.label if k == 0 else None,
+        )
     for k, (e1, e2) in enumerate(track.planes):
-        axes.plot(*zip(e1, e2, strict=True), color="#8e24aa", lw=3, label="virtual plane" if k == 0 else None)
+        axes.plot(
+            *zip(e1, e2, strict=True), color=plane.rgba, lw=3, ls="--", label=plane.label if k == 0 else None
+        )
     for k, point in enumerate(track.collision_points):
         axes.plot(*point, "k+", ms=12, mew=2, label="collision" if k == 0 else None)
     label_modes(axes, track.modes)

@@ -2,10 +2,10 @@
 
 Each frame shows the arena and its obstacles around the start, the goal and the path
 (the whole arena when that is most of it), start and goal, the path so far coloured by
-planner mode (as in the render), the virtual planes and objective, the moving obstacles where
-they stand with their trails of the last `TRAIL_S` (fading with age), the sonar echoes, the
-force arrows as logged (attractive green, repulsive red, virtual purple, total blue),
-the robot's disc and heading, the latest events as a caption and the simulated time.
+planner mode, the virtual planes and objective, the moving obstacles where they stand with
+their trails of the last `TRAIL_S` (fading with age), the sensor's echoes, the force arrows as
+logged, the robot's disc and heading, the latest events as a caption and the simulated time;
+in the colours of the render (`vplane_mj.viz.palette`).
 Frame k shows the last control tick at or before k * speed / fps simulated seconds; the
 last frame is held for `END_HOLD_S` so the end can be seen. Matplotlib (Agg) draws
 the frames, blitting everything that moves over a cached background; imageio-ffmpeg's
@@ -29,6 +29,7 @@ import numpy as np
 from matplotlib.artist import Artist
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
+from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Patch, Polygon
 from matplotlib.transforms import Bbox
 
@@ -41,7 +42,9 @@ from vplane_mj.logs.timeline import FORCE_NAMES, Timeline, timeline_from_log
 from vplane_mj.logs.writer import METADATA_NAME
 from vplane_mj.scenario import Scenario
 from vplane_mj.terminal import Progress
-from vplane_mj.viz.render import MODE_RGBA, OTHER_MODE_RGBA, TRACE_JUMP_M, TRACE_RGBA
+from vplane_mj.viz import palette
+from vplane_mj.viz.moving_marks import TRACE_JUMP_M
+from vplane_mj.viz.palette import MODE_RGBA, OTHER_MODE_RGBA, TRACE_RGBA, Mark
 
 
 @dataclass(frozen=True)
@@ -89,15 +92,6 @@ WALL_MARGIN_M = 0.3
 """Shown beyond the arena's sides (where the border walls stand)."""
 TRAIL_S = 2.0
 """Simulated seconds of a moving obstacle's trail."""
-_FORCE_COLOURS = {
-    "attractive": "#26bf40",
-    "repulsive": "#e6332a",
-    "virtual": "#b340e6",
-    "total": "#2673ff",
-}
-_OBSTACLE_COLOUR = "#5a5f6e"
-_ECHO_COLOUR = "#ff7f0e"
-_PLANE_COLOUR = "#8e24aa"
 
 
 def video_format(path: Path) -> VideoFormat:
@@ -199,23 +193,28 @@ class FrameCanvas:
         )
         self._animated: list[Artist] = []
         self.path = self._add(LineCollection([], linewidths=2.2, capstyle="round"))
-        self.planes = self._add(LineCollection([], colors=_PLANE_COLOUR, linewidths=3))
-        (self.objective,) = axes.plot([], [], "*", color="#1a5ae6", ms=font * 1.6, zorder=6)
-        self._animated.append(self.objective)
+        dashes = (0, (2, 1.2))
+        self.planes = self._add(
+            LineCollection([], colors=[palette.PLANE.rgba], linewidths=3, linestyles=dashes)
+        )
+        self.objective = self._add(_disc_marker(axes, palette.OBJECTIVE, font * 1.1))
         self.moving = None
         if scenario.world.moving and timeline.obstacles is not None:
             self.moving = MovingArtists(axes, scenario.world.moving, timeline.times_s, timeline.obstacles)
             self._animated += self.moving.artists
-        self.echoes = self._add(axes.scatter([], [], s=font * 2.2, color=_ECHO_COLOUR, zorder=7))
-        self.body = self._add(Circle((0, 0), robot_radius_m, fc="#333d52", ec="white", lw=1, zorder=8))
-        (self.heading,) = axes.plot([], [], color="white", lw=2, zorder=9)
+        self.echoes = self._add(axes.scatter([], [], s=font * 1.2, color=[palette.ECHO.rgba], zorder=7))
+        robot = palette.ROBOT
+        self.body = self._add(Circle((0, 0), robot_radius_m, fc=robot.rgba, ec=robot.rim, lw=1.2, zorder=8))
+        (self.heading,) = axes.plot([], [], color=robot.rim, lw=1.5, zorder=9)
         self._animated.append(self.heading)
         self.forces = axes.quiver(
             np.zeros(len(FORCE_NAMES)),
             np.zeros(len(FORCE_NAMES)),
             np.zeros(len(FORCE_NAMES)),
             np.zeros(len(FORCE_NAMES)),
-            color=[_FORCE_COLOURS[name] for name in FORCE_NAMES],
+            color=[palette.FORCE_RGBA[name] for name in FORCE_NAMES],
+            edgecolor=palette.BLACK,
+            linewidth=0.8,
             angles="xy",
             scale_units="xy",
             scale=1.0,
@@ -346,8 +345,8 @@ class MovingArtists:
 def _patch(piece: shapes.Piece) -> Patch:
     """A moving obstacle's shape about the origin, drawn over the path (which it crosses)."""
     if isinstance(piece, shapes.Disc):
-        return Circle((0.0, 0.0), piece.radius, color=_OBSTACLE_COLOUR, zorder=3)
-    return Polygon(piece.corners(), color=_OBSTACLE_COLOUR, zorder=3)
+        return Circle((0.0, 0.0), piece.radius, color=palette.MOVING_OBSTACLE.rgba, zorder=3)
+    return Polygon(piece.corners(), color=palette.MOVING_OBSTACLE.rgba, zorder=3)
 
 
 def _view(scenario: Scenario, timeline: Timeline) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -374,9 +373,15 @@ def _draw_world(axes, scenario: Scenario) -> None:
         pieces += list(shapes.border_footprint(scenario.world.size))
     for piece in pieces:
         if isinstance(piece, shapes.Disc):
-            axes.add_patch(Circle(piece.center, piece.radius, color=_OBSTACLE_COLOUR, zorder=1))
+            axes.add_patch(Circle(piece.center, piece.radius, color=palette.OBSTACLE.rgba, zorder=1))
         else:
-            axes.add_patch(Polygon(piece.corners(), color=_OBSTACLE_COLOUR, zorder=1))
-    robot = scenario.robot
-    axes.add_patch(Circle(robot.goal, robot.goal_tolerance, color="#ffbf1a", alpha=0.8, zorder=2))
-    axes.add_patch(Circle(robot.start, 0.08, color="#26bf40", zorder=2))
+            axes.add_patch(Polygon(piece.corners(), color=palette.OBSTACLE.rgba, zorder=1))
+    robot, start = scenario.robot, palette.START
+    axes.add_patch(Circle(robot.goal, robot.goal_tolerance, color=palette.GOAL.rgba, zorder=2))
+    axes.add_patch(Circle(robot.start, 0.08, fc=start.rgba, ec=start.rim, lw=1.5, zorder=2))
+
+
+def _disc_marker(axes, mark: Mark, size_pt: float) -> Line2D:
+    """An empty line that draws a disc of `mark` (its colour within its rim) at each point."""
+    (line,) = axes.plot([], [], "o", ms=size_pt, mfc=mark.rgba, mec=mark.rim or mark.rgba, mew=1.5, zorder=6)
+    return line

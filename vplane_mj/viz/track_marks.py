@@ -1,0 +1,129 @@
+"""What the render draws of a run over MuJoCo's world, as flat shapes per legend mark.
+
+The start, the goal, the path coloured by planner mode, the virtual planes and objectives and
+the collisions. Sizes are in pixels of the picture (`metres_per_px` turns them into metres), so
+that marks read the same in a small arena and a large one; the goal's disc is the goal
+tolerance. From the bottom up: goal and start, path, planes, a moving obstacle's closest
+approach, objectives, collisions.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+
+import numpy as np
+
+from vplane_mj.scenario import Scenario
+from vplane_mj.sim.loop import Track
+from vplane_mj.viz import palette
+from vplane_mj.viz.flat import Disc, Segment, Shape
+from vplane_mj.viz.palette import Mark
+
+Drawn = tuple[Mark, list[Shape]]
+"""A legend mark and the shapes that draw it."""
+
+MARKER_HEIGHT_M = 0.6
+"""The lowest mark lies above the obstacles (0.5 m) so that they hide none."""
+LAYER_STEP_M = 0.004
+"""Height (m) between two layers; within one, a rim lies at its bottom, a fill a quarter up,
+lines on top half way up."""
+FILL_M, TOP_M = LAYER_STEP_M / 4, LAYER_STEP_M / 2
+LAYERS = ("goal", "start", "path", "plane", "closest", "objective", "collision")
+"""The marks from the bottom up."""
+MAX_PATH_SEGMENTS = 3000
+PATH_PX = 4.0
+START_RADIUS_PX, OBJECTIVE_RADIUS_PX, RIM_PX = 8.0, 6.0, 2.0
+PLANE_PX, DASH_PX, GAP_PX = 5.0, 10.0, 6.0
+CROSS_HALF_PX, CROSS_PX = 7.0, 3.0
+
+
+def layer_z(layer: str) -> float:
+    """The height (m) of a layer of LAYERS."""
+    return MARKER_HEIGHT_M + LAYER_STEP_M * LAYERS.index(layer)
+
+
+def track_marks(scenario: Scenario, track: Track, metres_per_px: float) -> list[Drawn]:
+    """The run's marks that the picture holds, in the legend's order, with their shapes."""
+    px = metres_per_px
+    robot = scenario.robot
+    drawn: list[Drawn] = [
+        (palette.START, _disc(robot.start, START_RADIUS_PX * px, palette.START, "start", px)),
+        (palette.GOAL, [Disc(robot.goal, robot.goal_tolerance, palette.GOAL.rgba, layer_z("goal"))]),
+    ]
+    points = _decimated(track.positions)
+    modes = [track.modes[k] for k in points.index[:-1]]
+    drawn += _path(points.xy, modes)
+    if track.objectives:
+        radius = OBJECTIVE_RADIUS_PX * px
+        objectives = [
+            s for o in track.objectives for s in _disc(o, radius, palette.OBJECTIVE, "objective", px)
+        ]
+        drawn.append((palette.OBJECTIVE, objectives))
+    if track.planes:
+        drawn.append((palette.PLANE, [s for e1, e2 in track.planes for s in _dashes(e1, e2, px)]))
+    if track.collision_points:
+        drawn.append((palette.COLLISION, [s for point in track.collision_points for s in _cross(point, px)]))
+    return drawn
+
+
+@dataclasses.dataclass(frozen=True)
+class _Polyline:
+    """Points of a path (N, 2; m) and their indices in the whole path."""
+
+    xy: np.ndarray
+    index: list[int]
+
+
+def _decimated(positions: np.ndarray) -> _Polyline:
+    """The path's points at most MAX_PATH_SEGMENTS segments apart, its last point kept."""
+    if len(positions) < 2:
+        return _Polyline(np.asarray(positions, float).reshape(-1, 2), list(range(len(positions))))
+    stride = max(1, math.ceil((len(positions) - 1) / MAX_PATH_SEGMENTS))
+    kept = list(range(0, len(positions), stride))
+    if kept[-1] != len(positions) - 1:
+        kept.append(len(positions) - 1)
+    return _Polyline(np.asarray(positions, float)[kept], kept)
+
+
+def _path(xy: np.ndarray, modes: list[str]) -> list[Drawn]:
+    """A segment per pair of points (N, 2; m), in the colour of the mode at its start; a mark per
+    mode, in the order the modes first appear."""
+    by_mode: dict[str, list[Shape]] = {}
+    z = layer_z("path")
+    for (a, b), mode in zip(itertools.pairwise(xy), modes, strict=True):
+        by_mode.setdefault(mode, []).append(Segment(a, b, palette.path_mark(mode).rgba, PATH_PX, z))
+    return [(palette.path_mark(mode), shapes) for mode, shapes in by_mode.items()]
+
+
+def _disc(center, radius_m: float, mark: Mark, layer: str, px: float) -> list[Shape]:
+    """A disc of the mark's colour, within its rim when it has one."""
+    z = layer_z(layer)
+    if mark.rim is None:
+        return [Disc(center, radius_m, mark.rgba, z)]
+    return [Disc(center, radius_m, mark.rim, z), Disc(center, radius_m - RIM_PX * px, mark.rgba, z + FILL_M)]
+
+
+def _dashes(e1, e2, px: float) -> list[Shape]:
+    """A virtual plane from e1 to e2 (m) as dashes of DASH_PX with gaps of GAP_PX."""
+    a, b = np.asarray(e1, float), np.asarray(e2, float)
+    length = float(np.hypot(*(b - a)))
+    if length == 0.0:
+        return []
+    dash, period = DASH_PX * px, (DASH_PX + GAP_PX) * px
+    starts = np.arange(0.0, length, period)
+    z = layer_z("plane")
+    ends = [(a + (b - a) * s / length, a + (b - a) * min(s + dash, length) / length) for s in starts]
+    return [Segment(start, end, palette.PLANE.rgba, PLANE_PX, z) for start, end in ends]
+
+
+def _cross(point, px: float) -> list[Shape]:
+    """A "+" at a collision point (m)."""
+    x, y = point
+    arm, z = CROSS_HALF_PX * px, layer_z("collision")
+    rgba = palette.COLLISION.rgba
+    return [
+        Segment((x - arm, y), (x + arm, y), rgba, CROSS_PX, z),
+        Segment((x, y - arm), (x, y + arm), rgba, CROSS_PX, z),
+    ]
