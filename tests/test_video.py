@@ -1,5 +1,6 @@
 """`vplane-mj video` and `run --video`: a run replayed from its log as MP4 and GIF."""
 
+import dataclasses
 import math
 
 import imageio_ffmpeg
@@ -9,9 +10,12 @@ from PIL import Image
 
 from vplane_mj.cli import main
 from vplane_mj.logs.reader import read_log
+from vplane_mj.logs.replay import load_log
 from vplane_mj.logs.timeline import timeline_from_log
+from vplane_mj.logs.writer import METADATA_NAME
 from vplane_mj.planning.protocol.events import EventKind
 from vplane_mj.viz import palette
+from vplane_mj.viz.video import FrameCanvas
 
 TIME_LIMIT_S = 6.0  # vplane detects the trap at 5.45 s: the escape starts on screen
 
@@ -120,3 +124,41 @@ def test_the_timeline_of_a_log(logged):
         for x, y, dx, dy in timeline.forces[k].values():
             assert (x, y) == pytest.approx(tuple(timeline.poses[k, :2])) and math.hypot(dx, dy) <= 1.5 + 1e-9
     assert sum(len(echoes) for echoes in timeline.echoes) > 5 * ticks
+
+
+def canvas_of(log, **changes) -> FrameCanvas:
+    """The 720 px video canvas of a log, its timeline changed by `changes`."""
+    contents, scenario = load_log(log)
+    timeline = dataclasses.replace(timeline_from_log(log, contents), **changes)
+    radius = float(contents.metadata[METADATA_NAME]["robot_radius_m"])
+    return FrameCanvas(scenario, timeline, radius, 720, 1.0)
+
+
+def frame_at(canvas: FrameCanvas, time_s: float) -> np.ndarray:
+    """The frame at `time_s` as an (H, W, 3) array."""
+    width, height = canvas.size
+    return np.frombuffer(canvas.frame(time_s), np.uint8).reshape(height, width, 4)[..., :3]
+
+
+def rgb(rgba) -> tuple[int, int, int]:
+    """A palette colour's 8-bit RGB."""
+    return tuple(round(channel * 255) for channel in rgba[:3])
+
+
+def count(pixels: np.ndarray, colour, within: int = 0) -> int:
+    """The pixels of `colour`, each channel off by at most `within` (lines are antialiased)."""
+    return int((np.abs(pixels.reshape(-1, 3).astype(int) - rgb(colour)) <= within).all(axis=1).sum())
+
+
+def test_the_video_draws_the_start_above_a_virtual_plane_that_crosses_it(logged):
+    log = logged / "paper_c_escape-vplane-0.mcap"
+    x, y = load_log(log)[1].robot.start
+    canvas = canvas_of(log, planes=[[((x, y - 1.0), (x, y + 1.0))]] * len(read_log(log).times_ns))
+    frame = frame_at(canvas, 3.0)  # the robot has left the start
+    column, row = canvas.axes.transData.transform((x, y))
+    row = round(frame.shape[0] - row)
+    assert count(frame[row - 2 : row + 3, round(column) - 2 : round(column) + 3], palette.START.rgba) == 25
+    column, row = canvas.axes.transData.transform((x, y + 0.5))
+    row = round(frame.shape[0] - row)
+    beside = frame[row - 4 : row + 5, round(column) - 4 : round(column) + 5]
+    assert count(beside, palette.PLANE.rgba) >= 5  # the plane itself, under the start

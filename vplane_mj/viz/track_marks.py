@@ -3,8 +3,8 @@
 The start, the goal, the path coloured by planner mode, the virtual planes and objectives and
 the collisions. Sizes are in pixels of the picture (`metres_per_px` turns them into metres), so
 that marks read the same in a small arena and a large one; the goal's disc is the goal
-tolerance. From the bottom up: goal and start, path, planes, a moving obstacle's closest
-approach, objectives, collisions.
+tolerance. From the bottom up: goal, path, planes, a moving obstacle's closest approach,
+objectives, start, collisions (the start above a plane that crosses it).
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ LAYER_STEP_M = 0.004
 """Height (m) between two layers; within one, a rim lies at its bottom, a fill a quarter up,
 lines on top half way up."""
 FILL_M, TOP_M = LAYER_STEP_M / 4, LAYER_STEP_M / 2
-LAYERS = ("goal", "start", "path", "plane", "closest", "objective", "collision")
+LAYERS = ("goal", "path", "plane", "closest", "objective", "start", "collision")
 """The marks from the bottom up."""
 MAX_PATH_SEGMENTS = 3000
 PATH_PX = 4.0

@@ -198,6 +198,8 @@ class FrameCanvas:
             LineCollection([], colors=[palette.PLANE.rgba], linewidths=3, linestyles=dashes)
         )
         self.objective = self._add(_disc_marker(axes, palette.OBJECTIVE, font * 1.1))
+        self.start = self._add(_disc_marker(axes, palette.START, font * 1.2))  # over the planes
+        self.start.set_data([scenario.robot.start[0]], [scenario.robot.start[1]])
         self.moving = None
         if scenario.world.moving and timeline.obstacles is not None:
             self.moving = MovingArtists(axes, scenario.world.moving, timeline.times_s, timeline.obstacles)
@@ -365,7 +367,7 @@ def _view(scenario: Scenario, timeline: Timeline) -> tuple[tuple[float, float], 
 
 
 def _draw_world(axes, scenario: Scenario) -> None:
-    """Arena floor, obstacles, border walls, start and goal."""
+    """Arena floor, obstacles, border walls and the goal (the start is drawn over the planes)."""
     w, h = scenario.world.size
     axes.add_patch(Polygon([(0, 0), (w, 0), (w, h), (0, h)], color="#f2f2f2", zorder=0))
     pieces = [piece for obstacle in scenario.world.obstacles for piece in obstacle.footprint()]
@@ -376,9 +378,8 @@ def _draw_world(axes, scenario: Scenario) -> None:
             axes.add_patch(Circle(piece.center, piece.radius, color=palette.OBSTACLE.rgba, zorder=1))
         else:
             axes.add_patch(Polygon(piece.corners(), color=palette.OBSTACLE.rgba, zorder=1))
-    robot, start = scenario.robot, palette.START
+    robot = scenario.robot
     axes.add_patch(Circle(robot.goal, robot.goal_tolerance, color=palette.GOAL.rgba, zorder=2))
-    axes.add_patch(Circle(robot.start, 0.08, fc=start.rgba, ec=start.rim, lw=1.5, zorder=2))
 
 
 def _disc_marker(axes, mark: Mark, size_pt: float) -> Line2D:
