@@ -10,7 +10,8 @@ from vplane_mj.scenario import parse_scenario
 from vplane_mj.sim.loop import Track
 from vplane_mj.sim.world import top_view_extent
 from vplane_mj.viz import palette
-from vplane_mj.viz.render import LEGEND_PX, png_bytes, render_top_view, write_png
+from vplane_mj.viz.render import LEGEND_PX, SCALE_PX, png_bytes, render_top_view, write_png
+from vplane_mj.viz.swatches import SWATCH_PX
 
 
 @pytest.mark.parametrize("shape", [(1, 1, 3), (1, 7, 3), (5, 1, 3), (37, 53, 3)])
@@ -101,6 +102,25 @@ def small_world():
     return parse_scenario(tomli_w.dumps(doc), "marks.toml")
 
 
+MODES = ("normal", "avoiding", "escaping", "trapped", "following")
+
+
+def every_mark_track() -> Track:
+    """A path from the start 1 m in each mode to the right, a virtual objective and plane, a
+    collision."""
+    xs = np.linspace(1.0, 6.0, 501)
+    positions = np.column_stack((xs, np.full(len(xs), 3.0)))
+    modes = [MODES[min(int(x - 1.0), 4)] for x in xs]
+    return Track(
+        positions,
+        modes,
+        (6.0, 3.0, 0.0),
+        collision_points=[(6.0, 4.7)],
+        objectives=[(6.5, 2.0)],
+        planes=[((2.5, 2.0), (2.5, 4.0))],
+    )
+
+
 def arena_pixels(image: np.ndarray, scenario) -> np.ndarray:
     """The render's arena: the image left of the panel, as tall as the arena is."""
     width_m, height_m = top_view_extent(scenario.world.size)
@@ -108,9 +128,66 @@ def arena_pixels(image: np.ndarray, scenario) -> np.ndarray:
     return image[: round(width_px * height_m / width_m), :width_px]
 
 
+def swatches(image: np.ndarray) -> list[np.ndarray]:
+    """The legend's swatches from the top: the non-white runs of rows of the swatch column (its
+    pixels), above the scale bar."""
+    left = image.shape[1] - LEGEND_PX + 10
+    band = image[: image.shape[0] - SCALE_PX, left : left + SWATCH_PX]
+    inked = (band != 255).any(axis=(1, 2))
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], inked.astype(int), [0]))))
+    return [band[start:end] for start, end in zip(edges[::2], edges[1::2], strict=True)]
+
+
 def count(pixels: np.ndarray, colour: tuple[int, int, int]) -> int:
     """The pixels of exactly `colour` (8-bit RGB)."""
     return int((pixels.reshape(-1, 3) == colour).all(axis=1).sum())
+
+
+def test_the_legend_names_every_mark_the_render_draws_and_nothing_else():
+    scenario = small_world()
+    image = render_top_view(scenario, every_mark_track())
+    legend = [
+        palette.OBSTACLE,
+        palette.START,
+        palette.GOAL,
+        *(palette.path_mark(mode) for mode in MODES),
+        palette.OBJECTIVE,
+        palette.PLANE,
+        palette.COLLISION,
+        palette.ROBOT,
+    ]
+    rows = swatches(image)
+    assert len(rows) == len(legend)
+    for mark, swatch in zip(legend, rows, strict=True):  # each row's swatch in its colours
+        assert count(swatch, rgb(mark.rgba)) >= 8, mark.label
+        if mark.rim is not None:
+            assert count(swatch, rgb(mark.rim)) >= 8, mark.label
+    arena = arena_pixels(image, scenario)
+    named = {rgb(colour) for mark in legend for colour in (mark.rgba, mark.rim) if colour is not None}
+    for mark in legend:
+        assert count(arena, rgb(mark.rgba)) >= 20, mark.label  # drawn
+    marks = [value for value in vars(palette).values() if isinstance(value, palette.Mark)]
+    colours = {
+        rgb(c) for c in [*palette.MODE_RGBA.values(), *(m.rgba for m in marks), *palette.FORCE_RGBA.values()]
+    }
+    shown = {colour for colour in colours if count(arena, colour) >= 20}
+    assert shown <= named  # every colour of the palette the arena shows is a legend row's
+
+
+def test_a_render_without_virtual_marks_or_collisions_leaves_them_out_of_the_legend():
+    scenario = small_world()
+    positions = np.column_stack((np.linspace(1.0, 3.0, 50), np.full(50, 3.0)))
+    rows = swatches(render_top_view(scenario, Track(positions, ["normal"] * 50, (3.0, 3.0, 0.0))))
+    legend = [
+        palette.OBSTACLE,
+        palette.START,
+        palette.GOAL,
+        palette.path_mark("normal"),
+        palette.ROBOT,
+    ]
+    assert len(rows) == len(legend)
+    for mark, swatch in zip(legend, rows, strict=True):
+        assert count(swatch, rgb(mark.rgba)) >= 8, mark.label
 
 
 def test_the_start_shows_above_a_virtual_plane_that_crosses_it():

@@ -2,8 +2,8 @@
 
 The arena from the orthographic top camera, flat (no shading: every mark in its colour of
 `vplane_mj.viz.palette`), with the marks of the run over it (`track_marks`, `moving_marks`) and a
-panel at its right: the caption, a legend of the run's marks, and a scale bar. A `Track` holds
-what is drawn, from a run or from its log.
+panel at its right: the caption, a legend that names every mark the picture holds, and a scale
+bar. A `Track` holds what is drawn, from a run or from its log.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ import numpy as np
 from vplane_mj.geometry.motion import Moving
 from vplane_mj.sim.loop import Track
 from vplane_mj.sim.summary import RunSummary
-from vplane_mj.sim.world import MOVING_PREFIX, build_model
+from vplane_mj.sim.world import MOVING_PREFIX, ROBOT_PREFIX, build_model
 from vplane_mj.viz import palette
 from vplane_mj.viz.flat import add_shapes
 from vplane_mj.viz.moving_marks import moving_marks
@@ -32,6 +32,9 @@ PNG_FILTER_UP = 2
 """PNG's row filter "Up": each byte minus the one above it."""
 OBSTACLE_MATERIALS = ("obstacle", "border")
 """The world's materials of the obstacles and the border walls, drawn in the palette's colour."""
+HIDDEN_GROUP = 5
+"""The geom group the robot's own geoms are moved to, which the render leaves out: it draws the
+robot's footprint instead."""
 LEGEND_PX = 200
 """Width (px) of the panel right of the arena that holds the caption, the legend and the scale."""
 ROW_PX = 24
@@ -51,8 +54,6 @@ def render_top_view(scenario, track: Track, caption: str = "") -> np.ndarray:
     model = build_model(scenario)
     _flatten(model)
     data = mujoco.MjData(model)
-    x, y, yaw = track.final_pose
-    data.qpos[:7] = (x, y, 0.0, math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
     places = _moving_places(scenario, track)
     if places is not None:
         _stand_moving(model, data, scenario.world.moving, places[-1])
@@ -61,9 +62,10 @@ def render_top_view(scenario, track: Track, caption: str = "") -> np.ndarray:
     camera = mujoco.MjvCamera()
     camera.type, camera.fixedcamid = mujoco.mjtCamera.mjCAMERA_FIXED, model.camera("top").id
     metres_per_px = model.cam_fovy[camera.fixedcamid] / arena_px  # orthographic: the view's height in m
-    drawn: list[Drawn] = []
+    world = scenario.world
+    drawn: list[Drawn] = [(palette.OBSTACLE, [])] if world.obstacles or world.border else []  # MuJoCo's
     if places is not None:
-        drawn += moving_marks(scenario.world.moving, track.positions, places, metres_per_px)
+        drawn += moving_marks(world.moving, track.positions, places, metres_per_px)
     drawn += track_marks(scenario, track, metres_per_px)
     lines = [line for line in caption.splitlines() if line][:CAPTION_LINES]
     height = max(arena_px, _panel_height(len(lines), len(drawn)))
@@ -98,13 +100,15 @@ def render_top_view(scenario, track: Track, caption: str = "") -> np.ndarray:
 
 def _flatten(model: mujoco.MjModel) -> None:
     """Light the model evenly from the camera, so that every surface shows its own colour; paint
-    the obstacles and walls in the palette's colour."""
+    the obstacles and walls in the palette's colour; leave the robot's own geoms out."""
     model.vis.headlight.ambient[:] = 1.0
     model.vis.headlight.diffuse[:] = 0.0
     model.vis.headlight.specular[:] = 0.0
     model.light_active[:] = 0
     for name in OBSTACLE_MATERIALS:
         model.mat_rgba[model.material(name).id] = palette.OBSTACLE.rgba
+    robot = model.body(ROBOT_PREFIX).id
+    model.geom_group[model.body_rootid[model.geom_bodyid] == robot] = HIDDEN_GROUP
 
 
 def _panel_height(caption_lines: int, legend_rows: int) -> int:

@@ -1,10 +1,11 @@
-"""What the render draws of a run over MuJoCo's world, as flat shapes per legend mark.
+"""What the render draws of a run over MuJoCo's obstacles, as flat shapes per legend mark.
 
-The start, the goal, the path coloured by planner mode, the virtual planes and objectives and
-the collisions. Sizes are in pixels of the picture (`metres_per_px` turns them into metres), so
-that marks read the same in a small arena and a large one; the goal's disc is the goal
-tolerance. From the bottom up: goal, path, planes, a moving obstacle's closest approach,
-objectives, start, collisions (the start above a plane that crosses it).
+The start, the goal, the path coloured by planner mode, the virtual planes and objectives, the
+collisions and the robot's footprint where it ended. Sizes are in pixels of the picture
+(`metres_per_px` turns them into metres), so that marks read the same in a small arena and a
+large one; the goal's disc is the goal tolerance, the robot its footprint. From the bottom up:
+goal, robot, path, planes, a moving obstacle's closest approach, objectives, start, collisions
+(the start above a plane that crosses it).
 """
 
 from __future__ import annotations
@@ -15,11 +16,12 @@ import math
 
 import numpy as np
 
+from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario import Scenario
 from vplane_mj.sim.loop import Track
 from vplane_mj.viz import palette
-from vplane_mj.viz.flat import Disc, Segment, Shape
-from vplane_mj.viz.palette import Mark
+from vplane_mj.viz.flat import Disc, Segment, Shape, Triangle
+from vplane_mj.viz.palette import RGBA, Mark
 
 Drawn = tuple[Mark, list[Shape]]
 """A legend mark and the shapes that draw it."""
@@ -30,13 +32,17 @@ LAYER_STEP_M = 0.004
 """Height (m) between two layers; within one, a rim lies at its bottom, a fill a quarter up,
 lines on top half way up."""
 FILL_M, TOP_M = LAYER_STEP_M / 4, LAYER_STEP_M / 2
-LAYERS = ("goal", "path", "plane", "closest", "objective", "start", "collision")
+LAYERS = ("goal", "robot", "path", "plane", "closest", "objective", "start", "collision")
 """The marks from the bottom up."""
 MAX_PATH_SEGMENTS = 3000
 PATH_PX = 4.0
+DOT_TICKS = 10
+"""A stretch in one mode this many control ticks long, but shorter than the path is wide, is a
+dot (a mode of one tick on the way is not)."""
 START_RADIUS_PX, OBJECTIVE_RADIUS_PX, RIM_PX = 8.0, 6.0, 2.0
 PLANE_PX, DASH_PX, GAP_PX = 5.0, 10.0, 6.0
 CROSS_HALF_PX, CROSS_PX = 7.0, 3.0
+ROBOT_AT_END = dataclasses.replace(palette.ROBOT, label="robot at the end")
 
 
 def layer_z(layer: str) -> float:
@@ -54,7 +60,7 @@ def track_marks(scenario: Scenario, track: Track, metres_per_px: float) -> list[
     ]
     points = _decimated(track.positions)
     modes = [track.modes[k] for k in points.index[:-1]]
-    drawn += _path(points.xy, modes)
+    drawn += _path(points, modes, px)
     if track.objectives:
         radius = OBJECTIVE_RADIUS_PX * px
         objectives = [
@@ -65,6 +71,7 @@ def track_marks(scenario: Scenario, track: Track, metres_per_px: float) -> list[
         drawn.append((palette.PLANE, [s for e1, e2 in track.planes for s in _dashes(e1, e2, px)]))
     if track.collision_points:
         drawn.append((palette.COLLISION, [s for point in track.collision_points for s in _cross(point, px)]))
+    drawn.append((ROBOT_AT_END, _robot(scenario, track.final_pose, px)))
     return drawn
 
 
@@ -87,13 +94,29 @@ def _decimated(positions: np.ndarray) -> _Polyline:
     return _Polyline(np.asarray(positions, float)[kept], kept)
 
 
-def _path(xy: np.ndarray, modes: list[str]) -> list[Drawn]:
-    """A segment per pair of points (N, 2; m), in the colour of the mode at its start; a mark per
-    mode, in the order the modes first appear."""
+def _stretches(modes: list[str]) -> list[tuple[int, int]]:
+    """The path's stretches in one mode, as (first, last) point: segment k, from point k to
+    k + 1, is in `modes[k]`."""
+    if not modes:
+        return []
+    changes = [k for k in range(1, len(modes)) if modes[k] != modes[k - 1]]
+    return list(itertools.pairwise([0, *changes, len(modes)]))
+
+
+def _path(points: _Polyline, modes: list[str], px: float) -> list[Drawn]:
+    """A segment per pair of points, in the colour of the mode at its start, and a dot for a
+    stretch in one mode of at least DOT_TICKS ticks too short to show as a line (a robot trapped
+    on the spot); a mark per mode, in the order the modes first appear."""
     by_mode: dict[str, list[Shape]] = {}
-    z = layer_z("path")
+    xy, z = points.xy, layer_z("path")
     for (a, b), mode in zip(itertools.pairwise(xy), modes, strict=True):
         by_mode.setdefault(mode, []).append(Segment(a, b, palette.path_mark(mode).rgba, PATH_PX, z))
+    for first, last in _stretches(modes):
+        stretch = xy[first : last + 1]
+        ticks = points.index[last] - points.index[first]
+        if ticks >= DOT_TICKS and np.hypot(*np.ptp(stretch, axis=0)) < PATH_PX * px:
+            dot = Disc(stretch.mean(axis=0), PATH_PX * px, palette.path_mark(modes[first]).rgba, z + TOP_M)
+            by_mode[modes[first]].append(dot)
     return [(palette.path_mark(mode), shapes) for mode, shapes in by_mode.items()]
 
 
@@ -127,3 +150,27 @@ def _cross(point, px: float) -> list[Shape]:
         Segment((x - arm, y), (x + arm, y), rgba, CROSS_PX, z),
         Segment((x, y - arm), (x, y + arm), rgba, CROSS_PX, z),
     ]
+
+
+def _robot(scenario: Scenario, pose: tuple[float, float, float], px: float) -> list[Shape]:
+    """The robot's footprint where it ended: filled, within a rim, with a line from its centre
+    to its front."""
+    body = robot_body(scenario.robot.profile)
+    x, y, yaw = pose
+    mark, z = palette.ROBOT, layer_z("robot")
+    rim: RGBA = mark.rim or palette.BLACK
+    heading = np.array((math.cos(yaw), math.sin(yaw)))
+    if body.disc:
+        front = body.radius_m
+        shapes: list[Shape] = _disc((x, y), body.radius_m, mark, "robot", px)
+    else:
+        turn = np.array([[heading[0], -heading[1]], [heading[1], heading[0]]])
+        corners = body.footprint @ turn.T + (x, y)
+        shapes = [Triangle(corners[[0, k, k + 1]], mark.rgba, z + FILL_M) for k in range(1, len(corners) - 1)]
+        shapes += [
+            Segment(a, b, rim, RIM_PX, z + TOP_M)
+            for a, b in zip(corners, np.roll(corners, -1, axis=0), strict=True)
+        ]
+        front = float(body.footprint[:, 0].max())
+    shapes.append(Segment((x, y), np.array((x, y)) + heading * front, rim, RIM_PX, z + TOP_M))
+    return shapes
