@@ -151,6 +151,7 @@ def test_the_legend_names_every_mark_the_render_draws_and_nothing_else():
         palette.START,
         palette.GOAL,
         *(palette.path_mark(mode) for mode in MODES),
+        palette.DIRECTION,
         palette.OBJECTIVE,
         palette.PLANE,
         palette.COLLISION,
@@ -183,6 +184,7 @@ def test_a_render_without_virtual_marks_or_collisions_leaves_them_out_of_the_leg
         palette.START,
         palette.GOAL,
         palette.path_mark("normal"),
+        palette.DIRECTION,
         palette.ROBOT,
     ]
     assert len(rows) == len(legend)
@@ -203,3 +205,24 @@ def test_the_start_shows_above_a_virtual_plane_that_crosses_it():
     assert count(rim, rgb(palette.START.rim)) >= 20
     beside = window(image, scenario, (start[0], start[1] + 0.5), half_px=8)
     assert count(beside, rgb(palette.PLANE.rgba)) >= 20  # the plane is drawn, under the start
+
+
+@pytest.mark.parametrize("rightwards", [True, False])
+def test_arrowheads_point_the_way_the_robot_went(rightwards):
+    scenario = small_world()
+    xs = np.linspace(1.5, 5.5, 200)[:: 1 if rightwards else -1]
+    positions = np.column_stack((xs, np.full(200, 2.0)))
+    track = Track(positions, ["normal"] * 200, (xs[-1], 2.0, 0.0 if rightwards else np.pi))
+    image = render_top_view(scenario, track)
+    (row, left), (_, right) = pixel(image, scenario, (1.8, 2.0)), pixel(image, scenario, (5.2, 2.0))
+    band = image[row - 12 : row + 12, left:right]  # along the path, across it
+    black = (band == rgb(palette.DIRECTION.rgba)).all(axis=2)
+    heights = black.sum(axis=0)  # per column: the arrowhead's width across the path
+    assert heights.max() >= 10  # arrowheads, wider than the path
+    columns = np.flatnonzero(heights >= 3)
+    first = columns[np.diff(columns, prepend=columns[0] - 2) > 1]  # each arrowhead's first column
+    assert len(first) >= 2
+    for start in first:
+        head = heights[start : start + 14]
+        wide_at_left = int(np.argmax(head)) < len(head) / 2
+        assert wide_at_left == rightwards  # the base behind, the tip ahead

@@ -3,7 +3,7 @@
 Defined once here, so that the pictures cannot drift apart. The hues are Okabe and Ito's
 palette, told apart with every common colour-vision deficiency; obstacles are a neutral dark
 grey that no path shares; the marks that share black differ by shape (a dashed line, a cross,
-a rim). Colours are RGBA in [0, 1], as MuJoCo and matplotlib take them.
+an arrowhead, a rim). Colours are RGBA in [0, 1], as MuJoCo and matplotlib take them.
 """
 
 from __future__ import annotations
@@ -34,9 +34,9 @@ DARK_GREY = _hex("#505050")
 GREY = _hex("#999999")
 """The robot, and a path in a mode without a colour of its own."""
 
-Swatch = Literal["area", "disc", "dot", "line", "dashes", "fading", "cross", "outline"]
+Swatch = Literal["area", "disc", "dot", "line", "dashes", "fading", "cross", "arrow", "outline"]
 """The shape of a mark's legend swatch: a filled square, a disc, a small dot, a line, a dashed
-line, a line fading from white, a cross, a square's outline."""
+line, a line fading from white, a cross, an arrowhead, a square's outline."""
 
 
 @dataclass(frozen=True)
@@ -64,6 +64,7 @@ OBSTACLE = Mark("obstacle", DARK_GREY, "area")
 MOVING_OBSTACLE = Mark("moving obstacle", DARK_GREY, "area")
 START = Mark("start", WHITE, "disc", rim=BLACK)
 GOAL = Mark("goal (tolerance)", YELLOW, "disc")
+DIRECTION = Mark("direction of travel", BLACK, "arrow")
 OBJECTIVE = Mark("virtual objective", SKY_BLUE, "disc", rim=BLACK)
 PLANE = Mark("virtual plane", BLACK, "dashes")
 COLLISION = Mark("collision", BLACK, "cross")

@@ -1,5 +1,5 @@
 """A legend's swatch of a mark, painted into an RGB image (H, W, 3) of uint8: its shape (a
-square, a disc, a line, dashes, a cross...) in its colour, within its rim."""
+square, a disc, a line, dashes, a cross, an arrowhead...) in its colour, within its rim."""
 
 from __future__ import annotations
 
@@ -50,6 +50,7 @@ def _mask(shape: Swatch, x: np.ndarray, y: np.ndarray, inset: float) -> np.ndarr
         "fading": line,
         "dashes": line & ((x + SWATCH_PX / 2) // DASH_PX % 2 == 0),
         "cross": ((np.abs(y) <= 1.5) | (np.abs(x) <= 1.5)) & (box <= half),
+        "arrow": (x >= -half) & (np.abs(y) <= (half - x) / 2),  # pointing right
         "outline": (box <= half) & (box >= half - RIM_PX),
     }
     return masks[shape]

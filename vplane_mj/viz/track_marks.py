@@ -1,11 +1,11 @@
 """What the render draws of a run over MuJoCo's obstacles, as flat shapes per legend mark.
 
-The start, the goal, the path coloured by planner mode, the virtual planes and objectives, the
-collisions and the robot's footprint where it ended. Sizes are in pixels of the picture
-(`metres_per_px` turns them into metres), so that marks read the same in a small arena and a
-large one; the goal's disc is the goal tolerance, the robot its footprint. From the bottom up:
-goal, robot, path, planes, a moving obstacle's closest approach, objectives, start, collisions
-(the start above a plane that crosses it).
+The start, the goal, the path coloured by planner mode with arrowheads along it, the virtual
+planes and objectives, the collisions and the robot's footprint where it ended. Sizes are in
+pixels of the picture (`metres_per_px` turns them into metres), so that marks read the same in
+a small arena and a large one; the goal's disc is the goal tolerance, the robot its footprint.
+From the bottom up: goal, robot, path, planes, arrowheads, a moving obstacle's closest approach,
+objectives, start, collisions (the start above a plane that crosses it).
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ LAYER_STEP_M = 0.004
 """Height (m) between two layers; within one, a rim lies at its bottom, a fill a quarter up,
 lines on top half way up."""
 FILL_M, TOP_M = LAYER_STEP_M / 4, LAYER_STEP_M / 2
-LAYERS = ("goal", "robot", "path", "plane", "closest", "objective", "start", "collision")
+LAYERS = ("goal", "robot", "path", "plane", "arrow", "closest", "objective", "start", "collision")
 """The marks from the bottom up."""
 MAX_PATH_SEGMENTS = 3000
 PATH_PX = 4.0
@@ -42,6 +42,9 @@ dot (a mode of one tick on the way is not)."""
 START_RADIUS_PX, OBJECTIVE_RADIUS_PX, RIM_PX = 8.0, 6.0, 2.0
 PLANE_PX, DASH_PX, GAP_PX = 5.0, 10.0, 6.0
 CROSS_HALF_PX, CROSS_PX = 7.0, 3.0
+ARROW_LENGTH_PX, ARROW_HALF_WIDTH_PX = 16.0, 7.0
+ARROW_SPACING_PX = 120.0
+"""Path length (px) between two arrowheads along a stretch in one mode."""
 ROBOT_AT_END = dataclasses.replace(palette.ROBOT, label="robot at the end")
 
 
@@ -61,6 +64,9 @@ def track_marks(scenario: Scenario, track: Track, metres_per_px: float) -> list[
     points = _decimated(track.positions)
     modes = [track.modes[k] for k in points.index[:-1]]
     drawn += _path(points, modes, px)
+    arrows = _arrows(points.xy, modes, px)
+    if arrows:
+        drawn.append((palette.DIRECTION, arrows))
     if track.objectives:
         radius = OBJECTIVE_RADIUS_PX * px
         objectives = [
@@ -118,6 +124,41 @@ def _path(points: _Polyline, modes: list[str], px: float) -> list[Drawn]:
             dot = Disc(stretch.mean(axis=0), PATH_PX * px, palette.path_mark(modes[first]).rgba, z + TOP_M)
             by_mode[modes[first]].append(dot)
     return [(palette.path_mark(mode), shapes) for mode, shapes in by_mode.items()]
+
+
+def _arrows(xy: np.ndarray, modes: list[str], px: float) -> list[Shape]:
+    """Arrowheads along each stretch of the path (N, 2; m) in one mode: one every
+    ARROW_SPACING_PX, evenly spread, or one at the middle of a stretch shorter than that but
+    twice an arrowhead's length."""
+    arrows: list[Shape] = []
+    for first, last in _stretches(modes):
+        stretch = xy[first : last + 1]
+        along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(stretch, axis=0).T))))
+        length = along[-1]
+        if length < 2 * ARROW_LENGTH_PX * px:
+            continue
+        count = max(1, int(length // (ARROW_SPACING_PX * px)))
+        for s in (np.arange(count) + 0.5) * length / count:
+            arrow = _arrowhead(stretch, along, s, px)
+            if arrow is not None:
+                arrows.append(arrow)
+    return arrows
+
+
+def _arrowhead(xy: np.ndarray, along: np.ndarray, s: float, px: float) -> Triangle | None:
+    """The arrowhead centred `s` (m) along a polyline (N, 2; m) whose points lie `along` it (m),
+    pointing along its chord across the arrowhead's length (a jittering robot's small turns do
+    not swing it); None where that chord is too short to say (the robot turned on the spot)."""
+    half = ARROW_LENGTH_PX * px / 2
+    back, front = (np.array([np.interp(t, along, xy[:, k]) for k in (0, 1)]) for t in (s - half, s + half))
+    chord = float(np.hypot(*(front - back)))
+    if chord < half:
+        return None
+    ahead = (front - back) / chord
+    side = np.array((-ahead[1], ahead[0])) * ARROW_HALF_WIDTH_PX * px
+    centre = (back + front) / 2
+    tip, base = centre + ahead * half, centre - ahead * half
+    return Triangle(np.array((tip, base + side, base - side)), palette.DIRECTION.rgba, layer_z("arrow"))
 
 
 def _disc(center, radius_m: float, mark: Mark, layer: str, px: float) -> list[Shape]:
