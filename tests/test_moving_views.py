@@ -260,7 +260,7 @@ def test_the_video_moves_the_obstacles(run):
     contents, scenario = run["contents"], run["scenario"]
     timeline = timeline_from_log(run["path"], contents)
     np.testing.assert_array_equal(timeline.obstacles, contents.obstacle_places)
-    canvas = FrameCanvas(scenario, timeline, 0.11, 480, 1.0)
+    canvas = FrameCanvas(scenario, timeline, 480, 1.0)
     width, height = canvas.size
     frames, centres = [], []
     for t in (0.5, 2.5):

@@ -12,7 +12,6 @@ from vplane_mj.cli import main
 from vplane_mj.logs.reader import read_log
 from vplane_mj.logs.replay import load_log
 from vplane_mj.logs.timeline import timeline_from_log
-from vplane_mj.logs.writer import METADATA_NAME
 from vplane_mj.planning.protocol.events import EventKind
 from vplane_mj.viz import palette
 from vplane_mj.viz.video import FrameCanvas
@@ -130,8 +129,7 @@ def canvas_of(log, **changes) -> FrameCanvas:
     """The 720 px video canvas of a log, its timeline changed by `changes`."""
     contents, scenario = load_log(log)
     timeline = dataclasses.replace(timeline_from_log(log, contents), **changes)
-    radius = float(contents.metadata[METADATA_NAME]["robot_radius_m"])
-    return FrameCanvas(scenario, timeline, radius, 720, 1.0)
+    return FrameCanvas(scenario, timeline, 720, 1.0)
 
 
 def frame_at(canvas: FrameCanvas, time_s: float) -> np.ndarray:
@@ -148,6 +146,33 @@ def rgb(rgba) -> tuple[int, int, int]:
 def count(pixels: np.ndarray, colour, within: int = 0) -> int:
     """The pixels of `colour`, each channel off by at most `within` (lines are antialiased)."""
     return int((np.abs(pixels.reshape(-1, 3).astype(int) - rgb(colour)) <= within).all(axis=1).sum())
+
+
+def test_the_video_s_legend_names_every_mark_it_shows(logged):
+    canvas = canvas_of(logged / "paper_c_escape-vplane-0.mcap")
+    (legend,) = canvas.figure.legends
+    forces = ("attractive", "repulsive", "total")  # no plane before 6 s: no virtual force
+    marks = [
+        palette.OBSTACLE,
+        palette.START,
+        palette.GOAL,
+        palette.path_mark("normal"),
+        palette.path_mark("escaping"),  # from 5.45 s on
+        palette.OBJECTIVE,
+        dataclasses.replace(palette.ECHO, label="sonar echo"),
+        palette.ROBOT,
+        *(palette.force_mark(name) for name in forces),
+    ]
+    assert [text.get_text() for text in legend.get_texts()] == [mark.label for mark in marks]
+    (x0, y0), (x1, y1) = canvas.axes.get_window_extent().get_points()
+    for time_s, shown in (
+        (3.0, [m for m in marks if m.label not in ("path: escaping", "virtual objective")]),
+        (TIME_LIMIT_S - 0.2, [palette.OBJECTIVE]),
+    ):
+        frame = frame_at(canvas, time_s)
+        plot = frame[round(frame.shape[0] - y1) : round(frame.shape[0] - y0), round(x0) : round(x1)]
+        for mark in shown:  # each mark's colour shows in the plot, not only in the legend
+            assert count(plot, mark.rgba, within=24) >= 3, (time_s, mark.label)
 
 
 def test_the_video_draws_the_start_above_a_virtual_plane_that_crosses_it(logged):

@@ -87,6 +87,11 @@ def path_mark(mode: str) -> Mark:
     return Mark(f"path: {mode}", MODE_RGBA.get(mode, OTHER_MODE_RGBA), "line")
 
 
+def force_mark(name: str) -> Mark:
+    """The mark of the force arrow `name` (attractive, repulsive, virtual or total)."""
+    return Mark(f"force: {name}", FORCE_RGBA[name], "arrow", rim=BLACK)
+
+
 def trace_mark(label: str) -> Mark:
     """The mark of the moving obstacles' traces (render) or trails (video), labelled `label`."""
     return Mark(label, TRACE_RGBA, "fading")

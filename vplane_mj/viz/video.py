@@ -4,8 +4,9 @@ Each frame shows the arena and its obstacles around the start, the goal and the 
 (the whole arena when that is most of it), start and goal, the path so far coloured by
 planner mode, the virtual planes and objective, the moving obstacles where they stand with
 their trails of the last `TRAIL_S` (fading with age), the sensor's echoes, the force arrows as
-logged, the robot's disc and heading, the latest events as a caption and the simulated time;
-in the colours of the render (`vplane_mj.viz.palette`).
+logged, the robot's footprint and heading, a legend of every mark the video shows, the latest
+events as a caption and the simulated time; in the colours of the render
+(`vplane_mj.viz.palette`).
 Frame k shows the last control tick at or before k * speed / fps simulated seconds; the
 last frame is held for `END_HOLD_S` so the end can be seen. Matplotlib (Agg) draws
 the frames, blitting everything that moves over a cached background; imageio-ffmpeg's
@@ -39,12 +40,13 @@ from vplane_mj.geometry import shapes
 from vplane_mj.geometry.motion import Moving
 from vplane_mj.logs.replay import load_log
 from vplane_mj.logs.timeline import FORCE_NAMES, Timeline, timeline_from_log
-from vplane_mj.logs.writer import METADATA_NAME
+from vplane_mj.robots.facts import robot_body
 from vplane_mj.scenario import Scenario
 from vplane_mj.terminal import Progress
 from vplane_mj.viz import palette
 from vplane_mj.viz.moving_marks import TRACE_JUMP_M
 from vplane_mj.viz.palette import MODE_RGBA, OTHER_MODE_RGBA, TRACE_RGBA, Mark
+from vplane_mj.viz.video_legend import draw_legend, legend_height_px, video_marks
 
 
 @dataclass(frozen=True)
@@ -60,7 +62,9 @@ class VideoFormat:
 
 FORMATS = {
     ".mp4": VideoFormat(25, 720, "libx264", "yuv420p", ("-preset", "veryfast", "-crf", "26", "-f", "mp4")),
-    # One palette for the whole GIF (the frames differ little), a dither without noise.
+    # One palette for the whole GIF, from every frame whole (counting only what changes would
+    # leave out the colours of the legend and of what is drawn once, the path's), a dither
+    # without noise.
     ".gif": VideoFormat(
         10,
         480,
@@ -68,7 +72,7 @@ FORMATS = {
         "pal8",
         (
             "-filter_complex",
-            "split[a][b];[a]palettegen=max_colors=64:stats_mode=diff[p];"
+            "split[a][b];[a]palettegen=max_colors=64:stats_mode=full[p];"
             "[b][p]paletteuse=dither=bayer:bayer_scale=5:diff_mode=rectangle",
             "-loop",
             "0",
@@ -126,8 +130,7 @@ def write_video(log: Path, target: Path, speed: float = 1.0, show_progress: bool
             f"--speed: {frames} frames at {speed:g}x is too long a video (at most {MAX_FRAMES}); "
             "raise --speed"
         )
-    radius = float(contents.metadata[METADATA_NAME]["robot_radius_m"])
-    canvas = FrameCanvas(scenario, timeline, radius, fmt.width_px, speed)
+    canvas = FrameCanvas(scenario, timeline, fmt.width_px, speed)
     progress = Progress(target.name, frames + hold, "frames") if show_progress else None
 
     def encode(temporary: Path) -> None:
@@ -164,25 +167,26 @@ def write_video(log: Path, target: Path, speed: float = 1.0, show_progress: bool
 class FrameCanvas:
     """The figure of one run: a static background drawn once, the moving parts per frame."""
 
-    def __init__(
-        self, scenario: Scenario, timeline: Timeline, robot_radius_m: float, width_px: int, speed: float
-    ):
+    def __init__(self, scenario: Scenario, timeline: Timeline, width_px: int, speed: float):
         self.timeline = timeline
         self.speed = speed
+        marks = video_marks(scenario, timeline)
         (x0, x1), (y0, y1) = view = _view(scenario, timeline)
         aspect = min(max((y1 - y0) / (x1 - x0), 0.5), 1.6)
         top_px, bottom_px = round(0.06 * width_px), round(0.09 * width_px)  # title and time; caption
-        plot_px = 0.98 * width_px * aspect
-        height_px = 2 * round((top_px + plot_px + bottom_px) / 2)  # even, as H.264 wants
+        plot_px, legend_px = 0.98 * width_px * aspect, legend_height_px(marks, width_px)
+        height_px = 2 * round((top_px + plot_px + legend_px + bottom_px) / 2)  # even, as H.264 wants
         self.size = (width_px, height_px)
         self.figure = plt.figure(figsize=(width_px / 100, height_px / 100), dpi=100)
         top, bottom = 1 - top_px / height_px, bottom_px / height_px
-        axes = self.figure.add_axes((0.01, bottom, 0.98, top - bottom))
+        legend_top = (bottom_px + legend_px) / height_px
+        axes = self.figure.add_axes((0.01, legend_top, 0.98, top - legend_top))
         axes.set(xlim=view[0], ylim=view[1], aspect="equal", anchor="C")
         axes.set_axis_off()
         self.axes = axes
         _draw_world(axes, scenario)
         font = max(7.0, width_px / 70)
+        draw_legend(self.figure, marks, legend_top, font * 0.9)
         self.figure.text(
             0.02,
             (1 + top) / 2,
@@ -192,13 +196,36 @@ class FrameCanvas:
             weight="bold",
         )
         self._animated: list[Artist] = []
+        self._add_run_artists(scenario, timeline, font)
+        self.clock = self.figure.text(
+            0.98, (1 + top) / 2, "", ha="right", va="center", fontsize=font, family="monospace"
+        )
+        self._animated.append(self.clock)
+        self.caption = self.figure.text(0.5, bottom / 2, "", ha="center", va="center", fontsize=font * 0.9)
+        self.caption.set_animated(True)
+        self._caption_box = Bbox([[0, 0], [width_px, bottom_px]])
+        for artist in self._animated:
+            artist.set_animated(True)
+        canvas = self.figure.canvas
+        assert isinstance(canvas, FigureCanvasAgg)  # the backend chosen above: blitting, pixels
+        self.canvas = canvas
+        canvas.draw()
+        self._background = canvas.copy_from_bbox(self.figure.bbox)
+        self._path_drawn = 0  # path segments already in the background
+        self._caption_shown: tuple[str, object] | None = None  # the caption text and its pixels
+
+    def _add_run_artists(self, scenario: Scenario, timeline: Timeline, font: float) -> None:
+        """What changes from frame to frame, in the order drawn: the path (into the background),
+        the virtual planes and objective, the start over them, the moving obstacles, the echoes,
+        the robot and its heading, the force arrows."""
+        axes = self.axes
         self.path = self._add(LineCollection([], linewidths=2.2, capstyle="round"))
         dashes = (0, (2, 1.2))
         self.planes = self._add(
             LineCollection([], colors=[palette.PLANE.rgba], linewidths=3, linestyles=dashes)
         )
         self.objective = self._add(_disc_marker(axes, palette.OBJECTIVE, font * 1.1))
-        self.start = self._add(_disc_marker(axes, palette.START, font * 1.2))  # over the planes
+        self.start = self._add(_disc_marker(axes, palette.START, font * 1.2))
         self.start.set_data([scenario.robot.start[0]], [scenario.robot.start[1]])
         self.moving = None
         if scenario.world.moving and timeline.obstacles is not None:
@@ -206,7 +233,9 @@ class FrameCanvas:
             self._animated += self.moving.artists
         self.echoes = self._add(axes.scatter([], [], s=font * 1.2, color=[palette.ECHO.rgba], zorder=7))
         robot = palette.ROBOT
-        self.body = self._add(Circle((0, 0), robot_radius_m, fc=robot.rgba, ec=robot.rim, lw=1.2, zorder=8))
+        self.footprint = robot_body(scenario.robot.profile).footprint
+        self.front_m = float(self.footprint[:, 0].max())
+        self.body = self._add(Polygon(self.footprint, fc=robot.rgba, ec=robot.rim, lw=1.2, zorder=8))
         (self.heading,) = axes.plot([], [], color=robot.rim, lw=1.5, zorder=9)
         self._animated.append(self.heading)
         self.forces = axes.quiver(
@@ -228,28 +257,11 @@ class FrameCanvas:
             zorder=10,
         )
         self._animated.append(self.forces)
-        self.clock = self.figure.text(
-            0.98, (1 + top) / 2, "", ha="right", va="center", fontsize=font, family="monospace"
-        )
-        self._animated.append(self.clock)
-        self.caption = self.figure.text(0.5, bottom / 2, "", ha="center", va="center", fontsize=font * 0.9)
-        self.caption.set_animated(True)
-        self._caption_box = Bbox([[0, 0], [width_px, bottom_px]])
-        for artist in self._animated:
-            artist.set_animated(True)
-        self.robot_radius_m = robot_radius_m
-        canvas = self.figure.canvas
-        assert isinstance(canvas, FigureCanvasAgg)  # the backend chosen above: blitting, pixels
-        self.canvas = canvas
-        canvas.draw()
-        self._background = canvas.copy_from_bbox(self.figure.bbox)
-        self._path_drawn = 0  # path segments already in the background
-        self._caption_shown: tuple[str, object] | None = None  # the caption text and its pixels
 
     def _add(self, artist):
         if isinstance(artist, LineCollection):
             self.axes.add_collection(artist)
-        elif isinstance(artist, Circle):
+        elif isinstance(artist, Patch):
             self.axes.add_patch(artist)
         self._animated.append(artist)
         return artist
@@ -268,9 +280,10 @@ class FrameCanvas:
         if self.moving is not None:
             self.moving.show(k)
         self.echoes.set_offsets(tl.echoes[k] if len(tl.echoes[k]) else np.empty((0, 2)))
-        self.body.center = (x, y)
-        r = self.robot_radius_m
-        self.heading.set_data([x, x + r * math.cos(yaw)], [y, y + r * math.sin(yaw)])
+        c, s = math.cos(yaw), math.sin(yaw)
+        self.body.set_xy(self.footprint @ np.array([[c, s], [-s, c]]) + (x, y))
+        front = self.front_m
+        self.heading.set_data([x, x + front * c], [y, y + front * s])
         arrows = np.array([tl.forces[k].get(name, (x, y, np.nan, np.nan)) for name in FORCE_NAMES])
         self.forces.set_offsets(arrows[:, :2])
         self.forces.set_UVC(arrows[:, 2], arrows[:, 3])
