@@ -15,6 +15,7 @@ import dataclasses
 import enum
 import importlib
 import inspect
+import itertools
 import json
 import os
 import re
@@ -28,7 +29,10 @@ from decimal import ROUND_HALF_UP, Decimal
 from pathlib import Path
 from typing import Any
 
+import imageio_ffmpeg
+import numpy as np
 import pytest
+from PIL import Image
 
 import vplane_mj
 import vplane_mj.planning
@@ -299,6 +303,23 @@ def test_a_command_of_the_page_exits_0_and_prints_and_writes_what_it_shows(sessi
         if line.startswith("wrote "):
             path = home / line.removeprefix("wrote ")
             assert path.is_file() and path.stat().st_size > 0, path
+
+
+@pytest.mark.slow  # the page's commands, as above
+def test_getting_started_takes_a_frame_and_a_gif_out_of_a_video_with_the_installed_ffmpeg(sessions):
+    home, _ = sessions("getting-started")
+    assert any("imageio_ffmpeg.get_ffmpeg_exe()" in step.command for step in STEPS["getting-started"])
+    reader = imageio_ffmpeg.read_frames(str(home / "run.mp4"))
+    width, height = next(reader)["size"]
+    (fifth_second,) = itertools.islice(reader, 5 * 25, 5 * 25 + 1)  # the frame at 5 s, 25 a second
+    reader.close()
+    with Image.open(home / "frame.png") as png:
+        assert png.format == "PNG" and png.size == (width, height)
+        frame = np.asarray(png.convert("RGB"))
+    assert np.array_equal(frame, np.frombuffer(fifth_second, np.uint8).reshape(height, width, 3))
+    with Image.open(home / "clip.gif") as gif:
+        assert gif.format == "GIF" and gif.size[0] == 480 and gif.info.get("loop") == 0
+        assert gif.n_frames == 4 * 10  # 4 s at 10 frames a second
 
 
 def test_shown_output_must_match_what_was_printed():
