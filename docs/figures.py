@@ -6,7 +6,8 @@
 2. the escape geometry inside the trap: e1, e2, the bisector, the virtual new objective
    and the virtual plane (Algorithm 2);
 3. the total force around the trap with the virtual plane in place (eqs. 8-10);
-4. top-down renders of the four paper scenarios with `vplane`.
+4. top-down renders of the four paper scenarios with `vplane`, and of `paper_c_escape` with
+   `apf`, as `vplane-mj run` writes them.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from vplane_mj.planning.protocol.registry import make_planner
 from vplane_mj.planning.protocol.types import Observation
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.loop import run_scenario
-from vplane_mj.viz.render import render_top_view, write_png
+from vplane_mj.viz.render import render_top_view, run_caption, write_png
 
 RADIUS = 0.11
 CUP = shapes.Cup((5.0, 5.0), width=1.6, depth=1.2, thickness=0.1)
@@ -150,10 +151,22 @@ def plane_field_figure(path: Path) -> None:
     plt.close(fig)
 
 
+RENDERS = (
+    ("paper_c_avoid", "vplane"),
+    ("paper_c_escape", "vplane"),
+    ("paper_c_escape", "apf"),
+    ("paper_h_avoid", "vplane"),
+    ("paper_h_escape", "vplane"),
+)
+"""The runs whose renders the pages show: scenario, planner (seed 0)."""
+
+
 def renders(out: Path) -> None:
-    for name in ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape"):
-        scenario = load_scenario(name)
-        write_png(render_top_view(scenario, run_scenario(scenario).track()), out / f"{name}-vplane-0.png")
+    for name, planner in RENDERS:
+        scenario = load_scenario(name, [f"planner.name={planner}"])
+        result = run_scenario(scenario)
+        image = render_top_view(scenario, result.track(), run_caption(result.summary))
+        write_png(image, out / f"{name}-{planner}-0.png")
 
 
 def main() -> int:
