@@ -97,6 +97,6 @@ def test_the_summary_measures_the_belief_of_the_final_instant(pose):
     summary = run.summary()
     odometry = run.localiser.odometry
     measured = (odometry.x, odometry.y)
-    run.localiser.pose(run.position, run.yaw)
+    run.localiser.pose(run.position, run.drive.yaw())
     assert (odometry.x, odometry.y) == measured
     assert summary.odometry_error_m == pytest.approx(math.dist(measured, run.position), abs=1e-12)

@@ -488,7 +488,7 @@ class Run:
         odometry errors compare it with the true pose there, not with the one a tick before)
         and show the observers the state it ended in."""
         self.ending = ending
-        self.localiser.pose(self.position, self.yaw)
+        self.localiser.pose(self.position, self.drive.yaw())
         self._note(ending.event)
         self.clearance.flush()
         if self.observers and (not self.times or self.data.time > self.times[-1]):
