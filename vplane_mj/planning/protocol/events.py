@@ -8,8 +8,11 @@ from the log without reading the text (`vplane_mj.logs.replay`).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
+
+import numpy as np
 
 
 class EventKind(StrEnum):
@@ -96,11 +99,11 @@ class Event:
         return self.text
 
 
-def point(xy) -> tuple[float, float]:
+def point(xy: Sequence[float] | np.ndarray) -> tuple[float, float]:
     """A point for an event's data.
 
     Args:
-        xy: A plane point (m), any pair of numbers.
+        xy: A plane point (m): a pair of numbers or an array of two.
 
     Returns:
         (x, y) as plain floats, rounded to the millimetre.
