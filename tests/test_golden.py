@@ -69,7 +69,7 @@ def environment() -> dict[str, str]:
         "numpy": np.__version__,
         "numba": numba.__version__,
         "machine": platform.machine(),
-        "numpy_avx512": "yes" if "X86_V4" in numpy_dispatch_targets() else "no",
+        "numpy_avx512": "yes" if _cpu_features().get("X86_V4") else "no",
         "kernels_cpu": compiled_for_cpu(),
         "libm": libm(),
     }
@@ -84,21 +84,13 @@ def libm() -> str:
 
 
 def _cpu_features() -> dict[str, bool]:
-    """What numpy found the CPU to have (empty where it cannot say)."""
+    """What numpy found the CPU to have, its dispatch targets among them (X86_V4: its AVX-512
+    routines); empty where it cannot say (numpy before 2.0)."""
     try:
         from numpy._core._multiarray_umath import __cpu_features__
     except ImportError:
         return {}
     return dict(__cpu_features__)
-
-
-def numpy_dispatch_targets() -> list[str]:
-    """The optimised code paths numpy chose on this CPU (e.g. X86_V3, X86_V4, AVX512_SKX)."""
-    try:
-        from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
-    except ImportError:  # numpy before 2.0 (another environment than the recorded one anyway)
-        return ["unknown"]
-    return [target for target in __cpu_dispatch__ if __cpu_features__.get(target)]
 
 
 def worlds() -> list[tuple[str, str]]:
