@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from vplane_mj.bench import report as bench_report
-from vplane_mj.bench.sweep import family_of
+from vplane_mj.bench.sweep import family_of, summarize
 from vplane_mj.scenario import load_scenario
 
 
@@ -101,7 +101,9 @@ def page():
     tomls = {r["key"]: scenario.to_toml() for r in ROWS[:5]}  # the last run's scenario is unknown
     rows = [dict(r, path_xy=[[4.2, 5.2], [3.8, 5.2], [3.7, 6.1]]) for r in ROWS[:-1]] + [ROWS[-1]]
     table = [{"planner": "vplane", "runs": 4, "success_rate": 0.75}, {"planner": "apf", "runs": 2}]
-    text = bench_report.write_html_text(rows, table, tomls, {"a figure": b"\x89PNG fake"})
+    text = bench_report.write_html_text(
+        rows, table, summarize(rows, by_scenario=True), tomls, {"a figure": b"\x89PNG fake"}
+    )
     parser = Tags()
     parser.feed(text)
     return text, parser

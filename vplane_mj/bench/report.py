@@ -205,10 +205,12 @@ def png_bytes(figure: plt.Figure) -> bytes:
 def write_html_text(
     rows: list[dict],
     table: list[dict],
+    scenario_table: list[dict],
     scenario_tomls: dict[str, str],
     figures: dict[str, bytes],
 ) -> str:
-    """The page: `scenario_tomls` maps a row's key to its scenario's TOML text, `figures` a
+    """The page: `table` per planner, `scenario_table` per scenario and planner,
+    `scenario_tomls` maps a row's key to its scenario's TOML text, `figures` a
     title to PNG bytes. Everything is inline; nothing is loaded from anywhere."""
     symbols, symbol_of = _scenario_symbols(rows, scenario_tomls)
     images = "".join(
@@ -232,7 +234,7 @@ def write_html_text(
 <p>{html.escape(TABLE_BASIS[0].upper() + TABLE_BASIS[1:])}.</p>
 {_table_html(table)}
 <h2>Per scenario</h2>
-{_table_html(summarize(rows, by_scenario=True))}
+{_table_html(scenario_table)}
 <h2>Figures</h2>
 {images}
 <h2>Every run</h2>
@@ -391,13 +393,15 @@ svg.defs { position: absolute; width: 0; height: 0; }
 
 
 def write_outputs(rows: list[dict], table: list[dict], out_dir: Path, jobs: list[Job]) -> list[Path]:
-    """bench.csv (one row per run), bench.json (rows and table), the figures and bench.html."""
+    """bench.csv (one row per run), bench.json (rows, table, table per scenario), the figures and
+    bench.html."""
     columns = sorted({key for row in rows for key in row if not isinstance(row[key], dict | list)})
+    scenario_table = summarize(rows, by_scenario=True)
     written = [
         write_csv(out_dir / "bench.csv", rows, columns),
         write_json(
             out_dir / "bench.json",
-            {"format": 1, "rows": rows, "table": table, "scenario_table": summarize(rows, by_scenario=True)},
+            {"format": 1, "rows": rows, "table": table, "scenario_table": scenario_table},
         ),
     ]
     figures = {
@@ -409,6 +413,7 @@ def write_outputs(rows: list[dict], table: list[dict], out_dir: Path, jobs: list
     page = write_html_text(
         rows,
         table,
+        scenario_table,
         {job.key: job.toml for job in jobs},
         {
             "success per planner and family, times to goal, path ratios": figures["bench.png"],
