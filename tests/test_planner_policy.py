@@ -4,6 +4,7 @@ either kind of action; it refuses what it cannot do; and dm_control's viewer run
 runtime, the part of the viewer that steps the environment, here without a window)."""
 
 import warnings
+from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
@@ -13,10 +14,12 @@ from vplane_mj import VPlaneError
 from vplane_mj.envs import PlannerPolicy, VPlaneNavDmEnv
 from vplane_mj.planning.planners.bug2 import Bug2Planner
 from vplane_mj.planning.planners.vplane import VPlanePlanner
-from vplane_mj.planning.protocol.plugins import PlannerError
-from vplane_mj.planning.protocol.registry import PLANNERS
+from vplane_mj.planning.protocol.plugins import PlannerError, import_planner
+from vplane_mj.planning.protocol.registry import PLANNERS, register_planner
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.loop import run_scenario
+
+EXAMPLES = Path(__file__).parents[1] / "examples"
 
 
 def drive(env, policy):
@@ -133,3 +136,17 @@ def test_dm_controls_viewer_runs_the_policy_and_restarts_with_the_next_episode()
         while viewer.state is not runtime.State.STOPPED:
             viewer.tick(5.0, paused=False)
         assert env.info["summary"]["outcome"] == "reached" and env.info["summary"]["seed"] == 1
+
+
+def test_an_own_planner_is_governed_as_in_a_run(own_registry):
+    """go_to_goal on the Jackal: the policy's episode is the run's trajectory, governed."""
+    planner = import_planner(str(EXAMPLES / "go_to_goal_planner.py") + ":GoToGoalPlanner")
+    register_planner(planner)
+    overrides = ("robot.profile=jackal", "run.time_limit_s=8")
+    with VPlaneNavDmEnv("paper_c_escape", action="velocity", overrides=overrides) as env:
+        drive(env, PlannerPolicy(env, planner))
+        summary = env.info["summary"]
+    governed = run_digest("paper_c_escape", *overrides, "planner.name=go_to_goal")
+    free = run_digest("paper_c_escape", *overrides, "planner.name=go_to_goal", "planner.governor=false")
+    assert governed != free
+    assert (summary["trajectory_sha256"], summary["outcome"]) == governed

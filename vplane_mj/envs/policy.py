@@ -20,6 +20,7 @@ import dm_env
 import numpy as np
 
 from vplane_mj.errors import VPlaneError
+from vplane_mj.planning.planners.run_governor import RunGovernor
 from vplane_mj.planning.protocol.base import Planner
 from vplane_mj.planning.protocol.plugins import PlannerError, planner_problem
 from vplane_mj.planning.protocol.registry import PLANNERS, unknown_planner
@@ -34,7 +35,9 @@ if TYPE_CHECKING:
 
 class PlannerPolicy:
     """Drives `environment` with a planner; every episode gets a fresh planner for its robot
-    (profile, footprint, limits, sensor kind).
+    (profile, footprint, limits, sensor kind), whose forces are driven through the run's
+    governor as `vplane-mj run` drives them (a planner of your own, unless the scenario says
+    `planner.governor = false`).
 
     Args:
         environment: A VPlaneNavDmEnv, or a wrapper of one.
@@ -59,6 +62,7 @@ class PlannerPolicy:
         self.params = params
         self._run: Run | None = None
         self._planner: Planner | None = None
+        self._governor: RunGovernor | None = None
 
     def __call__(self, time_step: dm_env.TimeStep) -> np.ndarray:
         """The action for the tick that `time_step` begins. On a LAST step (no episode goes on)
@@ -68,12 +72,16 @@ class PlannerPolicy:
             return np.zeros(2)
         if run is not self._run:  # a new episode
             self._run, self._planner = run, self._planner_for(run)
+            self._governor = RunGovernor.offered(self._planner, run.scenario.planner_governor)
         assert self._planner is not None, "made for this episode above"
-        return self._action(self._planner.step(observation), observation, run)
+        decision = self._planner.step(observation)
+        if self._governor is not None:  # as a run drives it (`vplane_mj.planning.RunGovernor`)
+            self._governor.drive(decision, observation)
+        return self._action(decision, observation, run)
 
     def reset(self) -> None:
         """Forget the episode's planner (dm_control.viewer calls this when it restarts)."""
-        self._run = self._planner = None
+        self._run = self._planner = self._governor = None
 
     def _planner_for(self, run: Run) -> Planner:
         """A fresh planner for the robot of the run's scenario."""
