@@ -12,11 +12,14 @@ from vplane_mj.sim.odometry import WheelOdometry
 from vplane_mj.sim.world import ROBOT_PREFIX, build_model, standalone_xml
 
 WHEEL_RADIUS, TRACK = 0.04, 0.15
-SENSOR_AND_ACTUATION_FAULTS = (
+SENSOR_FAULTS = (
     "sensors.noise_std=0.02",
     "sensors.dropout=0.1",
     "sensors.crosstalk=0.03",
     "sensors.dead=[3, 11]",
+)
+SENSOR_AND_ACTUATION_FAULTS = (
+    *SENSOR_FAULTS,
     "robot.wheel_friction=0.7",
     "robot.motor_gain=[1.0, 0.8]",
     "robot.motor_bias_nm=[0.01, 0.0]",
@@ -118,10 +121,21 @@ def test_vplane_escapes_the_paper_traps_with_every_sensor_and_actuation_fault(sh
     assert summary.escapes >= 1 and summary.path_ratio < 2.5
 
 
-def test_vplane_escapes_on_odometry_alone_with_every_fault_on(shipped):
-    summary = sim.run_scenario(shipped("paper_h_escape", *SENSOR_AND_ACTUATION_FAULTS, *ODOMETRY)).summary
+def test_vplane_escapes_on_odometry_alone_with_every_sensor_fault_on(shipped):
+    summary = sim.run_scenario(shipped("paper_h_escape", *SENSOR_FAULTS, *ODOMETRY)).summary
     assert summary.outcome == "reached" and summary.success, summary
     assert 0.0 < summary.odometry_error_m < 0.15
+
+
+def test_with_every_fault_on_the_ekf_holds_the_pose_that_odometry_alone_loses(shipped):
+    # Slipping wheels and a weak, biased motor turn the robot in ways its encoders do not see.
+    def run(pose):
+        faults = (*SENSOR_AND_ACTUATION_FAULTS, f'sensors.pose="{pose}"', "sensors.odometry_noise=0.005")
+        return sim.run_scenario(shipped("paper_h_escape", *faults)).summary
+
+    fused, dead_reckoned = run("ekf"), run("odometry")
+    assert fused.outcome == "reached" and fused.success, fused
+    assert fused.odometry_error_m < 0.15 < dead_reckoned.odometry_error_m
 
 
 def test_a_robot_lost_by_its_odometry_stops_as_stuck_with_the_reason(shipped):

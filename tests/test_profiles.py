@@ -305,6 +305,17 @@ def test_each_robot_turns_in_place_at_its_top_turn_rate(name):
         assert accel <= profile.limits.max_turn_accel_radps2 <= peak
 
 
+@pytest.mark.parametrize("share", [0.5, 1.0])
+def test_the_default_robots_odometry_is_calibrated_to_the_track_it_turns_on(share):
+    # Turning in place, the wheels' rims travel (track / 2) x the yaw rate each way: the track
+    # the model turns on, which the wheel odometry's separation must be for its heading to hold.
+    profile = PROFILES["default"]
+    run = drive_from_standing(profile, 0.0, share * profile.limits.max_turn_rate_radps, False, 4.0)
+    rim = run.steady(run.wheel_rate) * profile.wheel_radius_m
+    turned_on = 2 * (run.steady(run.speed) - rim) / run.steady(run.yaw_rate)
+    assert turned_on / profile.track_m == pytest.approx(profile.odometry_track_scale, abs=0.01)
+
+
 @pytest.mark.parametrize("name", [name for name in NAMES if PROFILES[name].ramped])
 def test_each_robot_stops_turning_its_turn_lag_after_its_ramp(name):
     # Turning in place, then stopped: the drive ramps the turn rate down at the top turn
