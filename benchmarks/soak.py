@@ -3,7 +3,7 @@
 `--count` scenarios (default 1000) are generated in turn from the families traps, clutter and
 corridors (`vplane_mj.worlds.families.generate`, seed `--seed`, only cases with a reference path),
 the planners are assigned round-robin, and each run gets its own random faults, each fault
-turned on independently with probability 1/2 (the odometry pose 1/4), drawn from the same
+turned on independently with probability 1/2 (the estimated pose 1/4), drawn from the same
 seed so the soak is reproducible:
 
 | fault | key | range |
@@ -15,13 +15,16 @@ seed so the soak is reproducible:
 | wheel slip | robot.wheel_friction | 0.2-1.0 |
 | motor gain, per wheel | robot.motor_gain | 0.5-1.0 |
 | motor bias, per wheel | robot.motor_bias_nm | -0.05-0.05 N m |
-| dead-reckoned pose | sensors.pose = "odometry", sensors.odometry_noise | 0-0.02 per tick |
+| estimated pose | sensors.pose = the first of `--poses`, sensors.odometry_noise | 0-0.02 per tick |
 
-Each run has the simulated time limit `--time-limit` (s). The runs go through the sweep of
-`vplane-mj bench` (`vplane_mj.bench.sweep.run_sweep`) with `--jobs` worker processes. A run that
-raises is a crash: its row has outcome `error` and the exception with where it was raised,
-its traceback goes to `OUT/failed/<scenario>-<planner>-<seed>.traceback.txt`, and the soak
-goes on. A worker process that dies (segfault, out of memory) fails only the run it had under
+With several `--poses` (`odometry`, `ekf`, and `truth`: the simulator's), each run that drew the
+estimated pose is also run with each of the others, all else the same: their success columns
+compare the planners on the same runs. The outcomes and the success per family count the runs
+as drawn, with the first pose. Each run has the simulated time limit `--time-limit` (s). The
+runs go through the sweep of `vplane-mj bench` (`vplane_mj.bench.sweep.run_sweep`) with `--jobs`
+worker processes. A run that raises is a crash: its row has outcome `error` and the exception
+with where it was raised, its traceback goes to
+`OUT/failed/<scenario>-<planner>-<seed>.traceback.txt`, and the soak goes on. A worker process that dies (segfault, out of memory) fails only the run it had under
 way, which is recorded as ended without a summary; a new worker takes its place. The scenario
 of every crash, run without a summary or `error` outcome is written beside it as `<...>.toml`
 (run it again with `vplane-mj run FILE`). The planned runs (scenario texts and faults;
@@ -32,12 +35,13 @@ generators).
 
 Prints and writes `OUT/soak.json` (runs, crashes, runs without a summary, outcomes per
 planner, success rate per planner and family, the `error` outcomes with their messages,
-wall times), the planners' table (runs, outcomes, success per family and with the true pose
-and with odometry) as `OUT/soak_planners.md`, `.csv` and `.json` (with the command and the
+wall times), the planners' table (runs, outcomes, success per family, on the true pose and on
+each of `--poses`) as `OUT/soak_planners.md`, `.csv` and `.json` (with the command and the
 date), and `OUT/soak.png` (outcomes per planner). Exit status 1 if any run crashed or
 ended without a summary, else 0.
 
-    python benchmarks/soak.py [--count 1000] [--seed 0] [--jobs 2] [--time-limit 60] [--out logs/soak]
+    python benchmarks/soak.py [--count 1000] [--seed 0] [--jobs 2] [--time-limit 60] [--poses odometry]
+        [--out logs/soak]
 """
 
 from __future__ import annotations
@@ -68,11 +72,17 @@ PLAN = "plan.json"
 TABLE = "soak_planners"
 """The planners' table: `soak_planners.md`, `.csv` and `.json` (`soak.json` has every figure)."""
 OUTCOMES = ("reached", "timeout", "stuck", "error")
-ODOMETRY_FAULT = 'sensors.pose="odometry"'
+POSES = ("odometry", "ekf", "truth")
+"""The poses `--poses` lists from."""
 
 
-def draw_faults(rng: np.random.Generator) -> list[str]:
-    """`--set` overrides for one run's faults (see the table above)."""
+def pose_fault(pose: str) -> str:
+    """The override that has the planner use `pose` (one of POSES)."""
+    return f'sensors.pose="{pose}"'
+
+
+def draw_faults(rng: np.random.Generator, pose: str) -> list[str]:
+    """`--set` overrides for one run's faults (see the table above), `pose` the estimated one."""
 
     def on(probability: float = 0.5) -> bool:
         return rng.random() < probability
@@ -97,12 +107,15 @@ def draw_faults(rng: np.random.Generator) -> list[str]:
     if on():
         faults.append(f"robot.motor_bias_nm={draw(-0.05, 0.05, 2)}")
     if on(0.25):
-        faults += [ODOMETRY_FAULT, f"sensors.odometry_noise={draw(0.0, 0.02)}"]
+        faults += [pose_fault(pose), f"sensors.odometry_noise={draw(0.0, 0.02)}"]
     return faults
 
 
-def plan_soak(count: int, seed: int, time_limit: float) -> list[tuple[Job, list[str]]]:
-    """The runs, each with its fault overrides: families in turn, planners round-robin."""
+def plan_soak(
+    count: int, seed: int, time_limit: float, poses: tuple[str, ...]
+) -> list[tuple[Job, list[str]]]:
+    """The runs, each with its fault overrides: families in turn, planners round-robin; a run
+    that drew the estimated pose (the first of `poses`) again with each of the others."""
     families = ["traps", "clutter", "corridors"]
     cases = {
         family: generate(family, len(range(k, count, len(families))), seed)
@@ -114,26 +127,31 @@ def plan_soak(count: int, seed: int, time_limit: float) -> list[tuple[Job, list[
     for index in range(count):
         case = cases[families[index % len(families)]][index // len(families)]
         planner = planners[index % len(planners)]
-        faults = draw_faults(fault_rng)
-        overrides = [
-            *faults,
-            f"planner.name={planner}",
-            f"run.seed={index}",
-            f"run.time_limit_s={time_limit}",
-        ]
-        scenario = parse_scenario(case.toml(), case.name, overrides)
-        runs.append((Job(case.name, planner, index, scenario.to_toml()), faults))
+        drawn = draw_faults(fault_rng, poses[0])
+        estimated = pose_fault(poses[0]) in drawn
+        for pose in poses if estimated else poses[:1]:
+            faults = [pose_fault(pose) if fault == pose_fault(poses[0]) else fault for fault in drawn]
+            overrides = [
+                *faults,
+                f"planner.name={planner}",
+                f"run.seed={index}",
+                f"run.time_limit_s={time_limit}",
+            ]
+            scenario = parse_scenario(case.toml(), case.name, overrides)
+            runs.append((Job(case.name, planner, index, scenario.to_toml()), faults))
     return runs
 
 
-def load_or_plan(path: Path, count: int, seed: int, time_limit: float) -> list[tuple[Job, list[str]]]:
+def load_or_plan(
+    path: Path, count: int, seed: int, time_limit: float, poses: tuple[str, ...]
+) -> list[tuple[Job, list[str]]]:
     """The runs as planned before in `path` with the same arguments, else planned and saved there."""
-    settings = {"count": count, "seed": seed, "time_limit_s": time_limit}
+    settings = {"count": count, "seed": seed, "time_limit_s": time_limit, "poses": list(poses)}
     if path.exists():
         plan = json.loads(path.read_text(encoding="utf-8"))
         if plan["settings"] == settings:
             return [(Job(**run["job"]), run["faults"]) for run in plan["runs"]]
-    runs = plan_soak(count, seed, time_limit)
+    runs = plan_soak(count, seed, time_limit, poses)
     write_json(path, {"settings": settings, "runs": [{"job": asdict(j), "faults": f} for j, f in runs]})
     return runs
 
@@ -147,33 +165,54 @@ def success_rate(rows: list[dict]) -> float | None:
     return sum(row["success"] for row in rows) / len(rows) if rows else None
 
 
-def report(runs: list[tuple[Job, list[str]]], rows: dict[str, dict], wall_s: float) -> dict:
-    """The soak's figures from the journal rows of its runs (by key)."""
+def report(
+    runs: list[tuple[Job, list[str]]], rows: dict[str, dict], wall_s: float, poses: tuple[str, ...]
+) -> dict:
+    """The soak's figures from the journal rows of its runs (by key), run with `poses`."""
     planners = sorted({job.planner for job, _ in runs})
     families = list(dict.fromkeys(family_of(job.scenario) for job, _ in runs))
     finished = [(job, rows[job.key]) for job, _ in runs]
     summaries = [(job, row) for job, row in finished if FAILURE_KEY not in row]
     crashes = [(job, row) for job, row in finished if row.get(FAILURE_KEY) == FailureKind.EXCEPTION]
     died = [(job, row) for job, row in finished if row.get(FAILURE_KEY) == FailureKind.WORKER_DIED]
+    on_pose = {pose: {job.key for job, faults in runs if pose_fault(pose) in faults} for pose in poses}
+    drawn = {job.key for job, _ in runs} - set().union(*(on_pose[pose] for pose in poses[1:]))
     outcomes = {planner: dict.fromkeys(OUTCOMES, 0) for planner in planners}
     success: dict[str, dict] = {planner: {} for planner in planners}
     for planner in planners:
         for family in families:
-            mine = [r for j, r in summaries if j.planner == planner and family_of(j.scenario) == family]
+            mine = [
+                r
+                for j, r in summaries
+                if j.key in drawn and j.planner == planner and family_of(j.scenario) == family
+            ]
             success[planner][family] = success_rate(mine)
             for row in mine:
                 outcomes[planner][row["outcome"]] += 1
-    on_odometry = {job.key for job, faults in runs if ODOMETRY_FAULT in faults}
     by_pose: dict[str, dict] = {planner: {} for planner in planners}
     for planner in planners:
-        for pose, odometry in (("true pose", False), ("odometry", True)):
-            mine = [r for j, r in summaries if j.planner == planner and (j.key in on_odometry) == odometry]
-            by_pose[planner][pose] = success_rate(mine)
-    odometry_errors = [r["odometry_error_m"] for j, r in summaries if j.key in on_odometry]
+        mine = [r for j, r in summaries if j.planner == planner]
+        true_pose = drawn - on_pose[poses[0]]
+        by_pose[planner]["true pose"] = success_rate([r for r in mine if r["key"] in true_pose])
+        for pose in poses:
+            by_pose[planner][pose] = success_rate([r for r in mine if r["key"] in on_pose[pose]])
+    pose_errors = {
+        pose: statistics.median(errors)
+        for pose in poses
+        if (
+            errors := [
+                r["odometry_error_m"] for j, r in summaries if j.key in on_pose[pose] and pose != "truth"
+            ]
+        )
+    }
     run_wall = [row["wall_time_s"] for _, row in summaries]
     return {
         "format": 1,
-        "runs": len(runs),
+        "runs": len(drawn),
+        "runs_per_planner": {
+            planner: sum(j.key in drawn and j.planner == planner for j, _ in runs) for planner in planners
+        },
+        "runs_with_every_pose": len(runs) - len(drawn),
         "crashes": [
             {"run": base_name(j), "planner": j.planner, "exception": r["message"]} for j, r in crashes
         ],
@@ -183,11 +222,11 @@ def report(runs: list[tuple[Job, list[str]]], rows: dict[str, dict], wall_s: flo
         "outcomes_per_planner": outcomes,
         "success_rate_per_planner_and_family": success,
         "success_rate_per_planner_and_pose": by_pose,
-        "odometry_error_m_median": statistics.median(odometry_errors) if odometry_errors else None,
+        "position_error_m_median_per_pose": pose_errors,
         "errors": [
             {"run": base_name(j), "message": r["message"]} for j, r in summaries if r["outcome"] == "error"
         ],
-        "faults_per_run_mean": sum(len(faults) for _, faults in runs) / len(runs),
+        "faults_per_run_mean": sum(len(faults) for job, faults in runs if job.key in drawn) / len(drawn),
         "wall_time_s": wall_s,
         "run_wall_time_s_total": sum(run_wall),
         "run_wall_time_s_mean": sum(run_wall) / len(run_wall) if run_wall else None,
@@ -196,16 +235,16 @@ def report(runs: list[tuple[Job, list[str]]], rows: dict[str, dict], wall_s: flo
 
 
 def planner_table(figures: dict) -> list[dict]:
-    """One row per planner: its runs, their outcomes, and its success per family and per pose
-    (`success_traps`, ..., `success_true_pose`, `success_odometry`)."""
-    failed = figures["crashes"] + figures["without_summary"]
+    """One row per planner: its runs as drawn, their outcomes, and its success per family and
+    per pose (`success_traps`, ..., `success_true_pose`, then `success_odometry` and so on for
+    each of `--poses`, on the same runs)."""
     table = []
     for planner, counts in figures["outcomes_per_planner"].items():
         rates = {
             **figures["success_rate_per_planner_and_family"][planner],
             **figures["success_rate_per_planner_and_pose"][planner],
         }
-        runs = sum(counts.values()) + sum(entry["planner"] == planner for entry in failed)
+        runs = figures["runs_per_planner"][planner]
         success = {f"success_{name.replace(' ', '_')}": rate for name, rate in rates.items()}
         table.append({"planner": planner, "runs": runs, **counts, **success})
     return table
@@ -239,8 +278,8 @@ def print_report(figures: dict, text: str) -> None:
     total, mean, longest = (figures[f"run_wall_time_s_{k}"] for k in ("total", "mean", "max"))
     print(f"\nwall time {figures['wall_time_s']:.0f} s; simulation loops {total:.0f} s in all", end="")
     print(f", {mean:.2f} s mean, {longest:.1f} s max per run" if mean is not None else "")
-    if figures["odometry_error_m_median"] is not None:
-        print(f"odometry's position error at the end: {figures['odometry_error_m_median']:.2f} m median")
+    for pose, error in figures["position_error_m_median_per_pose"].items():
+        print(f"the {pose} pose's position error at the end: {error:.2f} m median")
 
 
 def plot(figures: dict, path: Path) -> Path:
@@ -274,17 +313,27 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0, help="master seed of scenarios and faults")
     parser.add_argument("--time-limit", type=float, default=60.0, help="simulated seconds per run")
     parser.add_argument("--jobs", type=int, default=2, help="worker processes")
+    parser.add_argument(
+        "--poses",
+        default="odometry",
+        help="the estimated pose of a quarter of the runs, then others to compare",
+    )
     parser.add_argument("--out", type=Path, default=Path("logs/soak"))
     args = parser.parse_args(argv)
     if args.count < 1 or args.seed < 0 or args.jobs < 1:
         parser.error("--count and --jobs must be at least 1, --seed at least 0")
+    poses = tuple(args.poses.split(","))
+    if not set(poses) <= set(POSES) or len(set(poses)) != len(poses) or poses[0] == "truth":
+        parser.error(
+            f"--poses: distinct names of {', '.join(POSES)}, the first not truth; got {args.poses!r}"
+        )
 
     started = time.monotonic()
     try:
         prepare_out_dir(args.out)
     except VPlaneError as exc:
         parser.error(str(exc))
-    runs = load_or_plan(args.out / PLAN, args.count, args.seed, args.time_limit)
+    runs = load_or_plan(args.out / PLAN, args.count, args.seed, args.time_limit, poses)
     try:
         with signals_raise_interrupted():
             rows = run_sweep([job for job, _ in runs], args.out, args.jobs, journal_name=JOURNAL)
@@ -292,7 +341,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"\ninterrupted by {exc}: the same command goes on from here", file=sys.stderr)
         return exc.exit_status
 
-    figures = report(runs, {row["key"]: row for row in rows}, time.monotonic() - started)
+    figures = report(runs, {row["key"]: row for row in rows}, time.monotonic() - started, poses)
     table = planner_table(figures)
     text = markdown(table)
     print_report(figures, text)

@@ -153,12 +153,14 @@ def test_sweep_benchmarks_write_their_results(tmp_path):
     assert int(families["suite"]["runs"]) == 34 and families["paper"]["success_rate"] == "0.0"  # apf
     for script, arguments in (
         ("degradation.py", ("--cases", "2", "--noise", "0", "--dropout", "0.1", "--planners", "apf")),
-        ("soak.py", ("--count", "3")),
+        ("soak.py", ("--count", "3", "--pose", "ekf")),
     ):
         name = script.removesuffix(".py")
         out = run_benchmark(script, *arguments, "--time-limit", "5", "--out", name, cwd=tmp_path)
         assert f"wrote {name}/{name}.png" in out
         assert (tmp_path / name / f"{name}.png").stat().st_size > 1000
+    header = (tmp_path / "soak" / "soak_planners.csv").read_text(encoding="utf-8").splitlines()[0]
+    assert header.endswith("success_true_pose,success_ekf")
 
 
 def test_barn_protocol_sweeps_the_planners_beside_barns_published_figures(tmp_path):
