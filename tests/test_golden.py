@@ -7,14 +7,14 @@ architecture, whether numpy computes sines, arctangents and the like by its AVX-
 (which may differ in the last bit), the CPU model the kernels are compiled for (`generic`
 unless NUMBA_CPU_NAME chooses one) and what the C library's mathematical functions return
 (MuJoCo, the kernels and numpy call them), every run is compared exactly: its trajectory by its
-digest, bit for bit, its outcome, collisions, local minima and escapes, and its path length to
-`PATH_RTOL`. No product in a run goes through BLAS, so the kernels OpenBLAS picks for a CPU are
-not among them (docs/contributing.md says what was measured).
+digest, bit for bit, and its outcome, collisions, local minima, escapes and path length. No
+product in a run goes through BLAS, so the kernels OpenBLAS picks for a CPU are not among them
+(docs/contributing.md says what was measured).
 
 Elsewhere a last bit that differs grows, in a run that grinds along a wall or dithers in a
 trap, into another path; so there each run is held to what does not hang on last bits: whether
 it succeeds (reaches its goal without a collision), and for a success its counts exactly and
-its path length to `PATH_RTOL_ELSEWHERE`. A skipped test says that the rest was left out and
+its path length to `PATH_RTOL`. A skipped test says that the rest was left out and
 why.
 
 A change to the code that is meant to leave behaviour alone must leave every recorded value
@@ -58,10 +58,7 @@ PLANNERS = sorted(BUILT_IN)
 EXACT_KEYS = ("outcome", "collisions", "local_minima", "escapes")
 """What a run made of its world, compared exactly (in another environment, for its successes)."""
 PATH_KEY = "path_length_m"
-PATH_RTOL = 1e-6
-"""Relative tolerance of the path length where the environment matches: a digest that differs
-fails the run anyway; this keeps the length's message readable."""
-PATH_RTOL_ELSEWHERE = 0.02
+PATH_RTOL = 0.02
 """Relative tolerance of a successful run's path length in another environment (with glibc's
 builds of its mathematical functions for CPUs without fused multiply-adds, every trajectory's
 last bits changed and the successes' lengths by up to 0.7%)."""
@@ -157,13 +154,12 @@ def changes(run: str, values: dict, recorded: dict) -> list[str]:
     """How a run's values differ from the recorded ones: all of them where the environment
     matches; elsewhere its success, and for a success its counts and path length."""
     if digests_compared():
-        keys = [key for key in (*EXACT_KEYS, DIGEST_KEY) if values[key] != recorded[key]]
-        rtol = PATH_RTOL
+        keys, rtol = [key for key in (*EXACT_KEYS, DIGEST_KEY) if values[key] != recorded[key]], 0.0
     elif succeeded(values) != succeeded(recorded):
         keys, rtol = ["outcome", "collisions"], math.inf
     elif succeeded(recorded):
         keys = [key for key in EXACT_KEYS if values[key] != recorded[key]]
-        rtol = PATH_RTOL_ELSEWHERE
+        rtol = PATH_RTOL
     else:
         keys, rtol = [], math.inf
     if not math.isclose(values[PATH_KEY], recorded[PATH_KEY], rel_tol=rtol):
