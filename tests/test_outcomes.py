@@ -54,6 +54,12 @@ CASES = {
         "stuck",
         "odometry has put the robot at the goal",
     ),
+    "stuck_ekf": (
+        "open_field",
+        ['sensors.pose="ekf"', "sensors.odometry_noise=0.9"],
+        "stuck",
+        "the EKF has put the robot at the goal",
+    ),
     "error_mujoco_warning": ("open_field", [], "error", "MuJoCo warning at t = "),
     "error_non_finite_force": ("open_field", [], "error", "planner 'vplane' gave a non-finite force"),
 }

@@ -358,8 +358,9 @@ class Run:
             believed_xy, _ = self._belief
             if self.localiser.believes_arrived(time_s, believed_xy, self.goal, self.tolerance):
                 away = math.dist(self.position, self.goal)
+                believer = "the EKF" if self.scenario.sensors.pose == "ekf" else "odometry"
                 message = (
-                    f"odometry has put the robot at the goal for {BELIEF_PATIENCE_S:g} s, but it is "
+                    f"{believer} has put the robot at the goal for {BELIEF_PATIENCE_S:g} s, but it is "
                     f"{away:.3f} m away: the planner has nowhere left to go"
                 )
                 return Ending(Outcome.STUCK, Event(EventKind.BELIEVED_ARRIVED, message))
