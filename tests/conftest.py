@@ -103,7 +103,7 @@ def doc_examples():
         ("paper_c_escape", 3, ("sensors.noise_std=0.02", "sensors.dropout=0.1")),
         (
             "paper_h_escape",
-            2,
+            3,
             ("sensors.pose=odometry", "sensors.odometry_noise=0.01", "run.time_limit_s=40"),
         ),
     ],
