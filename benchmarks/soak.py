@@ -24,14 +24,14 @@ as drawn, with the first pose. Each run has the simulated time limit `--time-lim
 runs go through the sweep of `vplane-mj bench` (`vplane_mj.bench.sweep.run_sweep`) with `--jobs`
 worker processes. A run that raises is a crash: its row has outcome `error` and the exception
 with where it was raised, its traceback goes to
-`OUT/failed/<scenario>-<planner>-<seed>.traceback.txt`, and the soak goes on. A worker process that dies (segfault, out of memory) fails only the run it had under
-way, which is recorded as ended without a summary; a new worker takes its place. The scenario
-of every crash, run without a summary or `error` outcome is written beside it as `<...>.toml`
-(run it again with `vplane-mj run FILE`). The planned runs (scenario texts and faults;
-planning 1000 takes a few minutes) are saved in `OUT/plan.json` and the finished ones
-journaled in `OUT/soak.jsonl`, so the same command run again (after Ctrl-C, say) only does
-what is missing (delete both to start afresh, e.g. after a change to the scenario
-generators).
+`OUT/failed/<scenario>-<planner>-<seed>.traceback.txt`, and the soak goes on. A worker process
+that dies (segfault, out of memory) fails only the run it had under way, which is recorded as
+ended without a summary; a new worker takes its place. The scenario of every crash, run without
+a summary or `error` outcome is written beside it as `<...>.toml` (run it again with
+`vplane-mj run FILE`). The planned runs (scenario texts and faults; planning 1000 takes a few minutes) are
+saved in `OUT/plan.json` and the finished ones journaled in `OUT/soak.jsonl`, so the same
+command run again (after Ctrl-C, say) only does what is missing (delete both to start afresh,
+e.g. after a change to the scenario generators).
 
 Prints and writes `OUT/soak.json` (runs, crashes, runs without a summary, outcomes per
 planner, success rate per planner and family, the `error` outcomes with their messages,
