@@ -141,9 +141,9 @@ DEFAULT = RobotProfile(
             "sensor height": "chosen: the sonar ring sits above the wheels (their top at 0.04 m)",
             "imu": "chosen: at the chassis' centre, the Jackal's gyro noise and drift",
             "odometry": "measured: the model turns as if its wheels stood 3% wider apart than they "
-            "do (1.032 turning in place at half the top turn rate, 1.034 at the top, 1.022 in an "
-            "arc at half the top speed; tests/test_profiles.py), so its wheel odometry is "
-            "calibrated to 1.03 times the separation, as a real robot's is",
+            "do (turning in place 1.032 at half the top turn rate and 1.034 at the top, as "
+            "tests/test_profiles.py measures; 1.022 in an arc at half the top speed), so its wheel "
+            "odometry is calibrated to 1.03 times the separation, as a real robot's is",
         }
     ),
     odometry_track_scale=1.03,
