@@ -28,10 +28,10 @@ with where it was raised, its traceback goes to
 that dies (segfault, out of memory) fails only the run it had under way, which is recorded as
 ended without a summary; a new worker takes its place. The scenario of every crash, run without
 a summary or `error` outcome is written beside it as `<...>.toml` (run it again with
-`vplane-mj run FILE`). The planned runs (scenario texts and faults; planning 1000 takes a few minutes) are
-saved in `OUT/plan.json` and the finished ones journaled in `OUT/soak.jsonl`, so the same
-command run again (after Ctrl-C, say) only does what is missing (delete both to start afresh,
-e.g. after a change to the scenario generators).
+`vplane-mj run FILE`). The planned runs (scenario texts and faults; planning 1000 takes a few
+minutes) are saved in `OUT/plan.json` and the finished ones journaled in `OUT/soak.jsonl`, so
+the same command run again (after Ctrl-C, say) only does what is missing (delete both to start
+afresh, e.g. after a change to the scenario generators).
 
 Prints and writes `OUT/soak.json` (runs, crashes, runs without a summary, outcomes per
 planner, success rate per planner and family, the `error` outcomes with their messages,
@@ -196,15 +196,12 @@ def report(
         by_pose[planner]["true pose"] = success_rate([r for r in mine if r["key"] in true_pose])
         for pose in poses:
             by_pose[planner][pose] = success_rate([r for r in mine if r["key"] in on_pose[pose]])
-    pose_errors = {
-        pose: statistics.median(errors)
+    estimates = {
+        pose: [r["odometry_error_m"] for j, r in summaries if j.key in on_pose[pose]]
         for pose in poses
-        if (
-            errors := [
-                r["odometry_error_m"] for j, r in summaries if j.key in on_pose[pose] and pose != "truth"
-            ]
-        )
+        if pose != "truth"
     }
+    pose_errors = {pose: statistics.median(errors) for pose, errors in estimates.items() if errors}
     run_wall = [row["wall_time_s"] for _, row in summaries]
     return {
         "format": 1,
@@ -212,7 +209,7 @@ def report(
         "runs_per_planner": {
             planner: sum(j.key in drawn and j.planner == planner for j, _ in runs) for planner in planners
         },
-        "runs_with_every_pose": len(runs) - len(drawn),
+        "runs_on_the_other_poses": len(runs) - len(drawn),
         "crashes": [
             {"run": base_name(j), "planner": j.planner, "exception": r["message"]} for j, r in crashes
         ],
