@@ -30,8 +30,10 @@ import functools
 import hashlib
 import json
 import math
+import os
 import platform
 import struct
+import subprocess
 import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -249,6 +251,29 @@ def test_every_planner_drives_its_recorded_runs(world, pool):
     runs = golden()["runs"]
     changed = [change for run, values in pool.map(_run, jobs) for change in changes(run, values, runs[run])]
     assert not changed, f"{len(changed)} recorded values changed:\n" + "\n".join(changed)
+
+
+ANOTHER_LIBM = "glibc.cpu.hwcaps=-AVX2,-FMA,-FMA4"
+"""GLIBC_TUNABLES that have glibc pick the builds of its mathematical functions for a CPU
+without fused multiply-adds: another machine's libm, here."""
+
+
+@pytest.mark.slow
+def test_with_another_libm_every_run_holds_what_last_bits_leave_alone():
+    # Every trajectory's last bits change under another libm; the suite must skip the digests,
+    # naming both environments, and pass on the rest (not fail, as it did when the fingerprint
+    # named the library's version instead of what its functions return).
+    root = Path(__file__).parents[1]
+    env = {**os.environ, "GLIBC_TUNABLES": ANOTHER_LIBM}
+    probe = [sys.executable, "-c", "from tests.test_golden import libm; print(libm())"]
+    other = subprocess.run(probe, capture_output=True, text=True, env=env, cwd=root, timeout=60)
+    if other.stdout.strip() == libm():
+        pytest.skip(f"GLIBC_TUNABLES={ANOTHER_LIBM} leaves this C library's results as they are")
+    suite = [sys.executable, "-m", "pytest", "-q", "-rs", "-m", "slow", "-o", "addopts=", __file__]
+    suite += ["-k", "not another_libm"]
+    finished = subprocess.run(suite, capture_output=True, text=True, env=env, cwd=root, timeout=900)
+    assert finished.returncode == 0, finished.stdout[-3000:]
+    assert "1 skipped" in finished.stdout and "trajectories not compared bit for bit" in finished.stdout
 
 
 def record() -> None:
