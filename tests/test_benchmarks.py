@@ -40,6 +40,19 @@ def run_benchmark(script: str, *arguments: str, cwd: Path) -> str:
     return done.stdout
 
 
+def refused_benchmark(script: str, *arguments: str) -> str:
+    """The standard error of `python benchmarks/SCRIPT ARGUMENTS`, which must exit 2 (bad input)."""
+    refused = subprocess.run(
+        [sys.executable, str(BENCHMARKS / script), *arguments],
+        env=SCRIPT_ENVIRONMENT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert refused.returncode == 2, refused.stderr[-2000:]
+    return refused.stderr
+
+
 def table_rows(text: str, first_cell: str) -> list[list[str]]:
     """The cells of the Markdown table rows of `text` whose first cell is `first_cell`."""
     rows = [[cell.strip() for cell in line.strip().strip("|").split("|")] for line in text.splitlines()]
@@ -220,13 +233,7 @@ def test_log_growth_reports_the_size_per_simulated_minute(tmp_path):
     assert number(half[4]) == 1.0 and 0.8 < number(two[4]) < 1.1  # MB per minute over the shortest's
     assert number(half[5]) < number(two[5])  # the path's vertices
     assert (tmp_path / "growth" / "log_growth.csv").is_file()
-    refused = subprocess.run(
-        [sys.executable, str(BENCHMARKS / "log_growth.py"), "--minutes", "0"],
-        env=SCRIPT_ENVIRONMENT,
-        capture_output=True,
-        text=True,
-    )
-    assert refused.returncode == 2 and "--minutes: positive numbers" in refused.stderr
+    assert "--minutes: positive numbers" in refused_benchmark("log_growth.py", "--minutes", "0")
 
 
 def test_sweep_rate_counts_runs_per_core_minute_of_each_planners_sweep(tmp_path):
@@ -298,10 +305,4 @@ def test_ros2_export_reports_its_time_and_the_bag_s_size_per_minute(tmp_path):
     assert number(jackal[5]) > number(default[5]) > 0  # MB per minute: 720 beams at 50 Hz weigh more
     assert number(jackal[6]) > 0 and number(default[6]) > 0  # the export's seconds
     assert (tmp_path / "bags" / "ros2_export.csv").is_file()
-    refused = subprocess.run(
-        [sys.executable, str(BENCHMARKS / "ros2_export.py"), "--repeat", "0"],
-        env=SCRIPT_ENVIRONMENT,
-        capture_output=True,
-        text=True,
-    )
-    assert refused.returncode == 2 and "--repeat at least 1" in refused.stderr
+    assert "--repeat at least 1" in refused_benchmark("ros2_export.py", "--repeat", "0")
