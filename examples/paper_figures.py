@@ -26,8 +26,15 @@ import numpy as np
 
 import vplane_mj
 from vplane_mj import EventKind, RunRecord
-from vplane_mj.viz import palette
-from vplane_mj.viz.plots import draw_path, draw_world, label_modes
+from vplane_mj.viz.plots import (
+    draw_collision,
+    draw_local_minimum,
+    draw_objective,
+    draw_path,
+    draw_plane,
+    draw_world,
+    label_modes,
+)
 
 PAPER_SCENARIOS = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")
 PLANE_EVENTS = (EventKind.ESCAPE_FINISHED, EventKind.PLANE_CREATED)
@@ -66,34 +73,23 @@ def draw_events(axes, record: RunRecord) -> None:
     """
     labelled: set[str] = set()
 
-    def once(label: str) -> str | None:  # one legend entry per kind of marker
-        if label in labelled:
-            return None
-        labelled.add(label)
-        return label
+    def first(mark: str) -> bool:  # one legend entry per kind of mark
+        new = mark not in labelled
+        labelled.add(mark)
+        return new
 
     times, positions = record.trajectory.times, record.trajectory.positions
-    objective, plane = palette.OBJECTIVE, palette.PLANE
     for event in record.events:
         data = event.data
         if event.kind is EventKind.ESCAPE_STARTED and "objective" in data:
-            axes.plot(
-                *data["objective"],
-                "o",
-                mfc=objective.rgba,
-                mec=objective.rim,
-                mew=1.5,
-                ms=9,
-                label=once(objective.label),
-            )
+            draw_objective(axes, data["objective"], first("objective"), size_pt=9.0)
         if event.kind in PLANE_EVENTS and {"e1", "e2"} <= data.keys():
-            (x1, y1), (x2, y2) = data["e1"], data["e2"]
-            axes.plot([x1, x2], [y1, y2], color=plane.rgba, lw=3, ls="--", label=once(plane.label))
+            draw_plane(axes, data["e1"], data["e2"], first("plane"))
         if event.kind is EventKind.LOCAL_MINIMUM:  # no point of its own: where the robot was
             where = positions[min(np.searchsorted(times, event.time_s), len(positions) - 1)]
-            axes.plot(*where, "X", color="black", ms=10, label=once("local minimum"))
+            draw_local_minimum(axes, where, first("local minimum"))
         if event.kind is EventKind.COLLISION and "point" in data:
-            axes.plot(*data["point"], "k+", ms=12, mew=2, label=once("collision"))
+            draw_collision(axes, data["point"], first("collision"))
 
 
 def view_of(records: list[RunRecord]) -> tuple[tuple[float, float], tuple[float, float]]:

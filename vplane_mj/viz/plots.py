@@ -115,6 +115,32 @@ def label_modes(axes, modes: Iterable[str]) -> None:
             axes.plot([], [], color=rgba, lw=2, label=f"path: {mode}")
 
 
+def draw_objective(axes, point, labelled: bool, size_pt: float = 8.0) -> None:
+    """A virtual new objective at `point` (x, y in m), a disc of `size_pt` points; in the
+    legend when `labelled`."""
+    objective = palette.OBJECTIVE
+    label = objective.label if labelled else None
+    axes.plot(*point, "o", mfc=objective.rgba, mec=objective.rim, mew=1.5, ms=size_pt, label=label)
+
+
+def draw_plane(axes, e1, e2, labelled: bool) -> None:
+    """A virtual plane from `e1` to `e2` (x, y in m), dashed; in the legend when `labelled`."""
+    plane = palette.PLANE
+    label = plane.label if labelled else None
+    axes.plot(*zip(e1, e2, strict=True), color=plane.rgba, lw=3, ls="--", label=label)
+
+
+def draw_local_minimum(axes, where, labelled: bool) -> None:
+    """Where (x, y in m) the robot was when a local minimum was detected; in the legend when
+    `labelled`."""
+    axes.plot(*where, "X", color="black", ms=10, label="local minimum" if labelled else None)
+
+
+def draw_collision(axes, point, labelled: bool) -> None:
+    """A collision's point of contact (x, y in m); in the legend when `labelled`."""
+    axes.plot(*point, "k+", ms=12, mew=2, label="collision" if labelled else None)
+
+
 def _draw_obstacles(axes, scenario: Scenario) -> None:
     pieces = [p for ob in scenario.world.obstacles for p in ob.footprint()]
     if scenario.world.border:
@@ -133,25 +159,13 @@ def _draw_map(axes, contents: LogContents, scenario: Scenario, track: Track) -> 
     times = contents.times_ns / 1e9
     minima = [e.time_s for e in contents.events if e.kind is EventKind.LOCAL_MINIMUM]
     for k, t in enumerate(minima):
-        where = points[min(int(np.searchsorted(times, t)), len(points) - 1)]
-        axes.plot(*where, "X", color="black", ms=10, label="local minimum" if k == 0 else None)
-    objective, plane = palette.OBJECTIVE, palette.PLANE
+        draw_local_minimum(axes, points[min(int(np.searchsorted(times, t)), len(points) - 1)], k == 0)
     for k, point in enumerate(track.objectives):
-        axes.plot(
-            *point,
-            "o",
-            mfc=objective.rgba,
-            mec=objective.rim,
-            mew=1.5,
-            ms=8,
-            label=objective.label if k == 0 else None,
-        )
+        draw_objective(axes, point, k == 0)
     for k, (e1, e2) in enumerate(track.planes):
-        axes.plot(
-            *zip(e1, e2, strict=True), color=plane.rgba, lw=3, ls="--", label=plane.label if k == 0 else None
-        )
+        draw_plane(axes, e1, e2, k == 0)
     for k, point in enumerate(track.collision_points):
-        axes.plot(*point, "k+", ms=12, mew=2, label="collision" if k == 0 else None)
+        draw_collision(axes, point, k == 0)
     label_modes(axes, track.modes)
     axes.set_title("travelled path")
     axes.legend(loc="upper left", fontsize=7)
