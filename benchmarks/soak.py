@@ -189,10 +189,10 @@ def report(
             success[planner][family] = success_rate(mine)
             for row in mine:
                 outcomes[planner][row["outcome"]] += 1
+    true_pose = drawn - on_pose[poses[0]]
     by_pose: dict[str, dict] = {planner: {} for planner in planners}
     for planner in planners:
         mine = [r for j, r in summaries if j.planner == planner]
-        true_pose = drawn - on_pose[poses[0]]
         by_pose[planner]["true pose"] = success_rate([r for r in mine if r["key"] in true_pose])
         for pose in poses:
             by_pose[planner][pose] = success_rate([r for r in mine if r["key"] in on_pose[pose]])
