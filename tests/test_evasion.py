@@ -83,6 +83,35 @@ def test_the_ranking_picks_a_clear_motion_that_still_makes_progress():
     assert risks[best, 2] > 1.0  # gets on toward the goal, not away from it
 
 
+def test_the_room_cap_skips_only_gaps_the_ranking_does_not_count():
+    # Gaps beyond the cap are pruned in the kernel; every column the ranking reads must equal
+    # what the uncapped check gives: the meeting, the progress, the command, the room up to the
+    # cap and any overlap within the first second. Two draws of four crossing tracks give gaps
+    # below and above the cap, and overlaps.
+    limits = JACKAL.limits
+    least, near = [], []
+    for seed in (1, 4):
+        rng = np.random.default_rng(seed)
+        tracks = np.column_stack(
+            (rng.uniform(-8, 8, (4, 2)), rng.uniform(-2, 2, (4, 2)), np.full(4, 0.5), np.full(4, 0.15))
+        )
+        args = (
+            EVASION.candidates((1.5, 0.3)), (0.0, 0.0, 0.3), (1.0, 0.2),
+            (limits.max_speed_mps, limits.max_turn_rate_radps, limits.max_accel_mps2,
+             limits.braking_in_turn_mps2, limits.max_turn_accel_radps2, JACKAL.gains.turn_gain),
+            (3.0, 0.1), np.ascontiguousarray(JACKAL.footprint, float), float(JACKAL.radius_m), tracks,
+            0.15, (10.0, 0.0), 1.0,
+        )  # fmt: skip
+        capped, full = kernels.candidate_risks(*args, 1.0), kernels.candidate_risks(*args, math.inf)
+        assert np.array_equal(capped[:, [0, 2, 3, 4]], full[:, [0, 2, 3, 4]])
+        assert np.array_equal(np.minimum(capped[:, 1], 1.0), np.minimum(full[:, 1], 1.0))
+        assert np.array_equal(np.minimum(capped[:, 5], 0.0), np.minimum(full[:, 5], 0.0))
+        least += full[:, 1].tolist()
+        near += full[:, 5].tolist()
+    assert min(least) < 0.0 and any(0.3 < gap < 1.0 for gap in least) and max(least) > 1.0
+    assert min(near) < 0.0
+
+
 def test_a_robot_already_in_the_way_gets_out_rather_than_on():
     # The cylinder is about to hit the robot's right side: every motion meets it at once; the
     # chosen one must take the robot away from it (left or back), not on across its path.

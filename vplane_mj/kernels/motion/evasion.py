@@ -66,6 +66,7 @@ def candidate_risks(
     margin_m: float,
     aim: tuple[float, float],
     near_s: float,
+    room_cap_m: float,
 ) -> np.ndarray:
     """(C, 6) per candidate of `candidates` (C, 3: a command's speed in m/s and turn rate in
     rad/s, held for its third column's seconds; then the heading controller makes for `aim`
@@ -91,6 +92,7 @@ def candidate_risks(
         v, w = state
         x, y, yaw = x0, y0, yaw0
         hit, least, near, advance = math.inf, math.inf, math.inf, 0.0
+        counted = room_cap_m  # the least gap that still counts: min(least, room_cap_m)
         for s in range(1, steps + 1):
             t = s * dt
             if t <= hold_s + 1e-9:
@@ -115,10 +117,11 @@ def candidate_risks(
                 oy = tracks[n, 1] + tracks[n, 3] * t - y
                 size = tracks[n, 4] + tracks[n, 5] * t
                 bound = math.sqrt(ox * ox + oy * oy) - reach_m - size  # a bound below the gap
-                if bound >= least and bound >= margin_m:
+                if bound >= counted and bound >= margin_m:
                     continue
                 gap = _outline_gap(outline, cos_yaw * ox + sin_yaw * oy, -sin_yaw * ox + cos_yaw * oy) - size
                 least = min(least, gap)
+                counted = min(counted, gap)
                 if t <= near_s + 1e-9:
                     near = min(near, gap)
                 if gap < margin_m and t < hit:

@@ -4,7 +4,7 @@ The governor (motion.py) checks a command's motion against obstacle points that 
 a moving obstacle needs a check in time instead: where will it be when the robot gets there?
 `Evasion` takes the tracks of the planner's tracker (`perception.tracker`) that move, and
 checks commands held for `horizon_s` against their constant-velocity predictions
-(`kernels.evasion.command_risks`): the robot's footprint against each track's disc at every
+(`kernels.motion.evasion.candidate_risks`): the robot's footprint against each track's disc at every
 time step, the disc grown by the track's position doubt and by `growth_mps` per second of
 prediction (obstacles turn; their paths are not straight). This is the time-indexed collision
 check of the velocity-obstacle family (Fiorini and Shiller 1998, "Motion Planning in Dynamic
@@ -25,7 +25,7 @@ nothing changes.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -83,6 +83,14 @@ class Evasion:
     growth_mps: float
     kept: tuple[float, float] | None = None
     """The command (m/s, rad/s) of the last evasion, None when the last tick needed none."""
+    _grid: np.ndarray = field(init=False, repr=False)
+    """`candidates` but for its first row (the command asked for): the robot's limits' alone."""
+
+    def __post_init__(self) -> None:
+        limits = self.body.limits
+        top, turn = limits.max_speed_mps, limits.max_turn_rate_radps
+        rows = [(v * top, w * turn, hold) for v in SPEED_SHARES for w in TURN_SHARES for hold in HOLDS_S]
+        self._grid = np.array([(0.0, 0.0, HOLDS_S[0]), *rows], dtype=float)
 
     def threat(self, position: np.ndarray, tracks: tuple[Track, ...], time_s: float) -> Threat:
         """The moving tracks that could come within the margin of the robot at `position` (m)
@@ -105,11 +113,9 @@ class Evasion:
         """The motions to rank (C, 3: speed m/s, turn rate rad/s, held s; then on for the aim):
         the command asked for (`wanted`, held HOLDS_S[0]) first, then SPEED_SHARES x TURN_SHARES
         of the robot's limits, each held HOLDS_S."""
-        limits = self.body.limits
-        top, turn = limits.max_speed_mps, limits.max_turn_rate_radps
-        rows = [(wanted[0], wanted[1], HOLDS_S[0])]
-        rows += [(v * top, w * turn, hold) for v in SPEED_SHARES for w in TURN_SHARES for hold in HOLDS_S]
-        return np.array(rows, dtype=float)
+        rows = self._grid.copy()
+        rows[0, :2] = wanted
+        return rows
 
     def risks(
         self, candidates: np.ndarray, pose: tuple[float, float, float], state: tuple[float, float],
@@ -141,6 +147,7 @@ class Evasion:
             float(self.margin_m),
             (float(aim[0]), float(aim[1])),
             NEAR_S,
+            ROOM_CAP_M,
         )
 
     def ranking(self, candidates: np.ndarray, risks: np.ndarray) -> np.ndarray:
