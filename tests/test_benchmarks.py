@@ -176,6 +176,28 @@ def test_sweep_benchmarks_write_their_results(tmp_path):
     assert header.endswith("success_true_pose,success_ekf")
 
 
+def test_pose_ceiling_shadows_the_soaks_true_pose_runs(tmp_path):
+    run_benchmark(
+        "soak.py",
+        *("--count", "16", "--poses", "odometry,ekf,truth", "--time-limit", "20", "--out", "soak"),
+        cwd=tmp_path,
+    )
+    journal = [json.loads(line) for line in (tmp_path / "soak" / "soak.jsonl").read_text().splitlines()]
+    plan = json.loads((tmp_path / "soak" / "plan.json").read_text())
+    on_truth = [run["job"]["planner"] for run in plan["runs"] if 'sensors.pose="truth"' in run["faults"]]
+    assert on_truth  # some runs drew the estimated pose
+    out = run_benchmark("pose_ceiling.py", "--soak", "soak", cwd=tmp_path)
+    assert "wrote soak/pose_ceiling.md" in out
+    rows = list(csv.DictReader((tmp_path / "soak" / "pose_ceiling.csv").open()))
+    assert sorted(row["planner"] for row in rows) == sorted(set(on_truth))
+    assert any(row["truth_successes"] != "0" for row in rows)  # a success to shadow
+    for row in rows:
+        for column in ("ekf_within_tolerance", "odometry_within_tolerance"):
+            assert row[column] == "" if row["truth_successes"] == "0" else 0.0 <= float(row[column]) <= 1.0
+    assert len(journal) == len(plan["runs"])
+    assert "error: " in refused_benchmark("pose_ceiling.py", "--soak", str(tmp_path / "none"))
+
+
 def test_barn_protocol_sweeps_the_planners_beside_barns_published_figures(tmp_path):
     out = run_benchmark(
         "barn_protocol.py",

@@ -1,0 +1,180 @@
+"""How much of the true pose's success an estimated pose can keep on the soak's runs, along the
+paths the planners drive.
+
+The soak (`benchmarks/soak.py --poses odometry,ekf,truth`) runs each run that drew an
+estimated pose three times: on wheel odometry, on the EKF and on the true pose. This script
+reads its plan and journal (`--soak`, its `--out`) and runs each of those runs on the true
+pose again with wheel odometry and the EKF following along unseen: the planner drives on the
+true pose, as in the journal (its trajectory digest is checked), while both estimates fold in
+the same wheels and gyro with the run's own faults and noise. When the run ends, the distance
+(m) between each estimate and the robot is what a planner that drove the same path on that
+estimate would be off: it stops where the estimate puts it at the goal. Where that exceeds
+the goal's tolerance, the success does not survive, unless the error happens to lie along the
+way in (the robot then crosses the goal's disc before its estimate arrives).
+
+So, per planner: its successes on the true pose, the share of them whose EKF and whose
+odometry ends within the goal tolerance (the ceiling of the soak's ekf / truth and
+odometry / truth ratios for a planner that drives these paths, but for that luck; a planner
+that turned less would drift less), the median errors, and the ratios the soak measured on
+the same runs. Writes `OUT/pose_ceiling.{csv,md,json}` (`--out`, else the soak's
+directory) and prints the table.
+
+    python benchmarks/pose_ceiling.py [--soak logs/soak] [--jobs 2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+from soak import JOURNAL, PLAN, pose_fault
+
+from vplane_mj.bench.job import Job
+from vplane_mj.bench.tables import markdown_table, write_table
+from vplane_mj.errors import VPlaneError
+from vplane_mj.files import prepare_out_dir
+from vplane_mj.scenario import parse_scenario
+from vplane_mj.sim.drive import Localiser
+from vplane_mj.sim.loop import Run
+
+COLUMNS = (
+    "planner",
+    "truth_successes",
+    "ekf_within_tolerance",
+    "odometry_within_tolerance",
+    "ekf_error_median_m",
+    "odometry_error_median_m",
+    "soak_ekf_over_truth",
+    "soak_odometry_over_truth",
+)
+
+
+def shadowed(toml: str, source: str) -> dict:
+    """One run on the true pose with wheel odometry and the EKF following along: its success,
+    trajectory digest and both estimates' distance (m) from the robot at its end."""
+    truth = parse_scenario(toml, source)
+    run = Run(parse_scenario(toml, source, [pose_fault("ekf")]))  # a model that carries the IMU
+    ekf = run.localiser
+    run.localiser = Localiser(run.drive, truth)  # the planner drives on the true pose
+    odometry = Localiser(run.drive, parse_scenario(toml, source, [pose_fault("odometry")]))
+    while run.step() is None:
+        ekf.pose(run.position, run.yaw)  # both read the wheels (and the gyro) as the run's own would
+        odometry.pose(run.position, run.yaw)
+    summary = run.summary()
+    return {
+        "success": summary.success,
+        "digest": summary.trajectory_sha256,
+        "ekf": ekf.error(run.position),
+        "odometry": odometry.error(run.position),
+        "tolerance": truth.robot.goal_tolerance,
+    }
+
+
+def _shadowed(run: dict) -> dict:
+    return shadowed(run["job"]["toml"], run["job"]["scenario"])
+
+
+def ratio(rows: list[dict], pose: str) -> float | None:
+    """Success on `pose` over success on the true pose, over the same runs (`rows`)."""
+    truth = sum(row["success"] for row in rows)
+    return sum(row[f"success_{pose}"] for row in rows) / truth if truth else None
+
+
+def table_of(runs: list[dict], journal: dict[str, dict], jobs: int) -> list[dict]:
+    """The table's rows (module docstring) from the soak's runs on the true pose that drew an
+    estimated pose (`runs`, plan entries) and the journal rows by key."""
+    with ProcessPoolExecutor(jobs) as pool:
+        results = list(pool.map(_shadowed, runs, chunksize=4))
+    per_planner: dict[str, list[dict]] = {}
+    for run, result in zip(runs, results, strict=True):
+        job = run["job"]
+        recorded = journal[job["key"]]
+        if result["digest"] != recorded["trajectory_sha256"]:
+            raise VPlaneError(f"{job['scenario']}: {job['planner']} ran another trajectory than the soak's")
+        twins = {f"success_{pose}": journal[key]["success"] for pose, key in run["others"].items()}
+        per_planner.setdefault(job["planner"], []).append({**result, **twins})
+    return [row_of(planner, rows) for planner, rows in sorted(per_planner.items())]
+
+
+def row_of(planner: str, rows: list[dict]) -> dict:
+    """One planner's row of the table from its runs' shadowed results (`table_of`)."""
+    reached = [row for row in rows if row["success"]]
+    row = {"planner": planner, "truth_successes": len(reached)}
+    for pose in ("ekf", "odometry"):
+        errors = [run[pose] for run in reached]
+        within = sum(error <= run["tolerance"] for error, run in zip(errors, reached, strict=True))
+        row[f"{pose}_within_tolerance"] = within / len(reached) if reached else None
+        row[f"{pose}_error_median_m"] = statistics.median(errors) if reached else None
+        row[f"soak_{pose}_over_truth"] = ratio(rows, pose)
+    return row
+
+
+def paired_runs(plan: dict) -> list[dict]:
+    """The plan's runs on the true pose that drew an estimated pose, each with the keys of its
+    twins on odometry and on the EKF (`others`)."""
+    runs = plan["runs"]
+    for run in runs:
+        run["job"]["key"] = Job(**run["job"]).key
+    twins: dict[tuple, dict[str, str]] = {}
+    for run in runs:
+        job = run["job"]
+        for pose in ("odometry", "ekf"):
+            if pose_fault(pose) in run["faults"]:
+                twins.setdefault((job["scenario"], job["planner"], job["seed"]), {})[pose] = job["key"]
+    paired = []
+    for run in runs:
+        job = run["job"]
+        if pose_fault("truth") in run["faults"]:
+            paired.append({**run, "others": twins[(job["scenario"], job["planner"], job["seed"])]})
+    return paired
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--soak", type=Path, default=Path("logs/soak"), help="soak.py's --out")
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--out", type=Path, help="default: the soak's directory")
+    args = parser.parse_args(argv)
+    try:
+        plan_path, journal_path = args.soak / PLAN, args.soak / JOURNAL
+        for path in (plan_path, journal_path):
+            if not path.is_file():
+                raise VPlaneError(
+                    f"{path}: missing (run benchmarks/soak.py --poses odometry,ekf,truth first)"
+                )
+        plan = json.loads(plan_path.read_text(encoding="utf-8"))
+        if set(plan["settings"]["poses"]) != {"odometry", "ekf", "truth"}:
+            raise VPlaneError(f"{plan_path}: poses: the soak must run odometry, ekf and truth")
+        journal = {}
+        for line in journal_path.read_text(encoding="utf-8").splitlines():
+            row = json.loads(line)
+            journal[row["key"]] = row
+        out = prepare_out_dir(args.out or args.soak)
+        table = table_of(paired_runs(plan), journal, args.jobs)
+    except VPlaneError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    text = markdown_table(table, COLUMNS, cell)
+    written = write_table(out, "pose_ceiling", table, COLUMNS, text)
+    print(text)
+    print("\n".join(f"wrote {path}" for path in written))
+    return 0
+
+
+def cell(column: str, value) -> str:
+    """A table cell: shares as percentages, metres and ratios to two decimals."""
+    if value is None:
+        return "-"
+    if column.endswith("_within_tolerance"):
+        return f"{value:.0%}"
+    if isinstance(value, float):
+        return f"{value:.2f}"
+    return f"`{value}`" if column == "planner" else str(value)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
