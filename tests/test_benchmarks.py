@@ -227,6 +227,29 @@ def test_dynabarn_sweeps_each_third_beside_the_published_rates(tmp_path):
     assert (tmp_path / "dyn" / "dynabarn.png").stat().st_size > 1000
 
 
+def test_dynabarn_collisions_are_classified_from_the_sweeps_journal(tmp_path):
+    # dwa meets a cylinder in most hard worlds: every collided run of the sweep is run again
+    # (its digest checked) and its first contact counted in exactly one class.
+    run_benchmark(
+        "dynabarn.py",
+        *("--count", "2", "--seeds", "0-1", "--planners", "dwa", "--out", "dyn"),
+        cwd=tmp_path,
+    )
+    journal = [json.loads(line) for line in (tmp_path / "dyn" / "bench.jsonl").read_text().splitlines()]
+    collided = sum(row["collisions"] > 0 for row in journal)
+    assert collided > 0
+    run_benchmark("dynabarn_collisions.py", "--sweep", "dyn", "--planners", "dwa", cwd=tmp_path)
+    (row,) = csv.DictReader((tmp_path / "dyn" / "dynabarn_collisions.csv").open())
+    assert int(row["runs"]) == 4 and int(row["collided"]) == collided
+    assert int(row["appeared"]) + int(row["unseen"]) + int(row["in_view"]) == collided
+    # Another laser noise runs other trajectories than the journal's: refused, naming the world.
+    refused = refused_benchmark(
+        "dynabarn_collisions.py", "--sweep", str(tmp_path / "dyn"), "--planners", "dwa", "--noise", "0"
+    )
+    assert "dynabarn_0_" in refused and "another trajectory" in refused
+    assert "error: " in refused_benchmark("dynabarn_collisions.py", "--sweep", str(tmp_path / "none"))
+
+
 def test_tracker_accuracy_scores_the_tracks_against_the_simulator(tmp_path):
     out = run_benchmark(
         "tracker_accuracy.py", "--count", "3", "--planner", "apf", "--out", "acc", cwd=tmp_path
