@@ -218,6 +218,37 @@ interpolation = "linear"
     assert summary.min_clearance_m == summary.min_clearance_moving_m
 
 
+def test_the_contact_of_any_of_several_moving_obstacles_is_a_collision_and_the_floor_is_not():
+    # Two sensors count the robot's contacts with anything and with the floor: the third of
+    # three cylinders (the first two far off) running into the robot is a collision; a robot
+    # on the floor with nothing near touches nothing.
+    far = "".join(
+        f"""
+[[world.obstacles]]
+kind = "cylinder"
+radius = 0.3
+[world.obstacles.motion]
+keyframes = [[0.0, {x}, 5.5], [4.0, {x}, 5.0]]
+"""
+        for x in (8.0, 9.0)
+    )
+    onto = """
+[[world.obstacles]]
+kind = "cylinder"
+radius = 0.4
+[world.obstacles.motion]
+keyframes = [[0.0, 4.0, 3.0], [1.0, 1.5, 3.0]]
+loop = false
+interpolation = "linear"
+"""
+    robot = "start = [1.5, 3.0]\ngoal = [1.5, 5.5]\nstart_yaw_deg = 90"
+    hit = Run(parse_scenario(scenario_text(far + onto, robot), "x.toml"))
+    assert sum(hit.model.sensor_type == mujoco.mjtSensor.mjSENS_CONTACT) == 2
+    assert hit.run().summary.collisions >= 1
+    clear = Run(parse_scenario(scenario_text(far, robot, "[run]\ntime_limit_s = 3"), "x.toml")).run()
+    assert clear.summary.collisions == 0 and clear.summary.min_clearance_moving_m > 0
+
+
 def test_clearance_to_moving_obstacles_is_measured_where_they_stood():
     discs = np.array([[0.0, 0.0, 0.5]])
     rects = np.array([[0.0, 0.0, 0.5, 0.25, 1.0, 0.0]])

@@ -15,7 +15,7 @@ from vplane_mj.sim.control import CommandRamp, WheelPI, wheel_targets
 from vplane_mj.sim.imu import Gyro
 from vplane_mj.sim.moving import MovingObstacles
 from vplane_mj.sim.odometry import FusedOdometry, WheelOdometry
-from vplane_mj.sim.world import BUMP_SENSOR, OBSTACLES_BODY, ROBOT_PREFIX
+from vplane_mj.sim.world import BUMP_FLOOR, BUMP_SENSOR, OBSTACLES_BODY, ROBOT_PREFIX
 
 ODOMETRY_STREAM = 1
 """Second word of the odometry noise's seed, (seed, 1): a stream apart from the sonar's."""
@@ -242,11 +242,14 @@ class CollisionCounter:
     contacts scanned in Python for the point of impact.
     """
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, moving: int = 0):
-        first = model.sensor_adr[model.sensor(BUMP_SENSOR).id]
-        self.found = data.sensordata[first:][: 1 + moving]
-        """The contact sensors' readings: the static obstacles', then each of the `moving`
-        obstacles' (`vplane_mj.sim.world.BUMP_SENSOR`)."""
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData):
+        bump = model.sensor_adr[model.sensor(BUMP_SENSOR).id]
+        self.found = data.sensordata[bump : bump + 1]
+        """The robot's contacts with the obstacles (`vplane_mj.sim.world.BUMP_SENSOR`), or in a
+        world with moving obstacles with anything, floor included."""
+        floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, BUMP_FLOOR)
+        self.floor = None if floor < 0 else data.sensordata[model.sensor_adr[floor] :][:1]
+        """The robot's contacts with the floor, counted among `found`; None without moving obstacles."""
         names = [
             OBSTACLES_BODY,
             *(model.body(i).name for i in range(model.nbody) if model.body_mocapid[i] >= 0),
@@ -259,8 +262,7 @@ class CollisionCounter:
 
     def in_contact(self) -> bool:
         """Whether the robot touches an obstacle now (after the last physics step)."""
-        found = self.found
-        return bool(found[0] > 0) if len(found) == 1 else bool(found.any())
+        return bool(self.found[0] > (0.0 if self.floor is None else self.floor[0]))
 
     def update(self, data: mujoco.MjData) -> tuple[float, float] | None:
         """Return the contact point when a new episode starts, else None."""

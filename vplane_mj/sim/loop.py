@@ -183,7 +183,7 @@ class Run:
         self.clearance = robot_clearance(
             scenario, self.body, self.radius, None if self.moving is None else self.moving.pieces()
         )
-        self.collisions = CollisionCounter(self.model, self.data, len(scenario.world.moving))
+        self.collisions = CollisionCounter(self.model, self.data)
         self.goal = np.asarray(scenario.robot.goal, float)
         self.tolerance = scenario.robot.goal_tolerance
         self.ranges = np.full(len(self.sensor.bearings), np.nan)
