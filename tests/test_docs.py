@@ -137,10 +137,10 @@ README_FIGURES = (
         rf"Among DynaBARN's moving cylinders a run costs more, {RANGE} times its floor for `apf` "
         rf"and {RANGE} for `vplane_plus`",
         [
-            (("dynabarn_0_medium_020", "`apf`"), "run / floor"),
             (("dynabarn_0_hard_041", "`apf`"), "run / floor"),
-            (("dynabarn_0_hard_041", "`vplane_plus`"), "run / floor"),
+            (("dynabarn_0_medium_020", "`apf`"), "run / floor"),
             (("dynabarn_0_medium_020", "`vplane_plus`"), "run / floor"),
+            (("dynabarn_0_hard_041", "`vplane_plus`"), "run / floor"),
         ],
     ),
 )
