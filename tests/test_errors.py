@@ -2,8 +2,10 @@
 came from outside."""
 
 import os
+import pickle
 
-from vplane_mj.errors import closest, cut, did_you_mean, readable, shown
+from vplane_mj.errors import ScenarioError, WorldFileError, closest, cut, did_you_mean, readable, shown
+from vplane_mj.planning.protocol.params import ParamError
 
 PLANNERS = ["apf", "bug2", "dwa", "vfh", "vobs", "vplane", "vplane_plus"]
 
@@ -34,3 +36,16 @@ def test_a_long_name_is_cut_with_its_length():
     assert shown("x" * 81) == "'" + "x" * 80 + "'... (81 characters)"
     assert cut("y" * 100) == "y" * 80 + "... (100 characters)"
     assert shown("a\x00") == "'a\\x00'"
+
+
+def test_the_errors_with_arguments_cross_a_process_boundary():
+    # A process pool's worker sends its exception back pickled: one that cannot be rebuilt
+    # breaks the pool instead of reaching the user's message.
+    for error in (
+        ScenarioError("a.toml", "robot.goal", "inside an obstacle"),
+        ScenarioError("a.toml", "planner.x", "unknown", origin="--set planner.x=1"),
+        WorldFileError("w.world", "model[2]", "no geometry"),
+        ParamError("gain", "must be positive"),
+    ):
+        copy = pickle.loads(pickle.dumps(error))
+        assert type(copy) is type(error) and str(copy) == str(error) and vars(copy) == vars(error)

@@ -44,6 +44,10 @@ class ScenarioError(VPlaneError):
             message = f"{source}: {key}: {reason}" if key else f"{source}: {reason}"
         super().__init__(message)
 
+    def __reduce__(self):
+        """Rebuilt from its arguments, so that it crosses a process boundary (a sweep's worker)."""
+        return type(self), (self.source, self.key, self.reason, self.origin)
+
 
 class WorldFileError(VPlaneError):
     """An imported world file (SDF) that cannot be converted: names the file, the element and
@@ -55,6 +59,10 @@ class WorldFileError(VPlaneError):
         self.reason = reason
         shown_source = readable(source)
         super().__init__(f"{shown_source}: {element}: {reason}" if element else f"{shown_source}: {reason}")
+
+    def __reduce__(self):
+        """Rebuilt from its arguments, so that it crosses a process boundary (a sweep's worker)."""
+        return type(self), (self.source, self.element, self.reason)
 
 
 def closest(word: str, known: Iterable[str]) -> str | None:

@@ -123,6 +123,10 @@ class ParamError(VPlaneError):
         self.reason = reason
         super().__init__(f"planner.{key}: {reason}")
 
+    def __reduce__(self):
+        """Rebuilt from its arguments, so that it crosses a process boundary (a sweep's worker)."""
+        return type(self), (self.key, self.reason)
+
 
 @dataclass(frozen=True)
 class PlannerParams:
