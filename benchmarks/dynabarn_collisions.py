@@ -24,7 +24,6 @@ beside the journal) and prints them.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 from concurrent.futures import ProcessPoolExecutor
@@ -32,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vplane_mj.bench.sweep import job_choice
+from vplane_mj.bench.sweep import JOURNAL, job_choice, read_journal
 from vplane_mj.bench.tables import markdown_table, write_table
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir
@@ -127,12 +126,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--out", type=Path, help="default: the sweep's directory")
     args = parser.parse_args(argv)
-    journal = args.sweep / "bench.jsonl"
+    journal = args.sweep / JOURNAL
     planners = [p.strip() for p in args.planners.split(",")]
     try:
         if not journal.is_file():
             raise VPlaneError(f"{journal}: no such journal (run benchmarks/dynabarn.py first)")
-        rows = [json.loads(line) for line in journal.read_text().splitlines() if line.strip()]
+        rows = list(read_journal(journal).values())
         runs = {planner: [r for r in rows if r.get("planner") == planner] for planner in planners}
         if missing := [planner for planner, mine in runs.items() if not mine]:
             raise VPlaneError(f"{journal}: no runs of planner {missing[0]!r}")

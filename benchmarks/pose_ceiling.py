@@ -25,15 +25,15 @@ directory) and prints the table.
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
 import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from soak import JOURNAL, PLAN, pose_fault
+from soak import JOURNAL, PLAN, pose_fault, read_plan
 
 from vplane_mj.bench.job import Job
+from vplane_mj.bench.sweep import read_journal
 from vplane_mj.bench.tables import markdown_table, write_table
 from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir
@@ -74,8 +74,8 @@ def shadowed(toml: str, source: str) -> dict:
     }
 
 
-def _shadowed(run: dict) -> dict:
-    return shadowed(run["job"]["toml"], run["job"]["scenario"])
+def _shadowed(job: Job) -> dict:
+    return shadowed(job.toml, job.scenario)
 
 
 def ratio(rows: list[dict], pose: str) -> float | None:
@@ -84,19 +84,18 @@ def ratio(rows: list[dict], pose: str) -> float | None:
     return sum(row[f"success_{pose}"] for row in rows) / truth if truth else None
 
 
-def table_of(runs: list[dict], journal: dict[str, dict], jobs: int) -> list[dict]:
+def table_of(pairs: list[tuple[Job, dict[str, str]]], journal: dict[str, dict], jobs: int) -> list[dict]:
     """The table's rows (module docstring) from the soak's runs on the true pose that drew an
-    estimated pose (`runs`, plan entries) and the journal rows by key."""
+    estimated pose, each with its twins' keys by pose (`paired_runs`), and the journal's rows
+    by key."""
     with ProcessPoolExecutor(jobs) as pool:
-        results = list(pool.map(_shadowed, runs, chunksize=4))
+        results = list(pool.map(_shadowed, [job for job, _ in pairs], chunksize=4))
     per_planner: dict[str, list[dict]] = {}
-    for run, result in zip(runs, results, strict=True):
-        job = run["job"]
-        recorded = journal[job["key"]]
-        if result["digest"] != recorded["trajectory_sha256"]:
-            raise VPlaneError(f"{job['scenario']}: {job['planner']} ran another trajectory than the soak's")
-        twins = {f"success_{pose}": journal[key]["success"] for pose, key in run["others"].items()}
-        per_planner.setdefault(job["planner"], []).append({**result, **twins})
+    for (job, twins), result in zip(pairs, results, strict=True):
+        if result["digest"] != journal[job.key]["trajectory_sha256"]:
+            raise VPlaneError(f"{job.scenario}: {job.planner} ran another trajectory than the soak's")
+        successes = {f"success_{pose}": journal[key]["success"] for pose, key in twins.items()}
+        per_planner.setdefault(job.planner, []).append({**result, **successes})
     return [row_of(planner, rows) for planner, rows in sorted(per_planner.items())]
 
 
@@ -113,24 +112,19 @@ def row_of(planner: str, rows: list[dict]) -> dict:
     return row
 
 
-def paired_runs(plan: dict) -> list[dict]:
-    """The plan's runs on the true pose that drew an estimated pose, each with the keys of its
-    twins on odometry and on the EKF (`others`)."""
-    runs = plan["runs"]
-    for run in runs:
-        run["job"]["key"] = Job(**run["job"]).key
+def paired_runs(runs: list[tuple[Job, list[str]]]) -> list[tuple[Job, dict[str, str]]]:
+    """The plan's runs on the true pose that drew an estimated pose, each with the journal keys
+    of its twins on odometry and on the EKF, by pose."""
     twins: dict[tuple, dict[str, str]] = {}
-    for run in runs:
-        job = run["job"]
+    for job, faults in runs:
         for pose in ("odometry", "ekf"):
-            if pose_fault(pose) in run["faults"]:
-                twins.setdefault((job["scenario"], job["planner"], job["seed"]), {})[pose] = job["key"]
-    paired = []
-    for run in runs:
-        job = run["job"]
-        if pose_fault("truth") in run["faults"]:
-            paired.append({**run, "others": twins[(job["scenario"], job["planner"], job["seed"])]})
-    return paired
+            if pose_fault(pose) in faults:
+                twins.setdefault((job.scenario, job.planner, job.seed), {})[pose] = job.key
+    return [
+        (job, twins[(job.scenario, job.planner, job.seed)])
+        for job, faults in runs
+        if pose_fault("truth") in faults
+    ]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -146,15 +140,11 @@ def main(argv: list[str] | None = None) -> int:
                 raise VPlaneError(
                     f"{path}: missing (run benchmarks/soak.py --poses odometry,ekf,truth first)"
                 )
-        plan = json.loads(plan_path.read_text(encoding="utf-8"))
-        if set(plan["settings"]["poses"]) != {"odometry", "ekf", "truth"}:
+        settings, runs = read_plan(plan_path)
+        if set(settings["poses"]) != {"odometry", "ekf", "truth"}:
             raise VPlaneError(f"{plan_path}: poses: the soak must run odometry, ekf and truth")
-        journal = {}
-        for line in journal_path.read_text(encoding="utf-8").splitlines():
-            row = json.loads(line)
-            journal[row["key"]] = row
         out = prepare_out_dir(args.out or args.soak)
-        table = table_of(paired_runs(plan), journal, args.jobs)
+        table = table_of(paired_runs(runs), read_journal(journal_path), args.jobs)
     except VPlaneError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

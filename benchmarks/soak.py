@@ -148,12 +148,18 @@ def load_or_plan(
     """The runs as planned before in `path` with the same arguments, else planned and saved there."""
     settings = {"count": count, "seed": seed, "time_limit_s": time_limit, "poses": list(poses)}
     if path.exists():
-        plan = json.loads(path.read_text(encoding="utf-8"))
-        if plan["settings"] == settings:
-            return [(Job(**run["job"]), run["faults"]) for run in plan["runs"]]
+        planned, runs = read_plan(path)
+        if planned == settings:
+            return runs
     runs = plan_soak(count, seed, time_limit, poses)
     write_json(path, {"settings": settings, "runs": [{"job": asdict(j), "faults": f} for j, f in runs]})
     return runs
+
+
+def read_plan(path: Path) -> tuple[dict, list[tuple[Job, list[str]]]]:
+    """A saved plan's settings and its runs, each with its fault overrides."""
+    plan = json.loads(path.read_text(encoding="utf-8"))
+    return plan["settings"], [(Job(**run["job"]), run["faults"]) for run in plan["runs"]]
 
 
 def base_name(job: Job) -> str:

@@ -248,8 +248,9 @@ class CollisionCounter:
         """The robot's contacts with the obstacles (`vplane_mj.sim.world.BUMP_SENSOR`), or in a
         world with moving obstacles with anything, floor included."""
         floor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, BUMP_FLOOR)
-        self.floor = None if floor < 0 else data.sensordata[model.sensor_adr[floor] :][:1]
-        """The robot's contacts with the floor, counted among `found`; None without moving obstacles."""
+        self.floor = np.zeros(1) if floor < 0 else data.sensordata[model.sensor_adr[floor] :][:1]
+        """The robot's contacts with the floor, counted among `found`; none counted (zero)
+        without moving obstacles."""
         names = [
             OBSTACLES_BODY,
             *(model.body(i).name for i in range(model.nbody) if model.body_mocapid[i] >= 0),
@@ -262,7 +263,7 @@ class CollisionCounter:
 
     def in_contact(self) -> bool:
         """Whether the robot touches an obstacle now (after the last physics step)."""
-        return bool(self.found[0] > (0.0 if self.floor is None else self.floor[0]))
+        return bool(self.found[0] > self.floor[0])
 
     def update(self, data: mujoco.MjData) -> tuple[float, float] | None:
         """Return the contact point when a new episode starts, else None."""

@@ -134,10 +134,13 @@ def build_spec(scenario: Scenario, rangefinders: bool = True) -> mujoco.MjSpec:
     # Moving obstacles are bodies of their own: the robot's contacts with anything, less those
     # with the floor, count them all in two sensors (a sensor per obstacle cost a tenth of a
     # physics step among DynaBARN's 20-odd cylinders).
+    body, geom = mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_GEOM
     touched = (
-        [(BUMP_SENSOR, None), (BUMP_FLOOR, FLOOR_GEOM)] if world.moving else [(BUMP_SENSOR, OBSTACLES_BODY)]
+        [(BUMP_SENSOR, None, ""), (BUMP_FLOOR, geom, FLOOR_GEOM)]
+        if world.moving
+        else [(BUMP_SENSOR, body, OBSTACLES_BODY)]
     )
-    for name, other in touched:
+    for name, reftype, refname in touched:
         sensor = arena.add_sensor(
             name=name,
             type=mujoco.mjtSensor.mjSENS_CONTACT,
@@ -145,9 +148,8 @@ def build_spec(scenario: Scenario, rangefinders: bool = True) -> mujoco.MjSpec:
             objname=ROBOT_PREFIX + BASE_BODY,
             intprm=[1, 0, 1],  # data "found" (all the matching contacts), no reduction, one contact
         )
-        if other is not None:
-            sensor.reftype = mujoco.mjtObj.mjOBJ_BODY if other == OBSTACLES_BODY else mujoco.mjtObj.mjOBJ_GEOM
-            sensor.refname = other
+        if reftype is not None:  # else: contacts with anything
+            sensor.reftype, sensor.refname = reftype, refname
 
     robot = mujoco.MjSpec.from_file(str(model_path(robot_profile(scenario.robot.profile).model_file)))
     if scenario.sensors.kind == "sonar":
