@@ -5,18 +5,21 @@ Reads the journal of `benchmarks/dynabarn.py` (`OUT/bench.jsonl` and the worlds 
 planner, seed and laser noise: the same trajectory, checked against the journal's digest) and
 classifies its first contact from the simulator's truth, which no planner sees:
 
-- **appeared**: the obstacle nearest the robot at the contact jumped more than JUMP_M between
-  two control ticks within APPEAR_S before it. DynaBARN's cylinders loop: at the end of its
-  loop a cylinder jumps back to its first keyframe, on the square's border, and the robot's
-  start is 1 m outside the border; one that lands on or beside the robot leaves it no time.
+- **landed**: the obstacle nearest the robot at the first control tick after the contact
+  jumped more than JUMP_M since the tick before the contact. DynaBARN's cylinders loop: at the
+  end of its loop a cylinder jumps back to its first keyframe, on the square's border, and the
+  robot's start is 1 m outside the border; this one landed on or against the robot without a
+  single scan in between that a planner could have acted on.
+- **appeared**: it jumped within APPEAR_S before the contact, a control tick in between.
 - **unseen**: it stayed out of the laser's view (beyond its half angle from the robot's
   heading, or its range) at every tick of the UNSEEN_S before the contact: it came from
   behind the Jackal's 270 degree laser.
 - **in view**: neither; of these, how many moved faster than the robot's top speed (the
   splines' speeds reach about 2.3 m/s, the Jackal's top is 2 m/s).
 
-Writes the counts per planner to `OUT/dynabarn_collisions.{csv,md,json}` (`--out`, else
-beside the journal) and prints them.
+Writes the counts per planner, and the share of its runs (%) whose first collision was not a
+landing, to `OUT/dynabarn_collisions.{csv,md,json}` (`--out`, else beside the journal) and
+prints them.
 
     python benchmarks/dynabarn_collisions.py --sweep logs/dynabarn [--planners apf,vplane_plus] [--jobs 2]
 """
@@ -47,7 +50,18 @@ APPEAR_S = 1.0
 """A contact this soon (s) after the obstacle's jump is one it appeared into."""
 UNSEEN_S = 1.0
 """An obstacle out of the laser's view for this long (s) before the contact came unseen."""
-COLUMNS = ("planner", "runs", "collided", "appeared", "unseen", "in_view", "in_view_faster_than_robot")
+COLUMNS = (
+    "planner",
+    "runs",
+    "collided",
+    "landed",
+    "appeared",
+    "unseen",
+    "in_view",
+    "in_view_faster_than_robot",
+    "collided_not_landed_pct",
+)
+KINDS = ("landed", "appeared", "unseen", "in_view")
 
 
 class _Contacts:
@@ -75,18 +89,20 @@ def classify(case: Path, planner: str, seed: int, noise: float, digest: str) -> 
             f"{case}: {planner} seed {seed} ran another trajectory than the journal's (--noise?)"
         )
     times, places = result.times, result.obstacle_places
-    k = max(0, int(np.searchsorted(times, contacts.times[0], side="right")) - 1)
+    after = min(int(np.searchsorted(times, contacts.times[0], side="left")), len(times) - 1)
+    before = max(0, after - 1)  # the last control tick before the contact
     offset = places - result.positions[:, None, :]
     radius = np.array(
         [getattr(moving.shape.footprint()[0], "radius", 0.0) for moving in scenario.world.moving]
     )
-    nearest = int(np.argmin(np.hypot(offset[k, :, 0], offset[k, :, 1]) - radius))
+    nearest = int(np.argmin(np.hypot(offset[after, :, 0], offset[after, :, 1]) - radius))
     tick_s = times[1] - times[0]
-    steps = np.hypot(*np.diff(places[:, nearest], axis=0).T)
-    recent = slice(max(0, k - round(APPEAR_S / tick_s)), k)
-    if (steps[recent] > JUMP_M).any():
+    steps = np.hypot(*np.diff(places[:, nearest], axis=0).T)  # steps[i]: tick i to i + 1
+    if after > before and steps[before] > JUMP_M:
+        return {"kind": "landed"}
+    if (steps[max(0, before - round(APPEAR_S / tick_s)) : before] > JUMP_M).any():
         return {"kind": "appeared"}
-    window = range(max(0, k - round(UNSEEN_S / tick_s)), k + 1)
+    window = range(max(0, before - round(UNSEEN_S / tick_s)), before + 1)
     half_fov = math.radians(scenario.sensors.fov_deg) / 2
     bearings = [math.atan2(offset[i, nearest, 1], offset[i, nearest, 0]) - result.yaws[i] for i in window]
     reach = [math.hypot(*offset[i, nearest]) - radius[nearest] for i in window]
@@ -96,7 +112,7 @@ def classify(case: Path, planner: str, seed: int, noise: float, digest: str) -> 
     )
     if not seen:
         return {"kind": "unseen"}
-    speed = steps[k - 1] / tick_s if k > 0 else 0.0
+    speed = steps[before - 1] / tick_s if before > 0 else 0.0
     top = robot_profile(scenario.robot.profile).limits.max_speed_mps
     return {"kind": "in_view", "faster": bool(speed > top)}
 
@@ -107,7 +123,7 @@ def _classify(job: tuple) -> dict:
 
 def row_of(planner: str, runs: int, kinds: list[dict]) -> dict:
     """A planner's row: its runs, the collided ones, and their first contacts by kind."""
-    counts = {kind: sum(k["kind"] == kind for k in kinds) for kind in ("appeared", "unseen", "in_view")}
+    counts = {kind: sum(k["kind"] == kind for k in kinds) for kind in KINDS}
     faster = sum(k.get("faster", False) for k in kinds)
     return {
         "planner": planner,
@@ -115,6 +131,7 @@ def row_of(planner: str, runs: int, kinds: list[dict]) -> dict:
         "collided": len(kinds),
         **counts,
         "in_view_faster_than_robot": faster,
+        "collided_not_landed_pct": round(100 * (len(kinds) - counts["landed"]) / runs, 1),
     }
 
 

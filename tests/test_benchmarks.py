@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+from vplane_mj.bench.sweep import job_choice
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.loop import run_scenario
 
@@ -241,13 +242,45 @@ def test_dynabarn_collisions_are_classified_from_the_sweeps_journal(tmp_path):
     run_benchmark("dynabarn_collisions.py", "--sweep", "dyn", "--planners", "dwa", cwd=tmp_path)
     (row,) = csv.DictReader((tmp_path / "dyn" / "dynabarn_collisions.csv").open())
     assert int(row["runs"]) == 4 and int(row["collided"]) == collided
-    assert int(row["appeared"]) + int(row["unseen"]) + int(row["in_view"]) == collided
+    assert sum(int(row[kind]) for kind in ("landed", "appeared", "unseen", "in_view")) == collided
     # Another laser noise runs other trajectories than the journal's: refused, naming the world.
     refused = refused_benchmark(
         "dynabarn_collisions.py", "--sweep", str(tmp_path / "dyn"), "--planners", "dwa", "--noise", "0"
     )
     assert "dynabarn_0_" in refused and "another trajectory" in refused
     assert "error: " in refused_benchmark("dynabarn_collisions.py", "--sweep", str(tmp_path / "none"))
+
+
+LANDING = """
+format = 1
+name = "landing"
+[world]
+size = [10.0, 6.0]
+[[world.obstacles]]
+kind = "cylinder"
+radius = 0.4
+[world.obstacles.motion]
+keyframes = [[0.0, 1.9, 3.0], [1.0, 1.9, 5.5]]
+interpolation = "linear"
+phase_s = 0.7
+[robot]
+start = [1.5, 3.0]
+goal = [8.0, 3.0]
+"""
+
+
+def test_a_cylinder_whose_loop_lands_it_on_the_robot_between_two_ticks_is_a_landing(tmp_path):
+    # The cylinder's loop wraps 0.3 s into the run: it jumps from 1.75 m north of the robot back
+    # to its first keyframe, over the robot's front, and touches it before the next control
+    # tick. The contact is classified from the tick after it (the tick before still has the
+    # cylinder far off, where it was never seen to jump).
+    spec = importlib.util.spec_from_file_location("collisions", BENCHMARKS / "dynabarn_collisions.py")
+    collisions = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(collisions)
+    case = tmp_path / "landing.toml"
+    case.write_text(LANDING)
+    digest = run_scenario(load_scenario(str(case), job_choice("apf", 0))).summary.trajectory_sha256
+    assert collisions.classify(case, "apf", 0, 0.0, digest) == {"kind": "landed"}
 
 
 def test_tracker_accuracy_scores_the_tracks_against_the_simulator(tmp_path):
