@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from vplane_mj.kernels.motion import evasion as kernels
+from vplane_mj.planning.motion import evasion as ranking_terms
 from vplane_mj.planning.motion.evasion import Evasion
 from vplane_mj.planning.perception.tracker import Track
 from vplane_mj.planning.planners.groups import MotionParams
@@ -110,6 +111,42 @@ def test_the_room_cap_skips_only_gaps_the_ranking_does_not_count():
         near += full[:, 5].tolist()
     assert min(least) < 0.0 and any(0.3 < gap < 1.0 for gap in least) and max(least) > 1.0
     assert min(near) < 0.0
+
+
+def test_the_ranking_orders_by_the_score_and_keeps_equal_scores_in_order():
+    # The compiled ranking against the score its docstring states, in numpy: random risks, a
+    # third of them meeting no track, three equal rows (equal scores keep their order) and the
+    # last evasion's command kept.
+    rng = np.random.default_rng(3)
+    candidates = EVASION.candidates((1.0, 0.5))
+    n = len(candidates)
+    meet = np.where(rng.random(n) < 0.3, math.inf, rng.uniform(0.0, 3.0, n))
+    risks = np.column_stack(
+        (
+            meet,
+            rng.uniform(-0.5, 2.0, n),
+            rng.uniform(-1.0, 6.0, n),
+            candidates[:, :2],
+            rng.uniform(-0.3, 1.0, n),
+        )
+    )
+    risks[20] = risks[30] = risks[10]
+    evasion = Evasion(JACKAL, horizon_s=3.0, margin_m=0.15, growth_mps=0.15)
+    evasion.kept = (float(candidates[40, 0]), float(candidates[40, 1]))
+    t = ranking_terms
+    soon = 1.0 - np.minimum(risks[:, 0], 3.0) / 3.0
+    score = (
+        risks[:, 2] / (JACKAL.limits.max_speed_mps * 3.0)
+        + t.ROOM_WEIGHT * np.clip(risks[:, 1], 0.0, t.ROOM_CAP_M) / t.ROOM_CAP_M
+        - t.HIT_WEIGHT * soon**t.HIT_EXPONENT
+        - t.DEPTH_WEIGHT * np.maximum(0.0, -risks[:, 5])
+    )
+    kept = score + t.KEEP_BONUS * np.all(candidates[:, :2] == evasion.kept, axis=1)
+    order = list(evasion.ranking(candidates, risks))
+    assert order == list(np.argsort(-kept, kind="stable"))
+    assert order.index(10) < order.index(20) < order.index(30)
+    evasion.kept = None
+    assert list(evasion.ranking(candidates, risks)) == list(np.argsort(-score, kind="stable"))
 
 
 def test_a_robot_already_in_the_way_gets_out_rather_than_on():

@@ -10,6 +10,8 @@ candidate: the first time (s) a disc comes within the margin of the footprint (i
 the horizon), the least gap (m) (footprint to disc, less the growth; negative: they overlap),
 the progress (m) toward the point until then, the command, and the least gap over its first
 moments. `arc_hits` does the same for constant commands alone (the dynamic window's arcs).
+`threat_rows` picks the tracks a robot can meet within the horizon, `ranking` orders the
+candidates by their score.
 """
 
 from __future__ import annotations
@@ -51,6 +53,67 @@ def _outline_gap(outline: np.ndarray, px: float, py: float) -> float:
         dx, dy = rx - t * ex, ry - t * ey
         best = min(best, math.sqrt(dx * dx + dy * dy))
     return best if outside else -best
+
+
+@njit
+def threat_rows(
+    moving: np.ndarray,
+    position: tuple[float, float],
+    limits: tuple[float, float, float, float, float],
+    doubt_caps: tuple[float, float],
+) -> np.ndarray:
+    """(N, 6) the tracks of `moving` (M, 7: x, y in m, vx, vy in m/s, radius in m, position
+    1-sigma in m, velocity 1-sigma in m/s) that could come within the margin of a robot at
+    `position` (m) within the horizon, whatever it does: x, y, vx, vy, radius (m) and its
+    growth (m/s), radius and growth wider by their doubts up to `doubt_caps` (m, m/s). `limits`:
+    the robot's top speed (m/s), the horizon (s), the robot's circumscribed radius (m), the
+    margin (m) and the growth of every track's disc (m/s)."""
+    top_speed, horizon_s, radius_m, margin_m, growth_mps = limits
+    cap_m, cap_mps = doubt_caps
+    rows = np.empty((moving.shape[0], 6))
+    count = 0
+    for n in range(moving.shape[0]):
+        speed = math.hypot(moving[n, 2], moving[n, 3])
+        growth = growth_mps + min(moving[n, 6], cap_mps)
+        size = moving[n, 4] + min(moving[n, 5], cap_m)
+        if math.hypot(moving[n, 0] - position[0], moving[n, 1] - position[1]) < (
+            (top_speed + speed + growth) * horizon_s + radius_m + margin_m + size
+        ):
+            rows[count, :4] = moving[n, :4]
+            rows[count, 4], rows[count, 5] = size, growth
+            count += 1
+    return rows[:count].copy()
+
+
+@njit
+def ranking(
+    candidates: np.ndarray,
+    risks: np.ndarray,
+    scale: tuple[float, float, float],
+    weights: tuple[float, float, float, float, float],
+    kept: tuple[float, float, bool],
+) -> np.ndarray:
+    """The indices of `candidates` (C, 3) best first (stable among equals) by their score from
+    `risks` (C, 6, as `candidate_risks` gives them): the progress over `scale[0]` (m: a horizon at
+    the top speed), plus weights[0] of the least gap up to `scale[2]` (m) over it, less weights[1]
+    (1 - t / `scale[1]`)^weights[2] for a first meeting at t (s) within the horizon `scale[1]`,
+    less weights[3] per metre of overlap within the first moments, plus weights[4] for the
+    command `kept` (m/s, rad/s) when its third item is true."""
+    top, horizon, cap = scale
+    room_weight, hit_weight, hit_exponent, depth_weight, keep_bonus = weights
+    kept_speed, kept_turn, keeping = kept
+    score = np.empty(candidates.shape[0])
+    for c in range(candidates.shape[0]):
+        soon = 1.0 - min(risks[c, 0], horizon) / horizon
+        score[c] = (
+            risks[c, 2] / top
+            + room_weight * min(max(risks[c, 1], 0.0), cap) / cap
+            - hit_weight * soon**hit_exponent
+            - depth_weight * max(0.0, -risks[c, 5])
+        )
+        if keeping and candidates[c, 0] == kept_speed and candidates[c, 1] == kept_turn:
+            score[c] += keep_bonus
+    return np.argsort(-score, kind="stable")
 
 
 @njit

@@ -100,14 +100,17 @@ class Evasion:
         moving = moving_tracks(tracks, time_s)
         if not len(moving):
             return Threat(np.empty((0, 6)))
-        speed = np.hypot(moving[:, 2], moving[:, 3])
-        growth = self.growth_mps + np.minimum(moving[:, 6], DOUBT_CAP_MPS)
-        size = moving[:, 4] + np.minimum(moving[:, 5], DOUBT_CAP_M)
-        top = self.body.limits.max_speed_mps
-        reach = (top + speed + growth) * self.horizon_s + self.body.radius_m + self.margin_m + size
-        near = np.hypot(moving[:, 0] - position[0], moving[:, 1] - position[1]) < reach
-        rows = np.column_stack((moving[:, :4], size, growth))[near]
-        return Threat(np.ascontiguousarray(rows, dtype=float))
+        from vplane_mj.kernels.motion import evasion  # numba: loaded by the first call
+
+        limits = (
+            self.body.limits.max_speed_mps,
+            self.horizon_s,
+            self.body.radius_m,
+            self.margin_m,
+            self.growth_mps,
+        )
+        at = (float(position[0]), float(position[1]))
+        return Threat(evasion.threat_rows(moving, at, limits, (DOUBT_CAP_M, DOUBT_CAP_MPS)))
 
     def candidates(self, wanted: tuple[float, float]) -> np.ndarray:
         """The motions to rank (C, 3: speed m/s, turn rate rad/s, held s; then on for the aim):
@@ -156,14 +159,13 @@ class Evasion:
         ROOM_CAP_M), plus KEEP_BONUS for the last evasion's command, less HIT_WEIGHT
         (1 - t / horizon)^HIT_EXPONENT for meeting a track at t and DEPTH_WEIGHT times the
         overlap predicted within NEAR_S."""
-        top = self.body.limits.max_speed_mps * self.horizon_s
-        soon = 1.0 - np.minimum(risks[:, 0], self.horizon_s) / self.horizon_s
-        score = (
-            risks[:, 2] / top
-            + ROOM_WEIGHT * np.clip(risks[:, 1], 0.0, ROOM_CAP_M) / ROOM_CAP_M
-            - HIT_WEIGHT * soon**HIT_EXPONENT
-            - DEPTH_WEIGHT * np.maximum(0.0, -risks[:, 5])
+        from vplane_mj.kernels.motion import evasion  # numba: loaded by the first call
+
+        kept = (0.0, 0.0, False) if self.kept is None else (*self.kept, True)
+        return evasion.ranking(
+            candidates,
+            risks,
+            (self.body.limits.max_speed_mps * self.horizon_s, self.horizon_s, ROOM_CAP_M),
+            (ROOM_WEIGHT, HIT_WEIGHT, HIT_EXPONENT, DEPTH_WEIGHT, KEEP_BONUS),
+            kept,
         )
-        if self.kept is not None:
-            score += KEEP_BONUS * np.all(candidates[:, :2] == self.kept, axis=1)
-        return np.argsort(-score, kind="stable")
