@@ -113,6 +113,36 @@ def test_the_room_cap_skips_only_gaps_the_ranking_does_not_count():
     assert min(near) < 0.0
 
 
+def test_a_candidate_that_follows_the_one_before_gets_what_it_gets_alone():
+    # A candidate with the command of the one before, held as long or longer, starts from that
+    # one's motion at the end of its hold (or where it stopped): every row must equal the row of
+    # the candidate checked alone, bit for bit. The grid's pairs (held 0.5 and 1.5 s), and pairs
+    # held 1.5 and 3 s, some of whose first meets a track within its hold and stops there.
+    limits = JACKAL.limits
+    grid = EVASION.candidates((1.5, 0.3))
+    assert (grid[1::2, :2] == grid[2::2, :2]).all()
+    longer = np.repeat(grid[1::2], 2, axis=0)
+    longer[:, 2] = np.tile([1.5, 3.0], len(longer) // 2)
+    for seed, candidates in ((2, grid), (5, grid), (2, longer)):
+        rng = np.random.default_rng(seed)
+        tracks = np.column_stack(
+            (rng.uniform(-4, 4, (6, 2)), rng.uniform(-2, 2, (6, 2)), np.full(6, 0.5), np.full(6, 0.15))
+        )
+        rest = (
+            (0.0, 0.0, 0.3), (1.0, 0.2),
+            (limits.max_speed_mps, limits.max_turn_rate_radps, limits.max_accel_mps2,
+             limits.braking_in_turn_mps2, limits.max_turn_accel_radps2, JACKAL.gains.turn_gain),
+            (3.0, 0.1), np.ascontiguousarray(JACKAL.footprint, float), float(JACKAL.radius_m), tracks,
+            0.15, (10.0, 0.0), 1.0, 1.0,
+        )  # fmt: skip
+        together = kernels.candidate_risks(candidates, *rest)
+        alone = np.vstack(
+            [kernels.candidate_risks(candidates[c : c + 1], *rest) for c in range(len(candidates))]
+        )
+        assert np.array_equal(together, alone)
+        assert np.isinf(together[:, 0]).any() and (together[:, 0] < 1.5).any()
+
+
 def test_the_ranking_orders_by_the_score_and_keeps_equal_scores_in_order():
     # The compiled ranking against the score its docstring states, in numpy: random risks, a
     # third of them meeting no track, three equal rows (equal scores keep their order) and the

@@ -116,6 +116,47 @@ def ranking(
     return np.argsort(-score, kind="stable")
 
 
+@njit(inline="always")
+def _toward_aim(
+    x: float, y: float, yaw: float, aim: tuple[float, float], limits: tuple[float, float, float, float]
+) -> tuple[float, float]:
+    """The heading controller's command (m/s, rad/s) from (x, y, yaw) toward the point `aim`:
+    the top speed times max(0, cos e) and k_w e, limited, and no turn faster than one that stops
+    where it faces the aim. `limits`: top speed, top turn rate, turn acceleration, k_w."""
+    top_speed, top_turn, alpha, gain = limits
+    error = _wrap(math.atan2(aim[1] - y, aim[0] - x) - yaw)
+    turn = min(max(gain * error, -top_turn), top_turn)
+    stop = math.sqrt(2.0 * alpha * abs(error))
+    return top_speed * max(0.0, math.cos(error)), min(max(turn, -stop), stop)
+
+
+@njit(inline="always")
+def _track_gaps(
+    tracks: np.ndarray, t: float, x: float, y: float, yaw: float, outline: np.ndarray,
+    reach_m: float, margin_m: float, counted: float,
+) -> tuple[float, float, bool]:  # fmt: skip
+    """At time `t` (s), the robot's footprint `outline` at (x, y, yaw) against each track's
+    predicted disc (`candidate_risks`), skipping a track whose bound below the gap lies beyond
+    both `counted` and `margin_m`: the least gap measured (inf: none), `counted` lowered by the
+    gaps, and whether a gap lies within the margin."""
+    least, within = math.inf, False
+    cos_yaw, sin_yaw, turned_to = 0.0, 0.0, False  # the heading's, once a track comes near
+    for n in range(tracks.shape[0]):
+        ox = tracks[n, 0] + tracks[n, 2] * t - x
+        oy = tracks[n, 1] + tracks[n, 3] * t - y
+        size = tracks[n, 4] + tracks[n, 5] * t
+        bound = math.sqrt(ox * ox + oy * oy) - reach_m - size  # a bound below the gap
+        if bound >= counted and bound >= margin_m:
+            continue
+        if not turned_to:
+            cos_yaw, sin_yaw, turned_to = math.cos(yaw), math.sin(yaw), True
+        gap = _outline_gap(outline, cos_yaw * ox + sin_yaw * oy, -sin_yaw * ox + cos_yaw * oy) - size
+        least = min(least, gap)
+        counted = min(counted, gap)
+        within = within or gap < margin_m
+    return least, counted, within
+
+
 @njit
 def candidate_risks(
     candidates: np.ndarray,
@@ -148,24 +189,30 @@ def candidate_risks(
     steps = math.ceil(horizon / dt - 1e-9)
     result = np.empty((candidates.shape[0], 6))
     x0, y0, yaw0 = pose
-    ax, ay = aim
-    away = math.hypot(ax - x0, ay - y0)
+    away = math.hypot(aim[0] - x0, aim[1] - y0)
+    # A motion's state: pose, speed, turn rate, first meeting, least gap, least gap within
+    # near_s, the least gap that still counts (min(least, room_cap_m)), and where the robot is
+    # at the last step that meets no track. `kept`: the last candidate's at the end of its hold
+    # (or where it stopped, `kept_ended`), at step `kept_step`; the next candidate with the same
+    # command held as long or longer follows it that far, step for step, and starts from there.
+    start = (x0, y0, yaw0, state[0], state[1], math.inf, math.inf, math.inf, room_cap_m, x0, y0)
+    kept, kept_step, kept_ended = start, -1, False
     for c in range(candidates.shape[0]):
         v_hold, w_hold, hold_s = candidates[c, 0], candidates[c, 1], candidates[c, 2]
-        v, w = state
-        x, y, yaw = x0, y0, yaw0
-        hit, least, near, advance = math.inf, math.inf, math.inf, 0.0
-        counted = room_cap_m  # the least gap that still counts: min(least, room_cap_m)
-        for s in range(1, steps + 1):
+        held = 0  # the steps of the hold: their times within hold_s
+        while (held + 1) * dt <= hold_s + 1e-9:
+            held += 1
+        follows = kept_step >= 0 and v_hold == candidates[c - 1, 0] and w_hold == candidates[c - 1, 1]
+        follows = follows and hold_s >= candidates[c - 1, 2]
+        x, y, yaw, v, w, hit, least, near, counted, last_x, last_y = kept if follows else start
+        s, ended = (kept_step + 1, kept_ended) if follows else (1, False)
+        kept_step = -1
+        while not ended and s <= steps:
             t = s * dt
             if t <= hold_s + 1e-9:
                 v_cmd, w_cmd = v_hold, w_hold
             else:  # resume: the heading controller toward the aim, at the top speed
-                error = _wrap(math.atan2(ay - y, ax - x) - yaw)
-                v_cmd = top_speed * max(0.0, math.cos(error))
-                w_cmd = min(max(gain * error, -top_turn), top_turn)
-                stop = math.sqrt(2.0 * alpha * abs(error))  # no turn faster than one that stops there
-                w_cmd = min(max(w_cmd, -stop), stop)
+                v_cmd, w_cmd = _toward_aim(x, y, yaw, aim, (top_speed, top_turn, alpha, gain))
             rate = accel if abs(v_cmd) > abs(v) and v_cmd * v >= 0.0 else brake
             v_next = _toward(v, min(max(v_cmd, -top_speed), top_speed), rate * dt)
             w_next = _toward(w, w_cmd, alpha * dt)
@@ -174,25 +221,19 @@ def candidate_risks(
             step = 0.5 * (v + v_next) * dt
             x, y, yaw = x + step * math.cos(mid), y + step * math.sin(mid), yaw + turned
             v, w = v_next, w_next
-            cos_yaw, sin_yaw = math.cos(yaw), math.sin(yaw)
-            for n in range(tracks.shape[0]):
-                ox = tracks[n, 0] + tracks[n, 2] * t - x
-                oy = tracks[n, 1] + tracks[n, 3] * t - y
-                size = tracks[n, 4] + tracks[n, 5] * t
-                bound = math.sqrt(ox * ox + oy * oy) - reach_m - size  # a bound below the gap
-                if bound >= counted and bound >= margin_m:
-                    continue
-                gap = _outline_gap(outline, cos_yaw * ox + sin_yaw * oy, -sin_yaw * ox + cos_yaw * oy) - size
-                least = min(least, gap)
-                counted = min(counted, gap)
-                if t <= near_s + 1e-9:
-                    near = min(near, gap)
-                if gap < margin_m and t < hit:
-                    hit = t
+            gap, counted, within = _track_gaps(tracks, t, x, y, yaw, outline, reach_m, margin_m, counted)
+            least = min(least, gap)
+            near = min(near, gap) if t <= near_s + 1e-9 else near
+            hit = t if within and t < hit else hit
             if hit == math.inf:
-                advance = away - math.hypot(ax - x, ay - y)
+                last_x, last_y = x, y
             elif t >= near_s:
-                break  # what is left to learn of a motion that meets a track: nothing that ranks it
+                ended = True  # what is left to learn of a motion that meets a track: nothing that ranks it
+            if s == held or (ended and s < held):
+                kept = (x, y, yaw, v, w, hit, least, near, counted, last_x, last_y)
+                kept_step, kept_ended = s, ended
+            s += 1
+        advance = away - math.hypot(aim[0] - last_x, aim[1] - last_y)  # 0 when every step meets a track
         result[c, 0], result[c, 1], result[c, 2] = hit, least, advance
         result[c, 3], result[c, 4], result[c, 5] = v_hold, w_hold, near
     return result
