@@ -263,6 +263,27 @@ def test_clearance_to_moving_obstacles_is_measured_where_they_stood():
     np.testing.assert_allclose(only_rects, [3.0 - 0.25 - 0.2, 3.0 - 0.25 - 0.2])
 
 
+def test_the_outline_is_measured_only_against_discs_that_can_be_nearest_and_nothing_is_lost():
+    # The outline's clearance to many discs equals its least gap to every one of them, each
+    # measured (an off-centre outline whose origin lies outside it, overlaps included).
+    rng = np.random.default_rng(7)
+    count, d = 300, 19
+    discs = np.column_stack((np.zeros((d, 2)), rng.uniform(0.2, 0.6, d)))
+    places = rng.uniform(-3, 3, (count, d, 2))
+    poses = np.column_stack((rng.uniform(-3, 3, (count, 2)), rng.uniform(-math.pi, math.pi, count)))
+    outline = np.array([[0.6, 0.1], [0.2, 0.3], [0.1, -0.2], [0.5, -0.3]])
+    found = shapes.moving_distances(discs, np.empty((0, 6)), places, poses, outline)
+    each = np.array(
+        [
+            [shapes._polygon_distance(outline, shapes._to_body(places[i, k : k + 1], poses[i : i + 1]))[0]
+             - discs[k, 2] for k in range(d)]
+            for i in range(count)
+        ]
+    )  # fmt: skip
+    np.testing.assert_array_equal(found, each.min(axis=1))
+    assert (found < 0).any() and (found > 0.5).any()
+
+
 # -- the sensors -------------------------------------------------------------------------------
 def random_moving_world(rng: np.random.Generator) -> str:
     """Moving cylinders and boxes on random looping paths, some static boxes."""

@@ -341,12 +341,11 @@ def moving_distances(
     poses = np.atleast_2d(np.asarray(poses, float))
     count, found = len(poses), np.full(len(poses), np.inf)
     d = len(discs)
-    if d:
+    if d and outline is not None:
+        found = np.minimum(found, _outline_to_discs(outline, discs[:, 2], places[:, :d], poses))
+    elif d:
         centres = places[:, :d].reshape(-1, 2)
-        if outline is None:
-            gaps = np.hypot(*(centres - np.repeat(poses[:, :2], d, 0)).T)
-        else:
-            gaps = _polygon_distance(outline, _to_body(centres, np.repeat(poses, d, 0)))
+        gaps = np.hypot(*(centres - np.repeat(poses[:, :2], d, 0)).T)
         found = np.minimum(found, (gaps.reshape(count, d) - discs[:, 2]).min(axis=1))
     r = len(rects)
     if r:
@@ -357,6 +356,27 @@ def moving_distances(
         else:
             gaps = placed._outline_to_rects(outline, repeated, np.arange(len(repeated)))
         found = np.minimum(found, gaps.reshape(count, r).min(axis=1))
+    return found
+
+
+def _outline_to_discs(
+    outline: np.ndarray, radii: np.ndarray, centres: np.ndarray, poses: np.ndarray
+) -> np.ndarray:
+    """Signed distance (m) from the outline (k, 2; convex, counter-clockwise, robot frame) at
+    each pose (N, 3) to the nearest disc of `radii` (D,) centred at `centres` (N, D, 2). The
+    outline's signed distance to a point is never less than the point's distance from the
+    origin less the outline's circumscribed radius R, so only the discs whose centres come
+    within R of the exact gap to the disc nearest by centre are measured."""
+    count = len(poses)
+    beyond = np.hypot(centres[..., 0] - poses[:, None, 0], centres[..., 1] - poses[:, None, 1]) - radii
+    nearest = beyond.argmin(axis=1)
+    rows = np.arange(count)
+    best = _polygon_distance(outline, _to_body(centres[rows, nearest], poses)) - radii[nearest]
+    circumradius = float(np.hypot(outline[:, 0], outline[:, 1]).max())
+    rows, columns = np.nonzero(beyond - circumradius <= best[:, None] + 1e-9)
+    gaps = _polygon_distance(outline, _to_body(centres[rows, columns], poses[rows])) - radii[columns]
+    found = np.full(count, np.inf)
+    np.minimum.at(found, rows, gaps)
     return found
 
 
