@@ -139,8 +139,8 @@ README_FIGURES = (
         [
             (("dynabarn_0_hard_041", "`apf`"), "run / floor"),
             (("dynabarn_0_medium_020", "`apf`"), "run / floor"),
-            (("dynabarn_0_medium_020", "`vplane_plus`"), "run / floor"),
             (("dynabarn_0_hard_041", "`vplane_plus`"), "run / floor"),
+            (("dynabarn_0_medium_020", "`vplane_plus`"), "run / floor"),
         ],
     ),
 )
