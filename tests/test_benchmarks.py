@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+from tests.test_moving import scenario_text
 from vplane_mj.bench.sweep import job_choice
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.loop import run_scenario
@@ -252,10 +253,6 @@ def test_dynabarn_collisions_are_classified_from_the_sweeps_journal(tmp_path):
 
 
 LANDING = """
-format = 1
-name = "landing"
-[world]
-size = [10.0, 6.0]
 [[world.obstacles]]
 kind = "cylinder"
 radius = 0.4
@@ -263,10 +260,8 @@ radius = 0.4
 keyframes = [[0.0, 1.9, 3.0], [1.0, 1.9, 5.5]]
 interpolation = "linear"
 phase_s = 0.7
-[robot]
-start = [1.5, 3.0]
-goal = [8.0, 3.0]
 """
+"""A cylinder whose loop lands it in front of a robot at (1.5, 3.0) 0.3 s into the run."""
 
 
 def test_a_cylinder_whose_loop_lands_it_on_the_robot_between_two_ticks_is_a_landing(tmp_path):
@@ -278,7 +273,7 @@ def test_a_cylinder_whose_loop_lands_it_on_the_robot_between_two_ticks_is_a_land
     collisions = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(collisions)
     case = tmp_path / "landing.toml"
-    case.write_text(LANDING)
+    case.write_text(scenario_text(LANDING, "start = [1.5, 3.0]\ngoal = [8.0, 3.0]"))
     digest = run_scenario(load_scenario(str(case), job_choice("apf", 0))).summary.trajectory_sha256
     assert collisions.classify(case, "apf", 0, 0.0, digest) == {"kind": "landed"}
 

@@ -84,25 +84,42 @@ def test_the_ranking_picks_a_clear_motion_that_still_makes_progress():
     assert risks[best, 2] > 1.0  # gets on toward the goal, not away from it
 
 
+def random_tracks(seed: int, count: int, spread_m: float) -> np.ndarray:
+    """`count` tracks as the check takes them (x, y within `spread_m` of the origin, up to 2
+    m/s each way, radius 0.5 m, growth 0.15 m/s), drawn from `seed`."""
+    rng = np.random.default_rng(seed)
+    return np.column_stack(
+        (
+            rng.uniform(-spread_m, spread_m, (count, 2)),
+            rng.uniform(-2, 2, (count, 2)),
+            np.full(count, 0.5),
+            np.full(count, 0.15),
+        )
+    )
+
+
+def check_arguments(tracks: np.ndarray) -> tuple:
+    """The compiled check's arguments after the candidates and before the room cap: the Jackal
+    at the origin heading 0.3 rad at 1 m/s and 0.2 rad/s, its limits, a 3 s horizon in 0.1 s
+    steps, `tracks`, a 0.15 m margin, the aim 10 m ahead and the first second."""
+    limits = JACKAL.limits
+    return (
+        (0.0, 0.0, 0.3), (1.0, 0.2),
+        (limits.max_speed_mps, limits.max_turn_rate_radps, limits.max_accel_mps2,
+         limits.braking_in_turn_mps2, limits.max_turn_accel_radps2, JACKAL.gains.turn_gain),
+        (3.0, 0.1), np.ascontiguousarray(JACKAL.footprint, float), float(JACKAL.radius_m), tracks,
+        0.15, (10.0, 0.0), 1.0,
+    )  # fmt: skip
+
+
 def test_the_room_cap_skips_only_gaps_the_ranking_does_not_count():
     # Gaps beyond the cap are pruned in the kernel; every column the ranking reads must equal
     # what the uncapped check gives: the meeting, the progress, the command, the room up to the
     # cap and any overlap within the first second. Two draws of four crossing tracks give gaps
     # below and above the cap, and overlaps.
-    limits = JACKAL.limits
     least, near = [], []
     for seed in (1, 4):
-        rng = np.random.default_rng(seed)
-        tracks = np.column_stack(
-            (rng.uniform(-8, 8, (4, 2)), rng.uniform(-2, 2, (4, 2)), np.full(4, 0.5), np.full(4, 0.15))
-        )
-        args = (
-            EVASION.candidates((1.5, 0.3)), (0.0, 0.0, 0.3), (1.0, 0.2),
-            (limits.max_speed_mps, limits.max_turn_rate_radps, limits.max_accel_mps2,
-             limits.braking_in_turn_mps2, limits.max_turn_accel_radps2, JACKAL.gains.turn_gain),
-            (3.0, 0.1), np.ascontiguousarray(JACKAL.footprint, float), float(JACKAL.radius_m), tracks,
-            0.15, (10.0, 0.0), 1.0,
-        )  # fmt: skip
+        args = (EVASION.candidates((1.5, 0.3)), *check_arguments(random_tracks(seed, 4, 8.0)))
         capped, full = kernels.candidate_risks(*args, 1.0), kernels.candidate_risks(*args, math.inf)
         assert np.array_equal(capped[:, [0, 2, 3, 4]], full[:, [0, 2, 3, 4]])
         assert np.array_equal(np.minimum(capped[:, 1], 1.0), np.minimum(full[:, 1], 1.0))
@@ -118,23 +135,12 @@ def test_a_candidate_that_follows_the_one_before_gets_what_it_gets_alone():
     # one's motion at the end of its hold (or where it stopped): every row must equal the row of
     # the candidate checked alone, bit for bit. The grid's pairs (held 0.5 and 1.5 s), and pairs
     # held 1.5 and 3 s, some of whose first meets a track within its hold and stops there.
-    limits = JACKAL.limits
     grid = EVASION.candidates((1.5, 0.3))
     assert (grid[1::2, :2] == grid[2::2, :2]).all()
     longer = np.repeat(grid[1::2], 2, axis=0)
     longer[:, 2] = np.tile([1.5, 3.0], len(longer) // 2)
     for seed, candidates in ((2, grid), (5, grid), (2, longer)):
-        rng = np.random.default_rng(seed)
-        tracks = np.column_stack(
-            (rng.uniform(-4, 4, (6, 2)), rng.uniform(-2, 2, (6, 2)), np.full(6, 0.5), np.full(6, 0.15))
-        )
-        rest = (
-            (0.0, 0.0, 0.3), (1.0, 0.2),
-            (limits.max_speed_mps, limits.max_turn_rate_radps, limits.max_accel_mps2,
-             limits.braking_in_turn_mps2, limits.max_turn_accel_radps2, JACKAL.gains.turn_gain),
-            (3.0, 0.1), np.ascontiguousarray(JACKAL.footprint, float), float(JACKAL.radius_m), tracks,
-            0.15, (10.0, 0.0), 1.0, 1.0,
-        )  # fmt: skip
+        rest = (*check_arguments(random_tracks(seed, 6, 4.0)), 1.0)
         together = kernels.candidate_risks(candidates, *rest)
         alone = np.vstack(
             [kernels.candidate_risks(candidates[c : c + 1], *rest) for c in range(len(candidates))]
