@@ -14,6 +14,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from tests.test_moving import scenario_text
@@ -379,3 +380,46 @@ def test_ros2_export_reports_its_time_and_the_bag_s_size_per_minute(tmp_path):
     assert number(jackal[6]) > 0 and number(default[6]) > 0  # the export's seconds
     assert (tmp_path / "bags" / "ros2_export.csv").is_file()
     assert "--repeat at least 1" in refused_benchmark("ros2_export.py", "--repeat", "0")
+
+
+def motion_prediction():
+    """benchmarks/motion_prediction.py as a module."""
+    spec = importlib.util.spec_from_file_location("motion_prediction", BENCHMARKS / "motion_prediction.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_prediction_misses_by_what_the_obstacle_changed_after_it():
+    predict = motion_prediction().prediction_errors
+    # 1 m/s east until 10 s, then 2 m/s: predicted from 8.0 s (its last half second at 1 m/s),
+    # 3 s ahead it is 1 m farther along than the constant velocity puts it, and not aside.
+    times = np.arange(150, 221) * 0.05
+    east = np.where(times < 10.0, times, 10.0 + 2.0 * (times - 10.0))
+    ((speeding,),) = predict(np.stack([east, np.zeros_like(east)], 1), 0.05, 0.5, 0.25, (3.0,))
+    assert speeding == pytest.approx([1.0, 1.0, 0.0, 1.0], abs=1e-9)
+    # A straight line at a steady speed is predicted exactly, both ways.
+    steady = predict(np.outer(times, [1.2, -0.5]), 0.05, 0.5, 0.25, (0.5, 3.0))
+    assert len(steady) > 0 and np.abs(steady).max() < 1e-9
+    # On a circle (2 m radius, 0.5 rad/s) the constant velocity strays to the left, the
+    # constant turn rate follows it.
+    times = np.arange(200) * 0.05
+    circle = predict(np.stack([2 * np.cos(0.5 * times), 2 * np.sin(0.5 * times)], 1), 0.05, 0.5, 0.25, (1.0,))
+    assert circle[:, 0, 2].min() > 0.2 and circle[:, 0, 3].max() < 0.02
+    # A window over a loop's jump back to its start is left out.
+    jumped = np.outer(times, [1.0, 0.0])
+    jumped[100:] -= 5.0
+    kept = predict(jumped, 0.05, 0.5, 0.25, (1.0,))
+    assert len(kept) == len(predict(np.outer(times, [1.0, 0.0]), 0.05, 0.5, 0.25, (1.0,))) - 6
+
+
+def test_motion_prediction_scores_generated_worlds(tmp_path):
+    out = run_benchmark(
+        "motion_prediction.py", *("--count", "3", "--span", "20", "--out", "mp"), cwd=tmp_path
+    )
+    one, three = table_rows(out, "all")[1], table_rows(out, "all")[3]
+    assert one[1] == "1.0" and three[1] == "3.0"
+    assert int(one[2]) > 0 and 0.0 < number(one[4]) < number(three[4])  # the error grows ahead
+    assert (tmp_path / "mp" / "motion_prediction.csv").is_file()
+    assert "--horizons: positive numbers" in refused_benchmark("motion_prediction.py", "--horizons", "0,1")
+    assert "--span: longer than" in refused_benchmark("motion_prediction.py", "--span", "3")
