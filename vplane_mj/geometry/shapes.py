@@ -341,12 +341,15 @@ def moving_distances(
     poses = np.atleast_2d(np.asarray(poses, float))
     count, found = len(poses), np.full(len(poses), np.inf)
     d = len(discs)
-    if d and outline is not None:
-        found = np.minimum(found, _outline_to_discs(outline, discs[:, 2], places[:, :d], poses))
-    elif d:
-        centres = places[:, :d].reshape(-1, 2)
-        gaps = np.hypot(*(centres - np.repeat(poses[:, :2], d, 0)).T)
-        found = np.minimum(found, (gaps.reshape(count, d) - discs[:, 2]).min(axis=1))
+    if d:
+        centres = places[:, :d]
+        beyond = (
+            np.hypot(centres[..., 0] - poses[:, None, 0], centres[..., 1] - poses[:, None, 1]) - discs[:, 2]
+        )
+        if outline is None:
+            found = np.minimum(found, beyond.min(axis=1))
+        else:
+            found = np.minimum(found, _outline_to_discs(outline, discs[:, 2], centres, poses, beyond))
     r = len(rects)
     if r:
         repeated = np.repeat(poses, r, 0)
@@ -360,15 +363,15 @@ def moving_distances(
 
 
 def _outline_to_discs(
-    outline: np.ndarray, radii: np.ndarray, centres: np.ndarray, poses: np.ndarray
+    outline: np.ndarray, radii: np.ndarray, centres: np.ndarray, poses: np.ndarray, beyond: np.ndarray
 ) -> np.ndarray:
     """Signed distance (m) from the outline (k, 2; convex, counter-clockwise, robot frame) at
-    each pose (N, 3) to the nearest disc of `radii` (D,) centred at `centres` (N, D, 2). The
-    outline's signed distance to a point is never less than the point's distance from the
-    origin less the outline's circumscribed radius R, so only the discs whose centres come
-    within R of the exact gap to the disc nearest by centre are measured."""
+    each pose (N, 3) to the nearest disc of `radii` (D,) centred at `centres` (N, D, 2), whose
+    gaps to each pose's origin are `beyond` (N, D; m). The outline's signed distance to a point
+    is never less than the point's distance from the origin less the outline's circumscribed
+    radius R, so only the discs whose gaps come within R of the exact gap to the disc nearest
+    by centre are measured."""
     count = len(poses)
-    beyond = np.hypot(centres[..., 0] - poses[:, None, 0], centres[..., 1] - poses[:, None, 1]) - radii
     nearest = beyond.argmin(axis=1)
     rows = np.arange(count)
     best = _polygon_distance(outline, _to_body(centres[rows, nearest], poses)) - radii[nearest]

@@ -136,7 +136,7 @@ def _track_gaps(
     reach_m: float, margin_m: float, counted: float,
 ) -> tuple[float, float, bool]:  # fmt: skip
     """At time `t` (s), the robot's footprint `outline` at (x, y, yaw) against each track's
-    predicted disc (`candidate_risks`), skipping a track whose bound below the gap lies beyond
+    predicted disc (`candidate_risks`, `arc_hits`), skipping a track whose bound below the gap lies beyond
     both `counted` and `margin_m`: the least gap measured (inf: none), `counted` lowered by the
     gaps, and whether a gap lies within the margin."""
     least, within = math.inf, False
@@ -268,19 +268,7 @@ def arc_hits(
                 y = y0 - v / w * (math.cos(yaw) - math.cos(yaw0))
             else:
                 x, y = x0 + v * t * math.cos(yaw0), y0 + v * t * math.sin(yaw0)
-            cos_yaw, sin_yaw = math.cos(yaw), math.sin(yaw)
-            hit = False
-            for n in range(tracks.shape[0]):
-                ox = tracks[n, 0] + tracks[n, 2] * t - x
-                oy = tracks[n, 1] + tracks[n, 3] * t - y
-                size = tracks[n, 4] + tracks[n, 5] * t
-                if math.sqrt(ox * ox + oy * oy) - reach_m - size >= margin_m:
-                    continue
-                gap = _outline_gap(outline, cos_yaw * ox + sin_yaw * oy, -sin_yaw * ox + cos_yaw * oy) - size
-                if gap < margin_m:
-                    hit = True
-                    break
-            if hit:
+            if _track_gaps(tracks, t, x, y, yaw, outline, reach_m, margin_m, margin_m)[2]:
                 hits[c] = t
                 break
     return hits
