@@ -30,9 +30,9 @@ from pathlib import Path
 
 import numpy as np
 
-from vplane_mj.bench.sweep import parse_seeds, plan_jobs, run_sweep
+from vplane_mj.bench import options
+from vplane_mj.bench.sweep import plan_jobs, run_sweep
 from vplane_mj.bench.tables import markdown_table, write_table
-from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir, write_atomically
 from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.worlds.barn_protocol import generate_protocol
@@ -135,31 +135,17 @@ def plot(table: list[dict], path: Path) -> None:
     plt.close(figure)
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     default = [name for name in PLANNER_ORDER if name in PLANNERS]
-    parser.add_argument("--planners", default=",".join(default))
-    parser.add_argument("--count", type=int, default=50, help="protocol worlds")
-    parser.add_argument("--world-seed", type=int, default=0, help="seed of the worlds")
-    parser.add_argument("--seeds", default="0-2", help="run seeds, as vplane-mj bench takes them")
-    parser.add_argument("--noise", type=float, default=0.01, help="laser range noise (m)")
-    parser.add_argument("--jobs", type=int, default=2)
-    parser.add_argument("--out", type=Path, default=Path("logs/barn_protocol"))
+    parser.add_argument("--planners", type=options.planners, default=",".join(default))
+    options.add_world_sweep(parser, (50, "protocol worlds"), "0-2", "barn_protocol")
     args = parser.parse_args(argv)
-    planners = [p.strip() for p in args.planners.split(",")]
-    unknown = sorted(set(planners) - set(PLANNERS))
-    if unknown or args.count < 1 or args.jobs < 1 or args.noise < 0:
-        print(f"error: bad arguments (unknown planners: {unknown})", file=sys.stderr)
-        return 2
-    try:
-        seeds = parse_seeds(args.seeds)
-        out = prepare_out_dir(args.out)
-    except VPlaneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    out = prepare_out_dir(args.out)
     scenarios = write_cases(out, args.count, args.world_seed)
     overrides = [f"sensors.noise_std={args.noise}"] if args.noise > 0 else []
-    jobs = plan_jobs(scenarios, planners, seeds, overrides)
+    jobs = plan_jobs(scenarios, args.planners, args.seeds, overrides)
     rows = run_sweep(jobs, out, args.jobs)
     table = planner_table(rows)
     text = markdown([*table, *PUBLISHED])

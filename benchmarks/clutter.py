@@ -28,9 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
+from vplane_mj.bench import options
 from vplane_mj.bench.sweep import plan_jobs, run_sweep
 from vplane_mj.bench.tables import markdown_table, write_table
-from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir, write_atomically
 from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.worlds.families import generate, trap_suite
@@ -169,32 +169,32 @@ def _number(value: float | None) -> float:
     return float("nan") if value is None else float(value)
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--planners", default=",".join(sorted(PLANNERS)))
-    parser.add_argument("--barn", type=int, default=100, help="BARN-like worlds (seed 0)")
-    parser.add_argument("--count", type=int, default=10, help="worlds of each other generated family")
-    parser.add_argument("--seed", type=int, default=1, help="seed of the traps, clutter and corridors")
-    parser.add_argument("--noise", type=float, default=0.03, help="sonar noise of the noisy barn runs (m)")
-    parser.add_argument("--dropout", type=float, default=0.1, help="dropout of the noisy barn runs")
-    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--planners", type=options.planners, default=",".join(sorted(PLANNERS)))
+    parser.add_argument("--barn", type=options.whole(0), default=100, help="BARN-like worlds (seed 0)")
+    parser.add_argument(
+        "--count", type=options.whole(0), default=10, help="worlds of each other generated family"
+    )
+    parser.add_argument(
+        "--seed", type=options.whole(0), default=1, help="seed of the traps, clutter and corridors"
+    )
+    parser.add_argument(
+        "--noise", type=options.non_negative, default=0.03, help="sonar noise of the noisy barn runs (m)"
+    )
+    parser.add_argument(
+        "--dropout", type=options.number(0.0, most=1.0), default=0.1, help="dropout of the noisy barn runs"
+    )
+    parser.add_argument("--jobs", type=options.whole(1), default=2, help="worker processes")
     parser.add_argument("--out", type=Path, default=Path("logs/clutter"))
     args = parser.parse_args(argv)
-    planners = [p.strip() for p in args.planners.split(",")]
-    unknown = sorted(set(planners) - set(PLANNERS))
-    if unknown or args.barn < 0 or args.count < 0 or args.jobs < 1:
-        print(f"error: bad arguments (unknown planners: {unknown})", file=sys.stderr)
-        return 2
-    try:
-        out = prepare_out_dir(args.out)
-    except VPlaneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    out = prepare_out_dir(args.out)
     families = write_cases(out, args.barn, args.count, args.seed)
     family_of = {}
     jobs = []
     for family, scenarios in families.items():
-        mine = plan_jobs(scenarios, planners, [0])
+        mine = plan_jobs(scenarios, args.planners, [0])
         family_of.update((job.scenario, family) for job in mine)
         jobs += mine
     noisy = []
@@ -202,7 +202,7 @@ def main(argv: list[str] | None = None) -> int:
         overrides = (f"sensors.noise_std={args.noise}", f"sensors.dropout={args.dropout}")
         noisy = [
             _renamed(job, job.scenario + NOISY_SUFFIX)
-            for job in plan_jobs(families["barn"], planners, [0], overrides)
+            for job in plan_jobs(families["barn"], args.planners, [0], overrides)
         ]
         for job in noisy:
             family_of[job.scenario] = "barn" + NOISY_SUFFIX

@@ -24,12 +24,12 @@ per planner, the reference point starred), and prints the success table.
 from __future__ import annotations
 
 import argparse
-import sys
+from collections.abc import Callable
 from pathlib import Path
 
-from vplane_mj.bench.sweep import parse_seeds, plan_jobs, run_sweep
+from vplane_mj.bench import options
+from vplane_mj.bench.sweep import plan_jobs, run_sweep
 from vplane_mj.bench.tables import markdown_table, write_table
-from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir, write_atomically
 from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.worlds.families import trap_suite
@@ -50,9 +50,9 @@ COLUMNS = (
 MARKERS = "os^Dv"
 
 
-def numbers(text: str) -> list[float]:
-    """A comma-separated list of numbers; the empty string is the empty list."""
-    return [float(part) for part in text.split(",") if part.strip()]
+def curve(numbers: Callable[[str], list[float]]) -> Callable[[str], list[float]]:
+    """An option's type: `numbers`, or none for the empty string."""
+    return lambda text: numbers(text) if text.strip() else []
 
 
 def sensor_levels(noise: list[float], dropout: list[float], reference: list[float]) -> list[tuple]:
@@ -138,38 +138,36 @@ def plot(table: list[dict], reference: list[float], path: Path) -> Path:
     return write_atomically(path, lambda tmp: figure.savefig(tmp, format="png", dpi=100))
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--noise", type=numbers, default="0,0.02,0.05,0.1", help="noise curve (m)")
-    parser.add_argument("--dropout", type=numbers, default="0.1,0.2,0.4", help="dropout curve")
+    noise, dropout = curve(options.numbers(0.0)), curve(options.numbers(0.0, most=1.0))
+    parser.add_argument("--noise", type=noise, default="0,0.02,0.05,0.1", help="noise curve (m; '' none)")
+    parser.add_argument("--dropout", type=dropout, default="0.1,0.2,0.4", help="dropout curve ('' none)")
     parser.add_argument(
-        "--reference", type=numbers, default="0.03,0.1", help="NOISE,DROPOUT of the reference ('' none)"
+        "--reference", type=noise, default="0.03,0.1", help="NOISE,DROPOUT of the reference ('' none)"
     )
-    parser.add_argument("--planners", default=",".join(sorted(PLANNERS)))
-    parser.add_argument("--seeds", default="0", help="seeds, e.g. 0-4")
-    parser.add_argument("--cases", type=int, help="only the first N trap cases")
-    parser.add_argument("--time-limit", type=float, default=120.0, help="simulated seconds per run")
-    parser.add_argument("--jobs", type=int, default=2, help="worker processes")
+    parser.add_argument("--planners", type=options.planners, default=",".join(sorted(PLANNERS)))
+    parser.add_argument("--seeds", type=options.seeds, default="0", help="seeds, e.g. 0-4")
+    parser.add_argument("--cases", type=options.whole(1), help="only the first N trap cases")
+    parser.add_argument(
+        "--time-limit", type=options.positive, default=120.0, help="simulated seconds per run"
+    )
+    parser.add_argument("--jobs", type=options.whole(1), default=2, help="worker processes")
     parser.add_argument("--out", type=Path, default=Path("logs/degradation"))
     args = parser.parse_args(argv)
-    if args.reference and len(args.reference) != 2:
-        parser.error("--reference: expected NOISE,DROPOUT")
-    try:
-        return sweep(args)
-    except VPlaneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    if args.reference and (len(args.reference) != 2 or args.reference[1] > 1.0):
+        parser.error("argument --reference: NOISE,DROPOUT expected, the dropout at most 1")
+    return sweep(args)
 
 
 def sweep(args: argparse.Namespace) -> int:
-    seeds = parse_seeds(args.seeds)
     cases_dir = prepare_out_dir(args.out / "cases")
     paths = []
     for case in trap_suite()[: args.cases]:
         text = case.toml()
         paths.append(write_atomically(cases_dir / f"{case.name}.toml", lambda tmp, t=text: tmp.write_text(t)))
     levels = sensor_levels(args.noise, args.dropout, args.reference)
-    planners = [name.strip() for name in args.planners.split(",")]
     jobs, jobs_levels = [], []
     for noise, dropout in levels:
         for path in paths:
@@ -179,7 +177,7 @@ def sweep(args: argparse.Namespace) -> int:
                 f"sensors.dropout={dropout}",
                 f"run.time_limit_s={args.time_limit}",
             ]
-            for job in plan_jobs([str(path)], planners, seeds, overrides):
+            for job in plan_jobs([str(path)], args.planners, args.seeds, overrides):
                 jobs.append(job)
                 jobs_levels.append((job.planner, (noise, dropout)))
 
@@ -188,7 +186,7 @@ def sweep(args: argparse.Namespace) -> int:
     text = markdown(table, levels)
     written = write_table(args.out, "degradation", table, COLUMNS, text)
     png_path = plot(table, args.reference, args.out / "degradation.png")
-    runs_per_cell = len(paths) * len(seeds)
+    runs_per_cell = len(paths) * len(args.seeds)
     print(f"success per planner and sensor level (noise_std m / dropout), {runs_per_cell} runs each")
     print(text)
     wall = sum(row["wall_time_s"] for row in rows)

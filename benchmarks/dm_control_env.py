@@ -28,7 +28,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-import vplane_mj  # before dm_control: OSMesa unless MUJOCO_GL is set
+from vplane_mj.bench import options  # vplane_mj before dm_control: OSMesa unless MUJOCO_GL is set
 from vplane_mj.bench.tables import formatted, markdown_table, write_table
 from vplane_mj.envs import VPlaneNavDmEnv
 from vplane_mj.envs.task import NavigationTask
@@ -142,21 +142,18 @@ def publish(out: Path, stem: str, table: list[dict], digits: int) -> list[Path]:
     return write_table(out, stem, table, columns, text)
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("scenario", nargs="?", default="paper_c_escape")
-    parser.add_argument("--steps", type=int, default=200, help="steps timed per variant")
-    parser.add_argument("--repeat", type=int, default=20, help="resets and builds timed")
+    parser.add_argument("scenario", nargs="?", type=options.scenario, default="paper_c_escape")
+    parser.add_argument("--steps", type=options.whole(1), default=200, help="steps timed per variant")
+    parser.add_argument("--repeat", type=options.whole(1), default=20, help="resets and builds timed")
     parser.add_argument("--out", type=Path, default=Path("logs/dm_control_env"))
     args = parser.parse_args(argv)
-    try:
-        out = prepare_out_dir(args.out)
-        written = publish(out, "dm_control_env", step_table(args.scenario, args.steps), 2)
-        written += publish(out, "dm_control_env_reset", reset_table(args.scenario, args.repeat), 1)
-        written += publish(out, "dm_control_env_build", build_table(args.scenario, args.repeat), 1)
-    except vplane_mj.VPlaneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    out = prepare_out_dir(args.out)
+    written = publish(out, "dm_control_env", step_table(args.scenario, args.steps), 2)
+    written += publish(out, "dm_control_env_reset", reset_table(args.scenario, args.repeat), 1)
+    written += publish(out, "dm_control_env_build", build_table(args.scenario, args.repeat), 1)
     print("\n" + "\n".join(f"wrote {path}" for path in written))
     return 0
 

@@ -29,9 +29,9 @@ from pathlib import Path
 
 import numpy as np
 
-from vplane_mj.bench.sweep import parse_seeds, plan_jobs, run_sweep
+from vplane_mj.bench import options
+from vplane_mj.bench.sweep import plan_jobs, run_sweep
 from vplane_mj.bench.tables import markdown_table, write_table
-from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir, write_atomically
 from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.worlds.dynabarn_generate import generate_dynabarn
@@ -160,31 +160,17 @@ def plot(table: list[dict], path: Path) -> None:
     plt.close(figure)
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     default = [name for name in PLANNER_ORDER if name in PLANNERS]
-    parser.add_argument("--planners", default=",".join(default))
-    parser.add_argument("--count", type=int, default=60, help="worlds, split into the three thirds")
-    parser.add_argument("--world-seed", type=int, default=0, help="seed of the worlds")
-    parser.add_argument("--seeds", default="0-4", help="run seeds, as vplane-mj bench takes them")
-    parser.add_argument("--noise", type=float, default=0.01, help="laser range noise (m)")
-    parser.add_argument("--jobs", type=int, default=2)
-    parser.add_argument("--out", type=Path, default=Path("logs/dynabarn"))
+    parser.add_argument("--planners", type=options.planners, default=",".join(default))
+    options.add_world_sweep(parser, (60, "worlds, split into the three thirds"), "0-4", "dynabarn")
     args = parser.parse_args(argv)
-    planners = [p.strip() for p in args.planners.split(",")]
-    unknown = sorted(set(planners) - set(PLANNERS))
-    if unknown or args.count < 1 or args.jobs < 1 or args.noise < 0:
-        print(f"error: bad arguments (unknown planners: {unknown})", file=sys.stderr)
-        return 2
-    try:
-        seeds = parse_seeds(args.seeds)
-        out = prepare_out_dir(args.out)
-    except VPlaneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    out = prepare_out_dir(args.out)
     scenarios = write_cases(out, args.count, args.world_seed)
     overrides = [f"sensors.noise_std={args.noise}"] if args.noise > 0 else []
-    rows = run_sweep(plan_jobs(scenarios, planners, seeds, overrides), out, args.jobs)
+    rows = run_sweep(plan_jobs(scenarios, args.planners, args.seeds, overrides), out, args.jobs)
     table = planner_table(rows)
     text = markdown([*table, *published_rows()])
     written = write_table(out, "dynabarn", table, COLUMNS, text)

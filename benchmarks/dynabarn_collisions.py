@@ -34,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vplane_mj.bench import options
 from vplane_mj.bench.sweep import JOURNAL, job_choice, read_journal
 from vplane_mj.bench.tables import markdown_table, write_table
 from vplane_mj.errors import VPlaneError
@@ -135,41 +136,39 @@ def row_of(planner: str, runs: int, kinds: list[dict]) -> dict:
     }
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sweep", type=Path, default=Path("logs/dynabarn"), help="dynabarn.py's --out")
-    parser.add_argument("--planners", default="apf,vplane_plus")
-    parser.add_argument("--noise", type=float, default=0.01, help="the sweep's laser noise (m)")
-    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--planners", type=options.planners, default="apf,vplane_plus")
+    parser.add_argument(
+        "--noise", type=options.non_negative, default=0.01, help="the sweep's laser noise (m)"
+    )
+    parser.add_argument("--jobs", type=options.whole(1), default=2, help="worker processes")
     parser.add_argument("--out", type=Path, help="default: the sweep's directory")
     args = parser.parse_args(argv)
     journal = args.sweep / JOURNAL
-    planners = [p.strip() for p in args.planners.split(",")]
-    try:
-        if not journal.is_file():
-            raise VPlaneError(f"{journal}: no such journal (run benchmarks/dynabarn.py first)")
-        rows = list(read_journal(journal).values())
-        runs = {planner: [r for r in rows if r.get("planner") == planner] for planner in planners}
-        if missing := [planner for planner, mine in runs.items() if not mine]:
-            raise VPlaneError(f"{journal}: no runs of planner {missing[0]!r}")
-        out = prepare_out_dir(args.out or args.sweep)
-        collided = [
-            (
-                args.sweep / "cases" / f"{r['scenario']}.toml",
-                planner,
-                r["seed"],
-                args.noise,
-                r["trajectory_sha256"],
-            )
-            for planner, mine in runs.items()
-            for r in mine
-            if r["collisions"]
-        ]
-        with ProcessPoolExecutor(max(1, args.jobs)) as pool:
-            kinds = list(pool.map(_classify, collided))
-    except VPlaneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    if not journal.is_file():
+        raise VPlaneError(f"{journal}: no such journal (run benchmarks/dynabarn.py first)")
+    rows = list(read_journal(journal).values())
+    runs = {planner: [r for r in rows if r.get("planner") == planner] for planner in args.planners}
+    if missing := [planner for planner, mine in runs.items() if not mine]:
+        raise VPlaneError(f"{journal}: no runs of planner {missing[0]!r}")
+    out = prepare_out_dir(args.out or args.sweep)
+    collided = [
+        (
+            args.sweep / "cases" / f"{r['scenario']}.toml",
+            planner,
+            r["seed"],
+            args.noise,
+            r["trajectory_sha256"],
+        )
+        for planner, mine in runs.items()
+        for r in mine
+        if r["collisions"]
+    ]
+    with ProcessPoolExecutor(args.jobs) as pool:
+        kinds = list(pool.map(_classify, collided))
     table = [
         row_of(planner, len(mine), [k for k, job in zip(kinds, collided, strict=True) if job[1] == planner])
         for planner, mine in runs.items()

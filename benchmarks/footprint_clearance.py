@@ -22,11 +22,13 @@ from __future__ import annotations
 
 import argparse
 import statistics
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
+from vplane_mj.bench import options
 from vplane_mj.bench.tables import formatted, markdown_table, write_table
 from vplane_mj.files import prepare_out_dir
 from vplane_mj.kernels.motion.footprint_clearance import footprint_clearance
@@ -121,13 +123,14 @@ def cpu_ms_per_tick(measure, calls: list[tuple], repeat: int) -> float:
     return (time.process_time() - started) / repeat * 1e3
 
 
-def main() -> None:
+@options.refusing
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--points", type=int, default=20)
-    parser.add_argument("--repeat", type=int, default=5)
-    parser.add_argument("--seed", type=int, default=7)
+    parser.add_argument("--points", type=options.whole(1), default=20)
+    parser.add_argument("--repeat", type=options.whole(1), default=5)
+    parser.add_argument("--seed", type=options.whole(0), default=7)
     parser.add_argument("--out", type=Path, default=Path("logs/footprint_clearance"))
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     out = prepare_out_dir(args.out)
     ticks = recorded_checks(args.seed, args.points)
     kernel, plain, worst, poses = [], [], 0.0, []
@@ -149,6 +152,8 @@ def main() -> None:
         )
     )
 
+    return 0
+
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -38,6 +38,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from vplane_mj.bench import options
 from vplane_mj.bench.tables import formatted, markdown_table, write_table
 from vplane_mj.files import prepare_out_dir
 from vplane_mj.geometry import shapes
@@ -202,13 +203,14 @@ def first_calls() -> list[dict]:
         ]
 
 
-def main() -> None:
+@options.refusing
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--origins", type=int, default=200)
-    parser.add_argument("--repeat", type=int, default=20)
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--origins", type=options.whole(1), default=200)
+    parser.add_argument("--repeat", type=options.whole(1), default=20)
+    parser.add_argument("--seed", type=options.whole(0), default=0)
     parser.add_argument("--out", type=Path, default=Path("logs/laser_cast"))
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     out = prepare_out_dir(args.out)
     table = []
     for label, scenario in (barn_world(args.seed), paper_world()):
@@ -228,6 +230,8 @@ def main() -> None:
     )
     print("\n".join(f"wrote {path}" for path in write_table(out, "laser_cast", table, list(CELLS), text)))
 
+    return 0
+
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -21,13 +21,11 @@ import argparse
 import math
 import sys
 from concurrent.futures import ProcessPoolExecutor
-from pathlib import Path
 
 import numpy as np
 
-from vplane_mj.bench.sweep import parse_seeds
+from vplane_mj.bench import options
 from vplane_mj.bench.tables import markdown_table, write_table
-from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.loop import Run
@@ -105,28 +103,22 @@ def markdown(table: list[dict]) -> str:
     return markdown_table(table, COLUMNS, cell)
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("scenarios", nargs="*", help="scenario files (default: generated protocol worlds)")
-    parser.add_argument("--planner", default="vplane_plus")
-    parser.add_argument("--poses", default="odometry,ekf", help="sensors.pose values, comma-separated")
-    parser.add_argument("--count", type=int, default=20, help="protocol worlds, without scenario files")
-    parser.add_argument("--world-seed", type=int, default=0)
-    parser.add_argument("--seeds", default="0")
-    parser.add_argument("--noise", type=float, default=0.01, help="laser range noise (m)")
-    parser.add_argument("--jobs", type=int, default=2)
-    parser.add_argument("--out", type=Path, default=Path("logs/localisation"))
+    parser.add_argument(
+        "scenarios",
+        nargs="*",
+        type=options.scenario,
+        help="scenario files (default: generated protocol worlds)",
+    )
+    parser.add_argument("--planner", type=options.planner, default="vplane_plus")
+    parser.add_argument(
+        "--poses", type=options.names(POSES, "pose"), default="odometry,ekf", help="sensors.pose values"
+    )
+    options.add_world_sweep(parser, (20, "protocol worlds, without scenario files"), "0", "localisation")
     args = parser.parse_args(argv)
-    poses = [p.strip() for p in args.poses.split(",")]
-    if set(poses) - set(POSES) or args.count < 1 or args.jobs < 1 or args.noise < 0:
-        print(f"error: bad arguments (poses are {', '.join(POSES)})", file=sys.stderr)
-        return 2
-    try:
-        seeds = parse_seeds(args.seeds)
-        out = prepare_out_dir(args.out)
-    except VPlaneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    out = prepare_out_dir(args.out)
     scenarios = args.scenarios
     if not scenarios:
         (out / "cases").mkdir(exist_ok=True)
@@ -136,15 +128,14 @@ def main(argv: list[str] | None = None) -> int:
             path.write_text(case.toml(), encoding="utf-8")
             scenarios.append(str(path))
     jobs = [
-        (path, args.planner, pose, seed, args.noise) for pose in poses for path in scenarios for seed in seeds
+        (path, args.planner, pose, seed, args.noise)
+        for pose in args.poses
+        for path in scenarios
+        for seed in args.seeds
     ]
-    try:
-        with ProcessPoolExecutor(args.jobs) as pool:
-            rows = list(pool.map(run_one, jobs))
-    except VPlaneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    table = pose_table(rows, poses)
+    with ProcessPoolExecutor(args.jobs) as pool:
+        rows = list(pool.map(run_one, jobs))
+    table = pose_table(rows, args.poses)
     text = markdown(table)
     written = write_table(out, "localisation", table, COLUMNS, text)
     print(text)

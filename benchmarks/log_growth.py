@@ -14,8 +14,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from vplane_mj.bench import options
 from vplane_mj.bench.tables import markdown_table, write_table
-from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir
 from vplane_mj.logs.reader import iter_messages
 from vplane_mj.logs.writer import McapLog
@@ -46,30 +46,22 @@ def measure(minutes: float, overrides: list[str], out: Path) -> dict:
     }
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--minutes", default="1,10,30", help="run lengths (simulated minutes)")
+    parser.add_argument(
+        "--minutes",
+        type=options.positives,
+        default="1,10,30",
+        help="run lengths (simulated minutes)",
+    )
     parser.add_argument(
         "--set", action="append", default=[], metavar="KEY=VALUE", help="a scenario key: robot.profile=jackal"
     )
     parser.add_argument("--out", type=Path, default=Path("logs/log_growth"))
     args = parser.parse_args(argv)
-    try:
-        lengths = sorted(float(text) for text in args.minutes.split(","))
-        if lengths[0] <= 0:
-            raise ValueError
-        out = prepare_out_dir(args.out)
-    except ValueError:
-        print(f"error: --minutes: positive numbers, comma-separated, not {args.minutes!r}", file=sys.stderr)
-        return 2
-    except VPlaneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    try:
-        table = [measure(minutes, args.set, out) for minutes in lengths]
-    except VPlaneError as exc:  # a --set the scenario refuses
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    out = prepare_out_dir(args.out)
+    table = [measure(minutes, args.set, out) for minutes in sorted(args.minutes)]
     for row in table:
         row["ratio_to_shortest"] = round(row["mb_per_minute"] / table[0]["mb_per_minute"], 3)
     text = markdown_table(table, COLUMNS, lambda _, value: f"{value:g}")

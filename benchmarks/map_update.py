@@ -24,12 +24,14 @@ import argparse
 import itertools
 import math
 import statistics
+import sys
 import time
 from collections import deque
 from pathlib import Path
 
 import numpy as np
 
+from vplane_mj.bench import options
 from vplane_mj.bench.tables import formatted, markdown_table, write_table
 from vplane_mj.files import prepare_out_dir
 from vplane_mj.geometry import shapes
@@ -145,18 +147,19 @@ def per_update_ms(scans: dict[str, list[np.ndarray]], poses, repeat: int) -> dic
     return {key: statistics.median(values) for key, values in times.items()}
 
 
-def main() -> None:
+@options.refusing
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeat", type=int, default=5)
-    parser.add_argument("--poses", type=int, default=300, help="poses of the drive at most")
-    parser.add_argument("--seed", type=int, default=0, help="first seed of the BARN field")
+    parser.add_argument("--repeat", type=options.whole(1), default=5)
+    parser.add_argument("--poses", type=options.whole(1), default=300, help="poses of the drive at most")
+    parser.add_argument("--seed", type=options.whole(0), default=0, help="first seed of the BARN field")
     parser.add_argument("--out", type=Path, default=Path("logs/map_update"))
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     out = prepare_out_dir(args.out)
-    footprints, poses = scene(args.seed, max(1, args.poses))
+    footprints, poses = scene(args.seed, args.poses)
     print(f"The first update that walks its cones: {first_walk_s(footprints, poses[0]):.2f} s CPU.\n")
     scans = {name: [layout.scan(footprints, *pose) for pose in poses] for name, layout in LAYOUTS.items()}
-    cost = per_update_ms(scans, poses, max(1, args.repeat))
+    cost = per_update_ms(scans, poses, args.repeat)
     columns = {"layout": "", "beams": "d", **{f"`{m}` ms": ".3f" for m in MAPS}}
     table = [
         {"layout": name, "beams": len(layout.bearings), **{f"`{m}` ms": cost[(name, m)] for m in MAPS}}
@@ -171,6 +174,8 @@ def main() -> None:
     )
     print("\n".join(f"wrote {path}" for path in write_table(out, "map_update", table, list(columns), text)))
 
+    return 0
+
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

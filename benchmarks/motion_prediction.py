@@ -29,8 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
+from vplane_mj.bench import options
 from vplane_mj.bench.tables import formatted, markdown_table, write_table
-from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir
 from vplane_mj.geometry.motion import MotionTable
 from vplane_mj.scenario import parse_document
@@ -128,45 +128,44 @@ def table_rows(third: str, errors: np.ndarray, horizons_s: tuple[float, ...]) ->
     ]
 
 
-def checked_horizons(args: argparse.Namespace) -> tuple[float, ...]:
-    """`--horizons` (comma-separated positive seconds), once every option is checked; else a
-    VPlaneError naming the option and what it needs."""
-    try:
-        horizons = tuple(float(part) for part in args.horizons.split(","))
-    except ValueError:
-        horizons = ()
-    if not horizons or not all(math.isfinite(h) and h > 0 for h in horizons):
-        raise VPlaneError(f"--horizons: positive numbers of seconds, comma-separated, got {args.horizons!r}")
-    if args.count < 1:
-        raise VPlaneError(f"--count: at least 1 world, got {args.count}")
-    if not (math.isfinite(args.step) and args.step > 0):
-        raise VPlaneError(f"--step: a positive number of seconds, got {args.step}")
+def check_spans(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Refuse (argparse's error, exit 2) a window or stride shorter than the step, or a span too
+    short for the window and the longest horizon."""
     for option in ("window", "stride"):
-        value = getattr(args, option)
-        if not (math.isfinite(value) and value >= args.step):
-            raise VPlaneError(f"--{option}: a number of seconds, at least --step, got {value}")
-    if not args.span > args.window + max(horizons) + args.step:
-        raise VPlaneError(f"--span: longer than --window and the longest horizon together, got {args.span}")
-    return horizons
+        if getattr(args, option) < args.step:
+            parser.error(
+                f"argument --{option}: at least --step ({args.step:g} s), not {getattr(args, option):g}"
+            )
+    if not args.span > args.window + max(args.horizons) + args.step:
+        parser.error(
+            f"argument --span: longer than --window and the longest horizon together, not {args.span:g}"
+        )
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--count", type=int, default=60, help="worlds, split into the three thirds")
-    parser.add_argument("--world-seed", type=int, default=0, help="seed of the worlds")
-    parser.add_argument("--horizons", default="0.5,1,2,3", help="seconds ahead, comma-separated")
-    parser.add_argument("--window", type=float, default=0.5, help="seconds of the past a velocity is fit to")
-    parser.add_argument("--span", type=float, default=60.0, help="seconds of each loop sampled")
-    parser.add_argument("--step", type=float, default=0.05, help="seconds between samples")
-    parser.add_argument("--stride", type=float, default=0.25, help="seconds between predictions")
+    parser.add_argument(
+        "--count", type=options.whole(1), default=60, help="worlds, split into the three thirds"
+    )
+    parser.add_argument("--world-seed", type=options.whole(0), default=0, help="seed of the worlds")
+    parser.add_argument(
+        "--horizons",
+        type=options.positives,
+        default="0.5,1,2,3",
+        help="seconds ahead, comma-separated",
+    )
+    parser.add_argument(
+        "--window", type=options.positive, default=0.5, help="seconds of the past a velocity is fit to"
+    )
+    parser.add_argument("--span", type=options.positive, default=60.0, help="seconds of each loop sampled")
+    parser.add_argument("--step", type=options.positive, default=0.05, help="seconds between samples")
+    parser.add_argument("--stride", type=options.positive, default=0.25, help="seconds between predictions")
     parser.add_argument("--out", type=Path, default=Path("logs/motion_prediction"))
     args = parser.parse_args(argv)
-    try:
-        horizons = checked_horizons(args)
-        out = prepare_out_dir(args.out)
-    except VPlaneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    check_spans(parser, args)
+    horizons = tuple(args.horizons)
+    out = prepare_out_dir(args.out)
     cases = generate_dynabarn(args.count, args.world_seed)
     per_third = {
         third: [world_errors(case.document, args, horizons) for case in cases if f"_{third}_" in case.name]

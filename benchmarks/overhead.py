@@ -41,6 +41,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from vplane_mj.bench import options
 from vplane_mj.bench.tables import formatted, markdown_table, write_table
 from vplane_mj.files import prepare_out_dir
 from vplane_mj.logs.writer import McapLog
@@ -205,20 +206,22 @@ def profile(ref: str, planner: str, top: int = 18) -> None:
     pstats.Stats(profiler, stream=sys.stdout).strip_dirs().sort_stats("tottime").print_stats(top)
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("scenarios", nargs="*", default=list(DEFAULT_SCENARIOS))
-    parser.add_argument("--planners", default="vplane", help="comma-separated planner names")
-    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("scenarios", nargs="*", type=options.scenario, default=list(DEFAULT_SCENARIOS))
+    parser.add_argument(
+        "--planners", type=options.planners, default="vplane", help="comma-separated planner names"
+    )
+    parser.add_argument("--repeat", type=options.whole(1), default=3)
     parser.add_argument("--no-log", action="store_true", help="do not time runs that write their log")
     parser.add_argument("--profile", action="store_true", help="profile one run of the first combination")
     parser.add_argument("--plot", type=Path, help="also draw the ratios into this PNG")
     parser.add_argument("--out", type=Path, default=Path("logs/overhead"))
     args = parser.parse_args(argv)
-    planners = [name.strip() for name in args.planners.split(",")]
     out = prepare_out_dir(args.out)
     with tempfile.TemporaryDirectory() as tmp:
-        rows = report(args.scenarios, planners, args.repeat, None if args.no_log else Path(tmp))
+        rows = report(args.scenarios, args.planners, args.repeat, None if args.no_log else Path(tmp))
     table = [table_row(row) for row in rows]
     text = markdown(table)
     print(f"median of {args.repeat} interleaved repeats, CPU time; mujoco {mujoco.__version__}\n\n{text}")
@@ -227,7 +230,7 @@ def main(argv: list[str] | None = None) -> int:
         plot(rows, args.plot)
         print(f"wrote {args.plot}")
     if args.profile:
-        profile(args.scenarios[0], planners[0])
+        profile(args.scenarios[0], args.planners[0])
     register_planner(StraightToGoal)
     harness = measure(HARNESS_SCENARIO, StraightToGoal.name, args.repeat, None)
     print(

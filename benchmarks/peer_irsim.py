@@ -64,8 +64,8 @@ from typing import Any, NamedTuple
 import mujoco
 import numpy as np
 
+from vplane_mj.bench import options
 from vplane_mj.bench.tables import formatted, markdown_table, write_table
-from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir
 from vplane_mj.geometry import shapes
 from vplane_mj.robots.profiles import robot_profile
@@ -390,30 +390,31 @@ def publish(out: Path, stem: str, table: list[dict], cells: dict[str, str]) -> l
     return write_table(out, stem, table, list(cells), text)
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--count", type=int, default=2, help="BARN protocol worlds")
-    parser.add_argument("--seed", type=int, default=0, help="the worlds' generator seed")
-    parser.add_argument("--time-limit", type=float, default=10.0, help="simulated seconds at most")
-    parser.add_argument("--repeat", type=int, default=3, help="interleaved repeats; the best is kept")
-    parser.add_argument("--planners", default="vplane_plus,dwa", help="comma-separated planner names")
+    parser.add_argument("--count", type=options.whole(1), default=2, help="BARN protocol worlds")
+    parser.add_argument("--seed", type=options.whole(0), default=0, help="the worlds' generator seed")
+    parser.add_argument("--time-limit", type=options.positive, default=10.0, help="simulated seconds at most")
     parser.add_argument(
-        "--blas-threads", type=int, default=1, help="threads BLAS may run (0: its own default, one a core)"
+        "--repeat", type=options.whole(1), default=3, help="interleaved repeats; the best is kept"
+    )
+    parser.add_argument(
+        "--planners", type=options.planners, default="vplane_plus,dwa", help="comma-separated planner names"
+    )
+    parser.add_argument(
+        "--blas-threads",
+        type=options.whole(0),
+        default=1,
+        help="threads BLAS may run (0: its own default, one a core)",
     )
     parser.add_argument("--out", type=Path, default=Path("logs/peer_irsim"))
     args = parser.parse_args(argv)
-    if args.count < 1 or args.repeat < 1 or not args.time_limit > 0 or args.blas_threads < 0:
-        parser.error("--count and --repeat must be at least 1, --time-limit positive, --blas-threads >= 0")
     peers = load_peers()
     if isinstance(peers, str):
         print(MISSING_PEERS.format(missing=peers), file=sys.stderr)
         return 2
-    planners = [name.strip() for name in args.planners.split(",") if name.strip()]
-    try:
-        out = prepare_out_dir(args.out)
-    except VPlaneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    out = prepare_out_dir(args.out)
     cases = generate_protocol(args.count, args.seed)
     cylinders = {
         case.name: sum(ob["kind"] == "cylinder" for ob in case.document["world"]["obstacles"])
@@ -421,14 +422,10 @@ def main(argv: list[str] | None = None) -> int:
     }
     limits = peers.threadpoolctl.threadpool_limits(args.blas_threads or None, user_api="blas")
     with limits, tempfile.TemporaryDirectory(prefix="peer_irsim_") as world_dir:
-        try:
-            runs = {
-                case.name: configurations(case, planners, args.time_limit, Path(world_dir), peers)
-                for case in cases
-            }
-        except VPlaneError as exc:  # a planner name that is not registered, say
-            print(f"error: {exc}", file=sys.stderr)
-            return 2
+        runs = {
+            case.name: configurations(case, args.planners, args.time_limit, Path(world_dir), peers)
+            for case in cases
+        }
         blas = ", ".join(
             dict.fromkeys(
                 f"{pool['internal_api']} with {pool['num_threads']} thread(s)"

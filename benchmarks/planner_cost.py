@@ -23,12 +23,14 @@ from __future__ import annotations
 import argparse
 import math
 import statistics
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
+from vplane_mj.bench import options
 from vplane_mj.bench.tables import markdown_table, write_table
 from vplane_mj.files import prepare_out_dir
 from vplane_mj.planning.planners.groups import LocalMapParams
@@ -140,13 +142,14 @@ def markdown(table: list[dict]) -> str:
     return markdown_table(list(lines.values()), list(next(iter(lines.values()))), lambda _, value: value)
 
 
-def main() -> None:
+@options.refusing
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("scenarios", nargs="*")
-    parser.add_argument("--driver", default="dwa", choices=sorted(PLANNERS))
-    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("scenarios", nargs="*", type=options.scenario)
+    parser.add_argument("--driver", type=options.planner, default="dwa")
+    parser.add_argument("--repeat", type=options.whole(1), default=5)
     parser.add_argument("--out", type=Path, default=Path("logs/planner_cost"))
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     out = prepare_out_dir(args.out)
     table = []
     for scenario in scenarios(args.scenarios, args.driver):
@@ -160,6 +163,8 @@ def main() -> None:
     print(f"\nOne numpy operation: {small:.2f} us on 16 floats, {large:.2f} us on 400 floats (CPU time).")
     print("\n".join(f"wrote {path}" for path in write_table(out, "planner_cost", table, COLUMNS, text)))
 
+    return 0
+
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -32,6 +32,7 @@ from pathlib import Path
 
 from soak import JOURNAL, PLAN, pose_fault, read_plan
 
+from vplane_mj.bench import options
 from vplane_mj.bench.job import Job
 from vplane_mj.bench.sweep import read_journal
 from vplane_mj.bench.tables import markdown_table, write_table
@@ -127,27 +128,22 @@ def paired_runs(runs: list[tuple[Job, list[str]]]) -> list[tuple[Job, dict[str, 
     ]
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--soak", type=Path, default=Path("logs/soak"), help="soak.py's --out")
-    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--jobs", type=options.whole(1), default=2, help="worker processes")
     parser.add_argument("--out", type=Path, help="default: the soak's directory")
     args = parser.parse_args(argv)
-    try:
-        plan_path, journal_path = args.soak / PLAN, args.soak / JOURNAL
-        for path in (plan_path, journal_path):
-            if not path.is_file():
-                raise VPlaneError(
-                    f"{path}: missing (run benchmarks/soak.py --poses odometry,ekf,truth first)"
-                )
-        settings, runs = read_plan(plan_path)
-        if set(settings["poses"]) != {"odometry", "ekf", "truth"}:
-            raise VPlaneError(f"{plan_path}: poses: the soak must run odometry, ekf and truth")
-        out = prepare_out_dir(args.out or args.soak)
-        table = table_of(paired_runs(runs), read_journal(journal_path), args.jobs)
-    except VPlaneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    plan_path, journal_path = args.soak / PLAN, args.soak / JOURNAL
+    for path in (plan_path, journal_path):
+        if not path.is_file():
+            raise VPlaneError(f"{path}: missing (run benchmarks/soak.py --poses odometry,ekf,truth first)")
+    settings, runs = read_plan(plan_path)
+    if set(settings["poses"]) != {"odometry", "ekf", "truth"}:
+        raise VPlaneError(f"{plan_path}: poses: the soak must run odometry, ekf and truth")
+    out = prepare_out_dir(args.out or args.soak)
+    table = table_of(paired_runs(runs), read_journal(journal_path), args.jobs)
     text = markdown_table(table, COLUMNS, cell)
     written = write_table(out, "pose_ceiling", table, COLUMNS, text)
     print(text)

@@ -23,6 +23,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from vplane_mj.bench import options
 from vplane_mj.bench.tables import formatted, markdown_table, write_table
 from vplane_mj.files import prepare_out_dir
 from vplane_mj.logs.reader import read_log
@@ -77,15 +78,15 @@ def measure(robot: str, seconds: float, repeat: int, work: Path) -> dict:
     }
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seconds", type=float, default=100.0, help="simulated seconds of each run")
-    parser.add_argument("--repeat", type=int, default=5, help="exports of each run's log")
+    parser.add_argument(
+        "--seconds", type=options.positive, default=100.0, help="simulated seconds of each run"
+    )
+    parser.add_argument("--repeat", type=options.whole(1), default=5, help="exports of each run's log")
     parser.add_argument("--out", type=Path, default=Path("logs/ros2_export"))
     args = parser.parse_args(argv)
-    if not args.seconds > 0 or args.repeat < 1:
-        print("error: --seconds must be positive and --repeat at least 1", file=sys.stderr)
-        return 2
     out = prepare_out_dir(args.out)
     with tempfile.TemporaryDirectory() as work:
         table = [measure(robot, args.seconds, args.repeat, Path(work)) for robot in ROBOTS]

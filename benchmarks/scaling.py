@@ -27,6 +27,7 @@ import mujoco
 import numpy as np
 import tomli_w
 
+from vplane_mj.bench import options
 from vplane_mj.bench.sweep import plan_jobs, run_sweep
 from vplane_mj.bench.tables import formatted, markdown_table, write_table
 from vplane_mj.files import prepare_out_dir
@@ -102,12 +103,15 @@ def sweep_documents(count: int) -> list[str]:
     return PAPER + [case.toml() for case in cases][: max(0, worlds - len(PAPER))]
 
 
-def main() -> int:
+@options.refusing
+def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seconds", type=float, default=10.0, help="simulated seconds per run")
-    parser.add_argument("--sweep", type=int, default=0, help="also time a sweep of this many runs")
+    parser.add_argument("--seconds", type=options.positive, default=10.0, help="simulated seconds per run")
+    parser.add_argument(
+        "--sweep", type=options.whole(0), default=0, help="also time a sweep of this many runs"
+    )
     parser.add_argument("--out", type=Path, default=Path("logs/scaling"))
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     out = prepare_out_dir(args.out)
     boxes = [(count, cost(clutter_document(count, args.seconds))) for count in (10, 100, 1000)]
     written = publish(out, "scaling", "boxes", boxes)

@@ -56,11 +56,11 @@ from pathlib import Path
 
 import numpy as np
 
+from vplane_mj.bench import options
 from vplane_mj.bench.failures import FAILURE_KEY, FailureKind
 from vplane_mj.bench.job import Job
 from vplane_mj.bench.sweep import family_of, run_sweep
 from vplane_mj.bench.tables import markdown_table, write_table
-from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir, write_atomically, write_json
 from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.scenario import SensorSpec, parse_scenario
@@ -310,32 +310,29 @@ def plot(figures: dict, path: Path) -> Path:
     return write_atomically(path, lambda tmp: figure.savefig(tmp, format="png", dpi=100))
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--count", type=int, default=1000, help="number of runs")
-    parser.add_argument("--seed", type=int, default=0, help="master seed of scenarios and faults")
-    parser.add_argument("--time-limit", type=float, default=60.0, help="simulated seconds per run")
-    parser.add_argument("--jobs", type=int, default=2, help="worker processes")
+    parser.add_argument("--count", type=options.whole(1), default=1000, help="number of runs")
+    parser.add_argument(
+        "--seed", type=options.whole(0), default=0, help="master seed of scenarios and faults"
+    )
+    parser.add_argument("--time-limit", type=options.positive, default=60.0, help="simulated seconds per run")
+    parser.add_argument("--jobs", type=options.whole(1), default=2, help="worker processes")
     parser.add_argument(
         "--poses",
+        type=options.names(POSES, "pose"),
         default="odometry",
         help="the estimated pose of a quarter of the runs, then others to compare",
     )
     parser.add_argument("--out", type=Path, default=Path("logs/soak"))
     args = parser.parse_args(argv)
-    if args.count < 1 or args.seed < 0 or args.jobs < 1:
-        parser.error("--count and --jobs must be at least 1, --seed at least 0")
-    poses = tuple(args.poses.split(","))
-    if not set(poses) <= set(POSES) or len(set(poses)) != len(poses) or poses[0] == "truth":
-        parser.error(
-            f"--poses: distinct names of {', '.join(POSES)}, the first not truth; got {args.poses!r}"
-        )
+    poses = tuple(args.poses)
+    if poses[0] == "truth":
+        parser.error("argument --poses: the first pose is the estimate the runs drive on, not truth")
 
     started = time.monotonic()
-    try:
-        prepare_out_dir(args.out)
-    except VPlaneError as exc:
-        parser.error(str(exc))
+    prepare_out_dir(args.out)
     runs = load_or_plan(args.out / PLAN, args.count, args.seed, args.time_limit, poses)
     try:
         with signals_raise_interrupted():

@@ -30,8 +30,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from vplane_mj.bench import options
 from vplane_mj.bench.tables import formatted, markdown_table, write_table
-from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir
 
 DEFAULT_SCENARIOS = ("paper_c_avoid", "paper_c_escape", "paper_h_avoid", "paper_h_escape")
@@ -129,17 +129,14 @@ def publish(out: Path, stem: str, table: list[dict]) -> list[Path]:
     return write_table(out, stem, table, columns, text)
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("scenarios", nargs="*", default=list(DEFAULT_SCENARIOS))
-    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("scenarios", nargs="*", type=options.scenario, default=list(DEFAULT_SCENARIOS))
+    parser.add_argument("--repeat", type=options.whole(1), default=5)
     parser.add_argument("--out", type=Path, default=Path("logs/startup"))
     args = parser.parse_args(argv)
-    try:
-        out = prepare_out_dir(args.out)
-    except VPlaneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    out = prepare_out_dir(args.out)
     with tempfile.TemporaryDirectory() as tmp:
         runs = Path(tmp)
         written = publish(out, "startup", scenario_table(args.scenarios, args.repeat, runs))

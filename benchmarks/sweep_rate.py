@@ -24,6 +24,7 @@ from pathlib import Path
 
 from barn_protocol import write_scenarios
 
+from vplane_mj.bench import options
 from vplane_mj.bench.sweep import plan_jobs, run_sweep
 from vplane_mj.bench.tables import markdown_table, write_table
 from vplane_mj.files import prepare_out_dir, write_atomically
@@ -76,13 +77,14 @@ def plot(table: list[dict], path: Path) -> None:
     plt.close(figure)
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--worlds", type=int, default=300)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--planners", default="vplane,vplane_plus,dwa")
+    parser.add_argument("--worlds", type=options.whole(1), default=300)
+    parser.add_argument("--seed", type=options.whole(0), default=0)
+    parser.add_argument("--planners", type=options.planners, default="vplane,vplane_plus,dwa")
     parser.add_argument("--protocol", action="store_true", help="also the protocol worlds (the Jackal)")
-    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--jobs", type=options.whole(1), default=2, help="worker processes")
     parser.add_argument("--out", type=Path, default=Path("logs/sweep_rate"))
     args = parser.parse_args(argv)
     out = prepare_out_dir(args.out)
@@ -91,11 +93,10 @@ def main(argv: list[str] | None = None) -> int:
         sets["protocol, Jackal"] = write_scenarios(
             out / "protocol", generate_protocol(args.worlds, args.seed)
         )
-    planners = [name.strip() for name in args.planners.split(",")]
     table = [
         sweep_row(label, scenarios, planner, args.jobs)
         for label, scenarios in sets.items()
-        for planner in planners
+        for planner in args.planners
     ]
     text = markdown(table)
     written = write_table(out, "sweep_rate", table, COLUMNS, text)

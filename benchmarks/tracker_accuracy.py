@@ -25,13 +25,11 @@ import argparse
 import math
 import sys
 from concurrent.futures import ProcessPoolExecutor
-from pathlib import Path
 
 import numpy as np
 
-from vplane_mj.bench.sweep import parse_seeds
+from vplane_mj.bench import options
 from vplane_mj.bench.tables import markdown_table, write_table
-from vplane_mj.errors import VPlaneError
 from vplane_mj.files import prepare_out_dir
 from vplane_mj.scenario import parse_document
 from vplane_mj.sim.loop import Run, Tick
@@ -139,34 +137,32 @@ def markdown(table: list[dict]) -> str:
     return markdown_table(table, COLUMNS, cell)
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--planner", default="vplane_plus")
-    parser.add_argument("--count", type=int, default=60, help="worlds, split into the three thirds")
-    parser.add_argument("--world-seed", type=int, default=0, help="seed of the worlds")
-    parser.add_argument("--seeds", default="0", help="run seeds, as vplane-mj bench takes them")
-    parser.add_argument("--noise", type=float, default=0.01, help="laser range noise (m)")
-    parser.add_argument("--beams", type=int, default=3, help="echoes on an obstacle for it to count as seen")
+    parser.add_argument("--planner", type=options.planner, default="vplane_plus")
+    options.add_world_sweep(parser, (60, "worlds, split into the three thirds"), "0", "tracker_accuracy")
     parser.add_argument(
-        "--seen", type=float, default=0.5, help="seconds an obstacle is seen before it is scored"
+        "--beams", type=options.whole(1), default=3, help="echoes on an obstacle for it to count as seen"
     )
-    parser.add_argument("--within", type=float, default=5.0, help="scored only this near the robot (m)")
-    parser.add_argument("--jobs", type=int, default=2)
-    parser.add_argument("--out", type=Path, default=Path("logs/tracker_accuracy"))
+    parser.add_argument(
+        "--seen",
+        type=options.non_negative,
+        default=0.5,
+        help="seconds an obstacle is seen before it is scored",
+    )
+    parser.add_argument(
+        "--within", type=options.positive, default=5.0, help="scored only this near the robot (m)"
+    )
     args = parser.parse_args(argv)
-    try:
-        seeds = parse_seeds(args.seeds)
-        out = prepare_out_dir(args.out)
-    except VPlaneError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+    out = prepare_out_dir(args.out)
     cases = generate_dynabarn(args.count, args.world_seed)
     jobs = [
         (case.document, third, seed, args.planner, args.beams, args.seen, args.within, args.noise)
         for case in cases
         for third in DIFFICULTIES
         if f"_{third}_" in case.name
-        for seed in seeds
+        for seed in args.seeds
     ]
     with ProcessPoolExecutor(args.jobs) as pool:
         results = list(pool.map(score_run, jobs))

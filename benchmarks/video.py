@@ -20,6 +20,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from vplane_mj.bench import options
 from vplane_mj.bench.tables import formatted, markdown_table, write_table
 from vplane_mj.files import prepare_out_dir
 from vplane_mj.logs.reader import read_log
@@ -100,11 +101,12 @@ def table_row(r: dict) -> dict:
     }
 
 
+@options.refusing
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("scenarios", nargs="*", default=list(DEFAULT_SCENARIOS))
-    parser.add_argument("--planner", default="vplane")
-    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("scenarios", nargs="*", type=options.scenario, default=list(DEFAULT_SCENARIOS))
+    parser.add_argument("--planner", type=options.planner, default="vplane")
+    parser.add_argument("--repeat", type=options.whole(1), default=3)
     parser.add_argument("--out", type=Path, default=Path("logs/video"))
     args = parser.parse_args(argv)
     out = prepare_out_dir(args.out)

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.test_benchmark_options import benchmark_module
 from tests.test_moving import scenario_text
 from vplane_mj.bench.sweep import job_choice
 from vplane_mj.scenario import load_scenario
@@ -270,9 +271,7 @@ def test_a_cylinder_whose_loop_lands_it_on_the_robot_between_two_ticks_is_a_land
     # to its first keyframe, over the robot's front, and touches it before the next control
     # tick. The contact is classified from the tick after it (the tick before still has the
     # cylinder far off, where it was never seen to jump).
-    spec = importlib.util.spec_from_file_location("collisions", BENCHMARKS / "dynabarn_collisions.py")
-    collisions = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(collisions)
+    collisions = benchmark_module("dynabarn_collisions")
     case = tmp_path / "landing.toml"
     case.write_text(scenario_text(LANDING, "start = [1.5, 3.0]\ngoal = [8.0, 3.0]"))
     digest = run_scenario(load_scenario(str(case), job_choice("apf", 0))).summary.trajectory_sha256
@@ -307,7 +306,6 @@ def test_log_growth_reports_the_size_per_simulated_minute(tmp_path):
     assert number(half[4]) == 1.0 and 0.8 < number(two[4]) < 1.1  # MB per minute over the shortest's
     assert number(half[5]) < number(two[5])  # the path's vertices
     assert (tmp_path / "growth" / "log_growth.csv").is_file()
-    assert "--minutes: positive numbers" in refused_benchmark("log_growth.py", "--minutes", "0")
 
 
 def test_sweep_rate_counts_runs_per_core_minute_of_each_planners_sweep(tmp_path):
@@ -379,19 +377,10 @@ def test_ros2_export_reports_its_time_and_the_bag_s_size_per_minute(tmp_path):
     assert number(jackal[5]) > number(default[5]) > 0  # MB per minute: 720 beams at 50 Hz weigh more
     assert number(jackal[6]) > 0 and number(default[6]) > 0  # the export's seconds
     assert (tmp_path / "bags" / "ros2_export.csv").is_file()
-    assert "--repeat at least 1" in refused_benchmark("ros2_export.py", "--repeat", "0")
-
-
-def motion_prediction():
-    """benchmarks/motion_prediction.py as a module."""
-    spec = importlib.util.spec_from_file_location("motion_prediction", BENCHMARKS / "motion_prediction.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def test_a_prediction_misses_by_what_the_obstacle_changed_after_it():
-    predict = motion_prediction().prediction_errors
+    predict = benchmark_module("motion_prediction").prediction_errors
     # 1 m/s east until 10 s, then 2 m/s: predicted from 8.0 s (its last half second at 1 m/s),
     # 3 s ahead it is 1 m farther along than the constant velocity puts it, and not aside.
     times = np.arange(150, 221) * 0.05
@@ -421,5 +410,3 @@ def test_motion_prediction_scores_generated_worlds(tmp_path):
     assert one[1] == "1.0" and three[1] == "3.0"
     assert int(one[2]) > 0 and 0.0 < number(one[4]) < number(three[4])  # the error grows ahead
     assert (tmp_path / "mp" / "motion_prediction.csv").is_file()
-    assert "--horizons: positive numbers" in refused_benchmark("motion_prediction.py", "--horizons", "0,1")
-    assert "--span: longer than" in refused_benchmark("motion_prediction.py", "--span", "3")
