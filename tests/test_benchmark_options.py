@@ -38,6 +38,7 @@ BAD_OPTIONS = [
     ("clutter", ["--dropout", "2"], "--dropout: a finite number at least 0 and at most 1, not '2'"),
     ("degradation", ["--reference", "0.1"], "--reference: NOISE,DROPOUT expected"),
     ("dm_control_env", ["--steps", "0"], "--steps: at least 1, not 0"),
+    ("dynabarn_ceiling", ["--modes", "seen,oracle"], "--modes: unknown mode 'oracle'; available"),
     ("dynabarn", ["--noise", "nan"], "--noise: a finite number at least 0, not 'nan'"),
     ("dynabarn_collisions", ["--planners", "apf,nope"], "--planners: unknown planner 'nope'; available"),
     ("footprint_clearance", ["--repeat", "0"], "--repeat: at least 1, not 0"),

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from tests.test_benchmark_options import benchmark_module
-from tests.test_moving import scenario_text
+from tests.test_moving import CROSSING, scenario_text
 from vplane_mj.bench.sweep import job_choice
 from vplane_mj.scenario import load_scenario
 from vplane_mj.sim.loop import run_scenario
@@ -276,6 +276,78 @@ def test_a_cylinder_whose_loop_lands_it_on_the_robot_between_two_ticks_is_a_land
     case.write_text(scenario_text(LANDING, "start = [1.5, 3.0]\ngoal = [8.0, 3.0]"))
     digest = run_scenario(load_scenario(str(case), job_choice("apf", 0))).summary.trajectory_sha256
     assert collisions.classify(case, "apf", 0, 0.0, digest) == {"kind": "landed"}
+
+
+class _Scans:
+    """A tracker's stand-in that counts the scans it is given and tracks nothing."""
+
+    moving_beams = np.zeros(0, dtype=bool)
+
+    def __init__(self):
+        self.scans = 0
+
+    def update(self, *scan) -> tuple:
+        self.scans += 1
+        return ()
+
+
+def _crossing_scenario(tmp_path):
+    """CROSSING with the Jackal and its laser: the cylinder crosses north at 1.25 m/s 4 m east of
+    a robot at (1, 3), ahead of it facing east, behind it (outside 270 degrees) facing west."""
+    case = tmp_path / "crossing.toml"
+    case.write_text(scenario_text(CROSSING, 'profile = "jackal"\nstart = [1.0, 3.0]\ngoal = [9.0, 3.0]'))
+    return load_scenario(str(case))
+
+
+def _scan_of(centre, radius, here, beams):
+    """`beams` beams of a robot at `here` facing east toward a disc, and their ranges (m)."""
+    offset = np.asarray(centre) - here
+    toward = math.atan2(offset[1], offset[0])
+    bearings = toward + np.linspace(-0.02, 0.02, beams)
+    along = np.hypot(*offset) * np.cos(bearings - toward)
+    across = np.hypot(*offset) * np.sin(bearings - toward)
+    return bearings, along - np.sqrt(radius**2 - across**2)
+
+
+def test_true_tracks_hand_over_what_the_laser_could_see_late_and_coast_out_of_view(tmp_path):
+    scenario = _crossing_scenario(tmp_path)
+    ceiling, scans = benchmark_module("dynabarn_ceiling"), _Scans()
+    truth = ceiling.TrueTracks(scans, scenario, ceiling.Handover(echoes=0, latency_s=0.1))
+    here, nothing = np.array([1.0, 3.0]), (np.zeros(0), np.zeros(0))
+    assert truth.update(0.0, here, 0.0, *nothing) == ()  # in view, not yet for 0.1 s
+    (track,) = truth.update(0.1, here, 0.0, *nothing)
+    np.testing.assert_allclose(track.position, scenario.world.moving[0].motion.position(0.1))
+    np.testing.assert_allclose(track.velocity, (0.0, 1.25))
+    assert track.radius_m == 0.4 and track.moving and track.position_std_m == 0.0
+    (coasting,) = truth.update(1.0, here, math.pi, *nothing)  # behind: it coasts at its velocity
+    np.testing.assert_allclose(coasting.position, track.position + 0.9 * track.velocity)
+    assert coasting.last_seen_s == 0.1 and coasting.stamp_s == 1.0
+    assert truth.update(2.2, here, math.pi, *nothing) == ()  # unseen for longer than coast_s (2 s)
+    assert truth.update(2.3, here, 0.0, *nothing) == ()  # back in view: late again
+    assert scans.scans == 5
+
+
+def test_true_tracks_of_what_the_scan_shows_need_echoes_on_the_obstacle(tmp_path):
+    scenario = _crossing_scenario(tmp_path)
+    ceiling = benchmark_module("dynabarn_ceiling")
+    truth = ceiling.TrueTracks(_Scans(), scenario, ceiling.Handover(echoes=3))
+    here, centre = np.array([1.0, 3.0]), scenario.world.moving[0].motion.position(0.5)
+    assert truth.update(0.5, here, 0.0, np.zeros(0), np.zeros(0)) == ()  # in view, no echo on it
+    assert truth.update(0.55, here, 0.0, *_scan_of(centre, 0.4, here, 2)) == ()  # two echoes: too few
+    (track,) = truth.update(0.5, here, 0.0, *_scan_of(centre, 0.4, here, 3))
+    np.testing.assert_allclose(track.position, centre)
+
+
+def test_dynabarn_ceiling_runs_each_mode_on_the_same_worlds(tmp_path):
+    out = run_benchmark(
+        "dynabarn_ceiling.py",
+        *("--count", "3", "--seeds", "0", "--modes", "tracker,seen", "--out", "c"),
+        cwd=tmp_path,
+    )
+    for mode in ("`tracker`", "`seen`"):
+        (row,) = table_rows(out, mode)
+        assert row[1] == "3" and 0 <= int(row[2]) <= 3 and int(row[2]) + int(row[4]) <= 3
+    assert (tmp_path / "c" / "dynabarn_ceiling.csv").is_file()
 
 
 def test_tracker_accuracy_scores_the_tracks_against_the_simulator(tmp_path):
