@@ -15,13 +15,18 @@ import math
 import sys
 from collections.abc import Callable, Collection
 from pathlib import Path
+from typing import Protocol
 
 from vplane_mj.bench.sweep import parse_seeds
 from vplane_mj.errors import VPlaneError
 from vplane_mj.planning.protocol.registry import PLANNERS
 from vplane_mj.scenario import resolve_path
 
-Main = Callable[[list[str] | None], int]
+
+class Main(Protocol):
+    """A script's `main`: its exit status for the command line `argv` (None: the process's)."""
+
+    def __call__(self, argv: list[str] | None = None) -> int: ...
 
 
 def whole(least: int) -> Callable[[str], int]:
