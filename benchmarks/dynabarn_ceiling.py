@@ -184,10 +184,11 @@ def main(argv: list[str] | None = None) -> int:
         "seen_late": Handover(args.echoes, args.latency),
         "in_view": Handover(0),
     }
+    cases = generate_dynabarn(args.count, args.world_seed)
     jobs = [
         (case.document, seed, mode, args.planner, args.noise, handovers[mode])
         for mode in args.modes
-        for case in generate_dynabarn(args.count, args.world_seed)
+        for case in cases
         for seed in args.seeds
     ]
     with ProcessPoolExecutor(args.jobs) as pool:
