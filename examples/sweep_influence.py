@@ -28,6 +28,7 @@ matplotlib.use("Agg")  # headless: files only, never a window
 import matplotlib.pyplot as plt
 
 import vplane_mj
+from vplane_mj.bench.sweep import parse_seeds  # the seeds as `vplane-mj bench` reads them
 
 PAPER_SCENARIOS = "paper_c_avoid,paper_c_escape,paper_h_avoid,paper_h_escape"
 
@@ -54,7 +55,12 @@ def parse_args() -> argparse.Namespace:
     parser.add_argument("--time-limit", type=float, help="simulated seconds per run (default: each world's)")
     parser.add_argument("--jobs", type=int, help="worker processes (default: one per core)")
     parser.add_argument("--out", type=Path, default=Path("logs/sweep_influence"), help="output directory")
-    return parser.parse_args()
+    args = parser.parse_args()
+    if args.jobs is not None and args.jobs < 1:
+        parser.error(f"argument --jobs: at least 1, not {args.jobs}")
+    if args.traps < 0:
+        parser.error(f"argument --traps: at least 0, not {args.traps}")
+    return args
 
 
 def generate_traps(count: int, seed: int, out_dir: Path) -> list[Path | str]:
@@ -95,16 +101,19 @@ def main() -> None:
     common = [f"sensors.noise_std={args.noise}"]
     if args.time_limit is not None:
         common.append(f"run.time_limit_s={args.time_limit}")
-    # Check every planner and value on a built-in world first: bad input stops before any file.
+    # Check every planner, value, named world and seed first: bad input stops before any file.
+    named = [name for name in args.scenarios.split(",") if name]
     for planner in planners:
         for value in values:
             choice = [*common, f"planner.name={planner}", f"planner.influence={value}"]
-            vplane_mj.load_scenario("open_field", overrides=choice)
+            for world in ["open_field", *named]:
+                vplane_mj.load_scenario(world, overrides=choice)
+    parse_seeds(args.seeds)
 
     worlds = generate_traps(args.traps, args.world_seed, args.out / "worlds")
     for world in worlds:
         print(f"wrote {world}")
-    worlds += [name for name in args.scenarios.split(",") if name]
+    worlds += named
 
     # One sweep per value: every world x planner x seed with planner.influence set to it.
     curves: dict[str, list[tuple[float, float, float | None]]] = {planner: [] for planner in planners}

@@ -126,6 +126,17 @@ def test_sweep_influence_refuses_a_planner_without_the_parameter(tmp_path):
     assert not (tmp_path / "influence.csv").exists()
 
 
+@pytest.mark.parametrize(
+    ("arguments", "named"),
+    [(("--seeds", "x"), "--seeds"), (("--jobs", "0"), "--jobs"), (("--scenarios", "nope"), "nope")],
+)
+def test_sweep_influence_refuses_bad_input_before_it_writes_the_trap_worlds(tmp_path, arguments, named):
+    out = tmp_path / "out"
+    stderr = run_example("sweep_influence.py", "--traps", "1", *arguments, "--out", str(out), expect=2)
+    assert named in stderr and "Traceback" not in stderr
+    assert not out.exists()
+
+
 def test_custom_world_is_validated_run_saved_and_runs_again_alike(tmp_path):
     stdout = run_example("custom_world.py", "--time-limit", "60", "--out", str(tmp_path))
     reason = "must be greater than 2*thickness (0.2), got 0.15"
