@@ -88,8 +88,7 @@ class TrueTracks:
         """The true tracks at `time_s` (s) for a robot at `xy` (m) facing `yaw` (rad), after the
         tracker took the scan (`bearings`, `ranges`; m)."""
         self.tracker.update(time_s, xy, yaw, bearings, ranges)
-        angles = yaw + bearings[np.isfinite(ranges)]
-        echoes = xy + ranges[np.isfinite(ranges), None] * np.column_stack((np.cos(angles), np.sin(angles)))
+        echoes = _echoes(xy, yaw, bearings, ranges) if self.handover.echoes else np.empty((0, 2))
         for k, obstacle in enumerate(self.obstacles):
             centre = obstacle.motion.position(time_s)
             if not self._shown(centre, self.radii[k], xy, yaw, echoes):
@@ -119,6 +118,14 @@ class TrueTracks:
         offset = centre - xy
         bearing = math.remainder(math.atan2(offset[1], offset[0]) - yaw, math.tau)
         return abs(bearing) <= self.half_view and math.hypot(offset[0], offset[1]) <= self.range_m
+
+
+def _echoes(xy: np.ndarray, yaw: float, bearings: np.ndarray, ranges: np.ndarray) -> np.ndarray:
+    """The scan's echoes (N, 2; m) of a robot at `xy` (m) facing `yaw` (rad): beams without one
+    left out."""
+    hit = np.isfinite(ranges)
+    angles = yaw + bearings[hit]
+    return xy + ranges[hit, None] * np.column_stack((np.cos(angles), np.sin(angles)))
 
 
 def _coasted(track: Track, time_s: float) -> Track:
